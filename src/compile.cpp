@@ -1,0 +1,259 @@
+// compile(spec): resolve names, switch on effects, mix per-pair parameters, check the time step.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "model.h"
+#include "timestep.h"
+#include "yaml_check.h"
+
+namespace dem {
+
+namespace {
+
+double mix(Mixing rule, double a, double b) {
+  switch (rule) {
+    case Mixing::arithmetic: return 0.5 * (a + b);
+    case Mixing::geometric: return std::sqrt(a * b);
+    case Mixing::harmonic: return (a > 0 && b > 0) ? 2.0 * a * b / (a + b) : 0.0;
+    case Mixing::minimum: return std::min(a, b);
+    case Mixing::maximum: return std::max(a, b);
+  }
+  return a;
+}
+
+/// 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (rigid: E = inf adds nothing).
+double effective_youngs(const Material& a, const Material& b) {
+  const double inv = (1 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus +
+                     (1 - b.poisson_ratio * b.poisson_ratio) / b.youngs_modulus;
+  return 1.0 / inv;
+}
+
+/// 1/G* = 2(2 - nu1)(1 + nu1)/E1 + 2(2 - nu2)(1 + nu2)/E2 (Mindlin; LIGGGHTS/EDEM form).
+double effective_shear(const Material& a, const Material& b) {
+  const double inv = 2 * (2 - a.poisson_ratio) * (1 + a.poisson_ratio) / a.youngs_modulus +
+                     2 * (2 - b.poisson_ratio) * (1 + b.poisson_ratio) / b.youngs_modulus;
+  return 1.0 / inv;
+}
+
+void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, int& param_cursor) {
+  if (choice.model == "none") return;
+  const EffectSpec* spec = find_effect(stage, choice.model);
+  ActiveEffect active{spec, param_cursor, model.history_width, {}};
+  for (const auto& [key, value] : choice.options) {
+    const auto option = std::find_if(spec->options.begin(), spec->options.end(),
+                                     [&](const OptionSpec& o) { return o.key == key; });
+    if (option == spec->options.end()) {
+      std::string valid = "model";
+      for (const auto& o : spec->options) valid += fmt::format(", {}", o.key);
+      throw CaseError(fmt::format("{}: contact.{}.{}: unknown option of '{}'; valid: {}", choice.location.str(),
+                                  kStageKeys[static_cast<int>(stage)], key, spec->name, valid));
+    }
+    const auto at = std::find(option->values.begin(), option->values.end(), value);
+    if (at == option->values.end()) {
+      std::string valid;
+      for (const auto& v : option->values) valid += (valid.empty() ? "" : ", ") + std::string(v);
+      throw CaseError(fmt::format("{}: contact.{}.{}: '{}' is not valid; valid: {}", choice.location.str(),
+                                  kStageKeys[static_cast<int>(stage)], key, value, valid));
+    }
+    active.options[option - spec->options.begin()] = static_cast<std::uint8_t>(at - option->values.begin());
+  }
+  for (const HistorySpec& h : spec->history) model.history_width += h.width;
+  param_cursor += static_cast<int>(spec->params.size()) + spec->derived_count;
+  model.effects.push_back(active);
+}
+
+const ParamSpec* active_param(const Model& model, std::string_view key) {
+  for (const ActiveEffect& e : model.effects)
+    for (const ParamSpec& p : e.spec->params)
+      if (p.key == key) return &p;
+  return nullptr;
+}
+
+void note_unused(Model& model, const std::map<std::string, double>& params,
+                 const std::map<std::string, SourceLocation>& where, const std::string& owner) {
+  for (const auto& [key, value] : params) {
+    if (active_param(model, key)) continue;
+    std::string effect;
+    for (const EffectSpec* e : effect_table())
+      for (const ParamSpec& p : e->params)
+        if (p.key == key && effect.empty()) effect = fmt::format("contact.{}: {}", kStageKeys[static_cast<int>(e->stage)], e->name);
+    model.notes.push_back(fmt::format("{}: {}.{} = {:g} has no effect: it belongs to {}, which this case does not switch on",
+                                      where.at(key).str(), owner, key, value, effect));
+  }
+}
+
+std::uint64_t fnv1a(const void* data, size_t bytes, std::uint64_t h) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 0x100000001b3ULL;
+  return h;
+}
+
+}  // namespace
+
+int Model::material_index(std::string_view name) const {
+  for (size_t k = 0; k < materials.size(); ++k)
+    if (materials[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+double Model::pair_param(int a, int b, std::string_view key) const {
+  for (const ActiveEffect& e : effects)
+    for (size_t k = 0; k < e.spec->params.size(); ++k)
+      if (e.spec->params[k].key == key) return pair_row(pair_type(a, b))[e.param_offset + k];
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+Model compile(const CaseSpec& spec) {
+  Model model;
+  model.source = spec.path;
+  model.title = spec.title;
+
+  for (const MaterialSpec& m : spec.materials)
+    model.materials.push_back({m.name, m.density, m.youngs_modulus, m.poisson_ratio});
+  auto material_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
+    const int index = model.material_index(name);
+    if (index >= 0) return index;
+    std::vector<std::string> names;
+    std::string list;
+    for (const auto& m : model.materials) names.push_back(m.name), list += (list.empty() ? "" : ", ") + m.name;
+    const std::string hint = nearest_word(name, names);
+    throw CaseError(fmt::format("{}: {}: unknown material '{}'{}; materials of this case: {}", where.str(), key, name,
+                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
+  };
+
+  // Effects in stage order.
+  int param_cursor = 2;  // columns 0, 1: E*, G*
+  const ContactSpec& c = spec.contact;
+  if (c.normal.model == "none")
+    throw CaseError(fmt::format("{}: contact.normal: a normal force law is required (hertz or linear)", c.normal.location.str()));
+  add_effect(model, c.normal, Stage::normal, param_cursor);
+  add_effect(model, c.damping, Stage::damping, param_cursor);
+  for (const auto& a : c.adhesion) add_effect(model, a, Stage::adhesion, param_cursor);
+  add_effect(model, c.tangential, Stage::tangential, param_cursor);
+  add_effect(model, c.rolling, Stage::rolling, param_cursor);
+  add_effect(model, c.twisting, Stage::twisting, param_cursor);
+  for (const auto& e : c.extra) add_effect(model, e, Stage::extra, param_cursor);
+  model.pair_stride = param_cursor;
+  for (const ActiveEffect& e : model.effects) {
+    if (!e.spec->requires_normal.empty() && e.spec->requires_normal != c.normal.model)
+      throw CaseError(fmt::format("{}: contact: '{}' is written for the '{}' normal law, but contact.normal is '{}'",
+                                  c.normal.location.str(), e.spec->name, e.spec->requires_normal, c.normal.model));
+  }
+
+  // Pair table: mixed material values, then explicit interactions, then derived values.
+  const int n = model.n_materials();
+  model.pair_table.assign(static_cast<size_t>(n) * n * model.pair_stride, 0.0);
+  auto value_of = [&](const MaterialSpec& m, const ParamSpec& p) {
+    const auto it = m.params.find(std::string(p.key));
+    return it == m.params.end() ? p.default_value : it->second;
+  };
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      double* row = model.pair_table.data() + static_cast<size_t>(model.pair_type(a, b)) * model.pair_stride;
+      row[0] = effective_youngs(model.materials[a], model.materials[b]);
+      row[1] = effective_shear(model.materials[a], model.materials[b]);
+      for (const ActiveEffect& e : model.effects)
+        for (size_t k = 0; k < e.spec->params.size(); ++k) {
+          const ParamSpec& p = e.spec->params[k];
+          row[e.param_offset + k] = mix(p.mixing, value_of(spec.materials[a], p), value_of(spec.materials[b], p));
+        }
+    }
+  }
+  for (size_t k = 0; k < spec.interactions.size(); ++k) {
+    const InteractionSpec& in = spec.interactions[k];
+    const std::string key = fmt::format("interactions[{}].materials", k);
+    const int a = material_or_fail(in.material_a, in.location, key);
+    const int b = material_or_fail(in.material_b, in.location, key);
+    for (const auto& [name, value] : in.params) {
+      for (const ActiveEffect& e : model.effects)
+        for (size_t p = 0; p < e.spec->params.size(); ++p)
+          if (e.spec->params[p].key == name) {
+            model.pair_table[static_cast<size_t>(model.pair_type(a, b)) * model.pair_stride + e.param_offset + p] = value;
+            model.pair_table[static_cast<size_t>(model.pair_type(b, a)) * model.pair_stride + e.param_offset + p] = value;
+          }
+    }
+    note_unused(model, in.params, in.where, fmt::format("interactions[{}]", k));
+  }
+  for (const MaterialSpec& m : spec.materials) note_unused(model, m.params, m.where, "materials." + m.name);
+  for (int t = 0; t < n * n; ++t)
+    for (const ActiveEffect& e : model.effects)
+      if (e.spec->derive) e.spec->derive(model.pair_table.data() + static_cast<size_t>(t) * model.pair_stride + e.param_offset);
+
+  // Walls and particle sources.
+  for (size_t k = 0; k < spec.planes.size(); ++k) {
+    const PlaneWallSpec& w = spec.planes[k];
+    model.planes.push_back({w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
+                            material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))});
+  }
+  model.radius_min = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < spec.particles.size(); ++k) {
+    const ParticleSetSpec& p = spec.particles[k];
+    model.sources.push_back({p, material_or_fail(p.material, p.location, fmt::format("particles[{}].material", k))});
+    model.radius_max = std::max(model.radius_max, 0.5 * p.diameter.largest());
+    model.radius_min = std::min(model.radius_min, 0.5 * p.diameter.smallest());
+  }
+
+  // Options.
+  const SimulationSpec& s = spec.simulation;
+  model.duration = s.duration;
+  model.gravity = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
+  model.seed = s.seed;
+  model.threads = s.threads;
+  model.skin = s.skin > 0 ? s.skin : 0.5 * model.radius_min;
+  model.has_domain = s.has_domain;
+  model.domain_min = {s.domain_min.x(), s.domain_min.y(), s.domain_min.z()};
+  model.domain_max = {s.domain_max.x(), s.domain_max.y(), s.domain_max.z()};
+  model.output = spec.output;
+  for (const ActiveEffect& e : model.effects) {
+    if (!e.spec->range) continue;
+    for (int t = 0; t < n * n; ++t) {
+      const double* row = model.pair_row(t);
+      model.interaction_range = std::max(model.interaction_range, e.spec->range(row, row + e.param_offset, model.radius_max));
+    }
+  }
+
+  model.advice = advise_time_step(model, s);
+  model.dt = model.advice.dt;
+  if (!model.advice.safe && s.refuse_unsafe_step)
+    throw CaseError(fmt::format("{}: simulation.time_step: {:g} s is unsafe for this material and particle size:\n{}\n"
+                                "Use a smaller step, `time_step: auto`, or `unsafe_time_step: warn` to run anyway.",
+                                spec.path, model.dt, model.advice.report));
+  if (!model.advice.safe) model.notes.push_back("time step is unsafe (unsafe_time_step: warn):\n" + model.advice.report);
+
+  // Hash of what determines the physics (checkpoints refuse a different model).
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  h = fnv1a(model.pair_table.data(), model.pair_table.size() * sizeof(double), h);
+  for (const ActiveEffect& e : model.effects) h = fnv1a(e.spec->name.data(), e.spec->name.size(), h);
+  h = fnv1a(&model.dt, sizeof model.dt, h);
+  h = fnv1a(model.gravity.data(), sizeof model.gravity, h);
+  for (const PlaneWall& w : model.planes) {
+    h = fnv1a(w.point.data(), sizeof w.point, h);
+    h = fnv1a(w.normal.data(), sizeof w.normal, h);
+  }
+  model.hash = h;
+  return model;
+}
+
+std::string describe_effects() {
+  std::string out;
+  for (const EffectSpec* e : effect_table()) {
+    out += fmt::format("contact.{}: {}\n    {}\n    source: {}\n", kStageKeys[static_cast<int>(e->stage)], e->name,
+                       e->summary, e->citation);
+    for (const ParamSpec& p : e->params)
+      out += fmt::format("    {:<26} [{}] default {:g}, range [{:g}, {:g}]{}: {}\n", p.key, p.unit, p.default_value,
+                         p.min_value, p.max_value, p.tunable ? ", tunable" : "", p.doc);
+    for (const OptionSpec& o : e->options) {
+      std::string values;
+      for (const auto& v : o.values) values += (values.empty() ? "" : " | ") + std::string(v);
+      out += fmt::format("    option {}: {} (default {}): {}\n", o.key, values, o.values[0], o.doc);
+    }
+    for (const HistorySpec& hs : e->history) out += fmt::format("    history: {} ({} values)\n", hs.name, hs.width);
+  }
+  return out;
+}
+
+}  // namespace dem

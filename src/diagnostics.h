@@ -1,0 +1,44 @@
+// Scalars of a state (energies, contacts, overlaps), a reproducibility hash, and the check for
+// numerical trouble.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "model.h"
+#include "state.h"
+#include "workspace.h"
+
+namespace dem {
+
+struct Scalars {
+  double time = 0;                 // [s]
+  std::int64_t step = 0;
+  std::size_t particles = 0;
+  double kinetic_translation = 0;  // [J]
+  double kinetic_rotation = 0;     // [J]
+  std::size_t contacts = 0;        ///< touching particle pairs and particle-wall contacts
+  double max_overlap_ratio = 0;    ///< largest overlap / smaller radius
+  double mean_overlap_ratio = 0;   ///< over touching contacts
+  double dt = 0;                   // [s]
+  std::int64_t lost = 0;
+};
+
+Scalars measure(const Model& model, const State& state, const Workspace& work);
+
+/// FNV-1a over position, velocity and angular velocity of every particle in id order, and the
+/// history of every contact in id order: equal hashes mean bitwise equal states.
+std::uint64_t state_hash(const State& state, int history_width);
+
+/// Numerical trouble the run cannot continue through; the message says where and why.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws NumericalError when a particle has a non-finite position or velocity, or an overlap
+/// beyond `max_overlap_ratio` of its radius, naming the particle and the likely cause.
+void check_numerics(const Model& model, const State& state, const Workspace& work, double max_overlap_ratio = 0.5);
+
+}  // namespace dem

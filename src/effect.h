@@ -1,0 +1,141 @@
+// A contact effect is one physical mechanism at a contact (Hertz normal force, restitution
+// damping, Coulomb friction, rolling resistance, a liquid bridge, ...). Each lives in one file
+// under src/effects/ and is registered in one row of src/effect_table.cpp.
+//
+// An effect declares
+//   - the stage it runs in (stages run in the order of `Stage`),
+//   - its parameter table (per material, mixed for unlike pairs), from which case parsing,
+//     validation, the documentation (`demdesign effects`) and calibration ranges all derive,
+//   - its options (model-wide choices such as the damping convention at the end of contact),
+//   - the per-contact history it needs, by name,
+//   - how far beyond touching it acts (liquid bridges, JKR necks),
+//   - a kernel that runs over a batch of contacts stored as columns.
+//
+// Rejected alternative: composing laws in the type system (LIGGGHTS/MercuryDPM templates).
+// Combinations explode and errors are opaque; a batch loop through a short table of kernels
+// costs one indirect call per effect per 64 contacts.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace dem {
+
+/// Order in which effects run at a contact. Later stages read what earlier ones wrote.
+enum class Stage : std::uint8_t { normal, damping, adhesion, tangential, rolling, twisting, extra };
+inline constexpr std::array<std::string_view, 7> kStageKeys = {
+    "normal", "damping", "adhesion", "tangential", "rolling", "twisting", "extra"};
+/// Stages that take any number of effects (a YAML list); the others take exactly one or none.
+inline constexpr bool stage_is_additive(Stage s) { return s == Stage::adhesion || s == Stage::extra; }
+
+/// How a per-material parameter combines for a contact between two different materials.
+/// Explicit `interactions:` entries in a case override any rule.
+enum class Mixing : std::uint8_t { arithmetic, geometric, harmonic, minimum, maximum };
+
+/// One row of an effect's parameter table.
+struct ParamSpec {
+  std::string_view key;   ///< key in a material's YAML map
+  std::string_view unit;  ///< SI unit, "-" when dimensionless
+  double default_value;
+  double min_value;  ///< inclusive
+  double max_value;  ///< inclusive
+  Mixing mixing;
+  bool tunable;  ///< calibration may vary it
+  std::string_view doc;
+};
+
+/// A model-wide choice of an effect, given as `stage: {model: NAME, OPTION: VALUE}`.
+struct OptionSpec {
+  std::string_view key;
+  std::span<const std::string_view> values;  ///< allowed values; values[0] is the default
+  std::string_view doc;
+};
+
+/// Per-contact state an effect keeps from step to step, in doubles.
+struct HistorySpec {
+  std::string_view name;
+  int width;
+};
+
+/// Contacts evaluated together. Columns, so kernels stream through them; 64 contacts keep a
+/// batch (about 30 doubles a contact, 15 KiB) inside L1.
+inline constexpr int kBatch = 64;
+
+struct ContactBatch {
+  int count = 0;
+  // --- inputs, filled by the contact geometry ----------------------------------------------
+  int pair_type[kBatch];              ///< row of the model's pair table
+  double overlap[kBatch];             ///< [m] positive when the bodies overlap, negative: gap
+  double nx[kBatch], ny[kBatch], nz[kBatch];  ///< unit normal, from body j towards body i
+  double vn[kBatch];                  ///< [m/s] normal relative velocity (v_i - v_j)·n, < 0 approaching
+  double vtx[kBatch], vty[kBatch], vtz[kBatch];  ///< [m/s] tangential relative velocity at the contact
+  double wx[kBatch], wy[kBatch], wz[kBatch];     ///< [rad/s] relative angular velocity w_i - w_j
+  double radius_i[kBatch];            ///< [m]
+  double radius_j[kBatch];            ///< [m] 0 for a wall (flat, infinite radius)
+  double r_eff[kBatch];               ///< [m] R* = R_i R_j/(R_i + R_j), R_i for a wall
+  double m_eff[kBatch];               ///< [kg] m* = m_i m_j/(m_i + m_j), m_i for a wall
+  double inertia_eff[kBatch];         ///< [kg m^2] reduced moment of inertia about the contact point
+  double* history[kBatch];            ///< this contact's history row (all effects' slots)
+  // --- written by effects, in stage order ---------------------------------------------------
+  double fn[kBatch];                  ///< [N] normal force on i along n (positive: repulsive)
+  double fn_elastic[kBatch];          ///< [N] elastic part of fn (set by the normal stage)
+  double load[kBatch];                ///< [N] normal load for friction limits, set after damping
+  double kn[kBatch], kt[kBatch];      ///< [N/m] normal and tangential stiffness now
+  double damp_sn[kBatch], damp_st[kBatch];  ///< [N/m] stiffness the damping law scales with
+  double damp_shape[kBatch];          ///< [-] 1 for a linear law, sqrt(5/6) for Hertz (Tsuji form)
+  double gamma_n[kBatch], gamma_t[kBatch];  ///< [N s/m] damping coefficients
+  double ftx[kBatch], fty[kBatch], ftz[kBatch];  ///< [N] tangential force on i
+  double mx[kBatch], my[kBatch], mz[kBatch];     ///< [N m] torque on i not from ft (rolling, ...)
+  double energy_dissipated[kBatch];   ///< [J] this step, by friction and damping (diagnostic)
+};
+
+/// What a kernel needs besides the batch.
+struct EffectContext {
+  const double* pair_table;  ///< rows of mixed parameters, `pair_stride` doubles each
+  int pair_stride;
+  int param_offset;    ///< where this effect's parameters start in a row
+  int history_offset;  ///< where this effect's history starts in a contact's row
+  const std::uint8_t* options;  ///< this effect's option choices, index into OptionSpec::values
+  double dt;           ///< [s] time step
+  /// This effect's k-th parameter for contact c.
+  double param(const ContactBatch& b, int c, int k) const {
+    return pair_table[b.pair_type[c] * pair_stride + param_offset + k];
+  }
+  /// Column 0 and 1 of every pair row: effective Young's and shear modulus.
+  double youngs_eff(const ContactBatch& b, int c) const { return pair_table[b.pair_type[c] * pair_stride]; }
+  double shear_eff(const ContactBatch& b, int c) const { return pair_table[b.pair_type[c] * pair_stride + 1]; }
+  double* hist(const ContactBatch& b, int c) const { return b.history[c] + history_offset; }
+};
+
+using EffectKernel = void (*)(const EffectContext&, ContactBatch&);
+/// Largest gap [m] at which the effect still acts for one pair row (0: only when touching).
+/// `row` is the whole pair row (row[0] = E*, row[1] = G*), `params` this effect's part of it,
+/// `radius_max` the largest particle radius of the case.
+using EffectRange = double (*)(const double* row, const double* params, double radius_max);
+
+struct EffectSpec {
+  Stage stage;
+  std::string_view name;      ///< the value that selects it in YAML, e.g. "hertz"
+  std::string_view summary;   ///< one line
+  std::string_view citation;  ///< source of the formulas
+  std::span<const ParamSpec> params;
+  std::span<const OptionSpec> options;
+  std::span<const HistorySpec> history;
+  EffectKernel kernel;
+  EffectRange range;  ///< nullptr: acts only while touching
+  /// Values computed once per pair row from the parameters (e.g. a damping ratio from the
+  /// restitution coefficient), stored right after the parameters; `derive` fills them.
+  int derived_count = 0;
+  void (*derive)(double* row_params) = nullptr;
+  /// Effects this one is written for (e.g. JKR adds to Hertz); empty: any.
+  std::string_view requires_normal;
+};
+
+/// The checked-in table of every effect (src/effect_table.cpp).
+std::span<const EffectSpec* const> effect_table();
+/// nullptr when no effect of that stage has that name.
+const EffectSpec* find_effect(Stage stage, std::string_view name);
+
+}  // namespace dem

@@ -1,0 +1,100 @@
+// The compiled, immutable form of a case: materials, the contact law as an ordered list of
+// effects with their mixed per-pair parameters, walls, options. Built once by `compile`; the
+// simulation only reads it. Everything that changes is in State (state.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "effect.h"
+#include "spec.h"
+
+namespace dem {
+
+struct Material {
+  std::string name;
+  double density;         // [kg/m^3]
+  double youngs_modulus;  // [Pa]; +inf for a rigid wall
+  double poisson_ratio;   // [-]
+};
+
+/// An effect switched on by the case, with where its data sit.
+struct ActiveEffect {
+  const EffectSpec* spec;
+  int param_offset;    ///< in a pair row
+  int history_offset;  ///< in a contact's history row
+  std::array<std::uint8_t, 4> options{};  ///< chosen value index per OptionSpec
+};
+
+/// Infinite plane; particles live on the side the normal points to.
+struct PlaneWall {
+  std::string name;
+  std::array<double, 3> point;   // [m]
+  std::array<double, 3> normal;  // unit
+  int material;
+};
+
+/// A set of particles to create at t = 0, with its material resolved.
+struct ParticleSource {
+  ParticleSetSpec spec;
+  int material;
+};
+
+/// What the time-step advisor found; printed at start and written with results.
+struct TimeStepAdvice {
+  double rayleigh_time = 0;          // [s] smallest particle, stiffest material
+  double contact_time = 0;           // [s] shortest binary contact at characteristic_velocity
+  double characteristic_velocity = 0;  // [m/s]
+  double dt = 0;                     // [s] step used
+  bool user_given = false;
+  bool safe = true;
+  std::string report;                // human-readable lines
+};
+
+struct Model {
+  std::string source;  ///< case file
+  std::string title;
+  std::vector<Material> materials;
+
+  // Contact law: effects in stage order, parameters per material pair.
+  std::vector<ActiveEffect> effects;
+  int history_width = 0;           ///< doubles of history per contact
+  int pair_stride = 0;             ///< doubles per pair row: E*, G*, then each effect's params
+  std::vector<double> pair_table;  ///< (n_materials^2 x pair_stride)
+  double interaction_range = 0;    ///< [m] largest gap at which any effect acts
+
+  std::vector<PlaneWall> planes;
+  std::vector<ParticleSource> sources;
+
+  double dt = 0;                  // [s]
+  double duration = 0;            // [s]
+  std::array<double, 3> gravity;  // [m/s^2]
+  double skin = 0;                // [m] Verlet skin
+  double radius_max = 0;          // [m] largest particle radius the case can create
+  double radius_min = 0;          // [m]
+  std::uint64_t seed = 1;
+  int threads = 0;
+  bool has_domain = false;
+  std::array<double, 3> domain_min{}, domain_max{};  // [m]
+  TimeStepAdvice advice;
+  OutputSpec output;
+  std::vector<std::string> notes;  ///< warnings found while compiling (unused parameters, ...)
+  std::uint64_t hash = 0;          ///< of everything above that changes the physics
+
+  int n_materials() const { return static_cast<int>(materials.size()); }
+  int pair_type(int a, int b) const { return a * n_materials() + b; }
+  const double* pair_row(int type) const { return pair_table.data() + static_cast<size_t>(type) * pair_stride; }
+  /// Value of a named parameter for a material pair; NaN when no active effect has it.
+  double pair_param(int a, int b, std::string_view key) const;
+  int material_index(std::string_view name) const;  ///< -1 when absent
+};
+
+/// Checks the spec and builds the model. Throws CaseError naming file, line and key.
+Model compile(const CaseSpec& spec);
+
+/// The effect documentation table (`demdesign effects`).
+std::string describe_effects();
+
+}  // namespace dem

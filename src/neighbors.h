@@ -1,0 +1,18 @@
+// Linked cells with a Verlet skin. The contact lists are rebuilt only when some particle has
+// moved more than half the skin since the last rebuild; at each rebuild particles leaving the
+// domain are removed, the particle slots are sorted by cell (neighbours near in memory), and
+// every contact's history is carried to its new slot by particle id.
+#pragma once
+
+#include "model.h"
+#include "state.h"
+#include "workspace.h"
+
+namespace dem {
+
+/// True when the lists no longer cover every contact that could form.
+bool needs_rebuild(const Model& model, const State& state, const Workspace& work);
+/// Rebuilds the contact lists (see above).
+void rebuild_contacts(const Model& model, State& state, Workspace& work);
+
+}  // namespace dem

@@ -1,0 +1,44 @@
+// Running a compiled case from its initial state to its end time: progress with time left,
+// per-step scalars to CSV (written atomically), numerical checks.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "diagnostics.h"
+#include "model.h"
+#include "state.h"
+#include "workspace.h"
+
+namespace dem {
+
+struct RunOptions {
+  double duration = -1;           ///< [s] overrides the case's when >= 0
+  std::int64_t max_steps = -1;    ///< stop after this many steps when >= 0 (shortened runs)
+  std::string output_directory;   ///< overrides the case's when not empty
+  bool write_files = true;
+  bool progress = true;
+};
+
+struct RunSummary {
+  std::int64_t steps = 0;
+  double wall_seconds = 0;
+  double particle_steps_per_second = 0;
+  std::vector<Scalars> scalars;
+  std::string output_directory;
+};
+
+/// Prints the model's set-up (effects, time-step advice, notes) to `log`.
+void print_setup(const Model& model, const State& state, std::ostream& log);
+
+/// Runs from the state as it is (prepare() is called here). `log` gets the set-up, progress
+/// and summary lines.
+RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
+
+/// Writes `content` to `path` through a temporary file and a rename, so a reader never sees a
+/// half-written file. Creates the parent directory.
+void write_file_atomically(const std::string& path, const std::string& content);
+
+}  // namespace dem

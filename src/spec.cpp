@@ -1,0 +1,356 @@
+// Reading a case file into a CaseSpec. The YAML layout is documented in cases/hello_sphere.yaml
+// and README.md; every key read here is checked for type and range.
+#include "spec.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <limits>
+
+#include "effect.h"
+#include "yaml_check.h"
+
+namespace dem {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Parameter keys of every effect, for checking material and interaction maps.
+const ParamSpec* find_param(const std::string& key) {
+  for (const EffectSpec* effect : effect_table())
+    for (const ParamSpec& p : effect->params)
+      if (p.key == key) return &p;
+  return nullptr;
+}
+
+std::vector<std::string> all_param_keys() {
+  std::vector<std::string> keys;
+  for (const EffectSpec* effect : effect_table())
+    for (const ParamSpec& p : effect->params) keys.emplace_back(p.key);
+  return keys;
+}
+
+/// Reads the effect parameters of a material or interaction map (all keys not in `fixed`).
+void read_effect_params(MapReader& map, const std::vector<std::string>& fixed, std::map<std::string, double>& params,
+                        std::map<std::string, SourceLocation>& where) {
+  std::vector<std::string> valid = fixed;
+  const auto keys = all_param_keys();
+  valid.insert(valid.end(), keys.begin(), keys.end());
+  for (const std::string& key : map.keys()) {
+    if (std::find(fixed.begin(), fixed.end(), key) != fixed.end()) continue;
+    const ParamSpec* p = find_param(key);
+    if (!p) continue;  // reported by finish() with a suggestion
+    params[key] = map.number(key, p->default_value, p->min_value, p->max_value, p->unit);
+    where[key] = map.where(key);
+  }
+  map.finish(valid);
+}
+
+MaterialSpec read_material(const std::string& name, const YAML::Node& node, const std::string& file) {
+  MapReader map(node, file, "materials." + name);
+  MaterialSpec m;
+  m.name = name;
+  m.location = map.location();
+  m.density = map.required_number("density", 1.0, 1e5, "kg/m^3");
+  m.youngs_modulus = map.required_number("youngs_modulus", 1e3, kInf, "Pa");
+  m.poisson_ratio = map.number("poisson_ratio", 0.25, -0.99, 0.499, "-");
+  read_effect_params(map, {"density", "youngs_modulus", "poisson_ratio"}, m.params, m.where);
+  return m;
+}
+
+ContactSpec::Choice read_choice(const YAML::Node& node, const std::string& file, const std::string& path,
+                                MapReader& parent, const std::string& key) {
+  ContactSpec::Choice choice;
+  choice.location = parent.at(node);
+  if (node.IsScalar()) {
+    choice.model = node.Scalar();
+    return choice;
+  }
+  if (!node.IsMap()) parent.fail(key, "must be a model name or a map {model: NAME, OPTION: VALUE}");
+  MapReader map(node, file, path);
+  choice.model = map.string("model", "");
+  if (choice.model.empty()) map.fail("model", "missing: name the model");
+  for (const std::string& k : map.keys())
+    if (k != "model") choice.options[k] = map.string(k, "");
+  return choice;
+}
+
+std::vector<std::string> effect_names(Stage stage, bool with_none) {
+  std::vector<std::string> names;
+  if (with_none) names.emplace_back("none");
+  for (const EffectSpec* e : effect_table())
+    if (e->stage == stage) names.emplace_back(e->name);
+  return names;
+}
+
+void check_choice(const ContactSpec::Choice& c, Stage stage, const std::string& path) {
+  const auto valid = effect_names(stage, !stage_is_additive(stage));
+  if (std::find(valid.begin(), valid.end(), c.model) != valid.end()) return;
+  const std::string hint = nearest_word(c.model, valid);
+  std::string list;
+  for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+  throw CaseError(fmt::format("{}: {}: '{}' is not a {} model{}; valid: {}", c.location.str(), path, c.model,
+                              kStageKeys[static_cast<int>(stage)],
+                              hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
+}
+
+ContactSpec read_contact(const YAML::Node& node, const std::string& file) {
+  ContactSpec contact;
+  if (!node) return contact;
+  MapReader map(node, file, "contact");
+  const std::pair<Stage, ContactSpec::Choice*> single[] = {{Stage::normal, &contact.normal},
+                                                           {Stage::damping, &contact.damping},
+                                                           {Stage::tangential, &contact.tangential},
+                                                           {Stage::rolling, &contact.rolling},
+                                                           {Stage::twisting, &contact.twisting}};
+  for (auto [stage, choice] : single) {
+    const std::string key(kStageKeys[static_cast<int>(stage)]);
+    if (!map.has(key)) {
+      map.node(key);
+      continue;
+    }
+    *choice = read_choice(map.node(key), file, "contact." + key, map, key);
+    check_choice(*choice, stage, "contact." + key);
+  }
+  for (Stage stage : {Stage::adhesion, Stage::extra}) {
+    const std::string key(kStageKeys[static_cast<int>(stage)]);
+    const YAML::Node list = map.node(key);
+    if (!list) continue;
+    if (!list.IsSequence()) map.fail(key, "must be a list of models, e.g. [liquid_bridge]");
+    auto& out = stage == Stage::adhesion ? contact.adhesion : contact.extra;
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string path = fmt::format("contact.{}[{}]", key, k);
+      out.push_back(read_choice(list[k], file, path, map, key));
+      check_choice(out.back(), stage, path);
+    }
+  }
+  map.finish();
+  return contact;
+}
+
+SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
+  SizeDistributionSpec d;
+  const YAML::Node node = parent.node("diameter");
+  if (!node) parent.fail("diameter", "missing: give a diameter [m] or {distribution: normal|uniform|discrete, ...}");
+  if (node.IsScalar()) {
+    d.value = MapReader::scalar_number(node, parent, "diameter");
+    if (!(d.value > 0 && d.value < 10)) parent.fail("diameter", fmt::format("{:g} m is out of range; valid: (0, 10] m", d.value));
+    return d;
+  }
+  MapReader map(node, file, parent.key_path("diameter"));
+  const std::string kind = map.string("distribution", "", {"normal", "uniform", "discrete"});
+  if (kind.empty()) map.fail("distribution", "missing: normal, uniform or discrete");
+  if (kind == "normal") {
+    d.kind = SizeDistributionSpec::Kind::normal;
+    d.mean = map.required_number("mean", 1e-7, 10, "m");
+    d.std_dev = map.required_number("std", 0, 10, "m");
+    d.min = map.number("min", std::max(d.mean - 3 * d.std_dev, 0.1 * d.mean), 1e-7, 10, "m");
+    d.max = map.number("max", d.mean + 3 * d.std_dev, 1e-7, 10, "m");
+    if (!(d.min <= d.mean && d.mean <= d.max)) map.fail("min", "needs min <= mean <= max");
+  } else if (kind == "uniform") {
+    d.kind = SizeDistributionSpec::Kind::uniform;
+    d.min = map.required_number("min", 1e-7, 10, "m");
+    d.max = map.required_number("max", d.min, 10, "m");
+  } else {
+    d.kind = SizeDistributionSpec::Kind::discrete;
+    const YAML::Node values = map.node("values"), fractions = map.node("mass_fractions");
+    if (!values || !values.IsSequence() || values.size() == 0) map.fail("values", "must be a list of diameters [m]");
+    if (!fractions || !fractions.IsSequence() || fractions.size() != values.size())
+      map.fail("mass_fractions", "must be a list as long as 'values'");
+    double sum = 0;
+    for (size_t k = 0; k < values.size(); ++k) {
+      d.values.push_back(MapReader::scalar_number(values[k], map, "values"));
+      d.mass_fractions.push_back(MapReader::scalar_number(fractions[k], map, "mass_fractions"));
+      if (!(d.values.back() > 0)) map.fail("values", "diameters must be positive");
+      if (!(d.mass_fractions.back() >= 0)) map.fail("mass_fractions", "fractions must not be negative");
+      sum += d.mass_fractions.back();
+    }
+    if (std::abs(sum - 1.0) > 1e-6) map.fail("mass_fractions", fmt::format("sum to {:g}; they must sum to 1", sum));
+  }
+  map.finish();
+  return d;
+}
+
+ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("particles[{}]", index));
+  ParticleSetSpec p;
+  p.location = map.location();
+  p.material = map.string("material", "");
+  if (p.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  p.diameter = read_diameter(map, file);
+  p.velocity = map.vec3("velocity", p.velocity);
+  p.angular_velocity = map.vec3("angular_velocity", p.angular_velocity);
+  const YAML::Node positions = map.node("positions");
+  if (positions) {
+    if (!positions.IsSequence() || positions.size() == 0) map.fail("positions", "must be a list of [x, y, z] centres");
+    for (const auto& item : positions) {
+      if (!item.IsSequence() || item.size() != 3) map.fail("positions", "each entry must be [x, y, z]");
+      p.positions.emplace_back(MapReader::scalar_number(item[0], map, "positions"),
+                               MapReader::scalar_number(item[1], map, "positions"),
+                               MapReader::scalar_number(item[2], map, "positions"));
+    }
+    p.count = static_cast<int64_t>(p.positions.size());
+  } else {
+    p.count = map.integer("count", 0, 1, 100'000'000);
+    if (p.count == 0) map.fail("count", "missing: give `count` with a `region`, or explicit `positions`");
+    const YAML::Node region = map.node("region");
+    if (!region) map.fail("region", "missing: the box {min: [x,y,z], max: [x,y,z]} to place the particles in");
+    MapReader box(region, file, map.key_path("region"));
+    p.region_min = box.vec3("min", Vec3::Zero());
+    p.region_max = box.vec3("max", Vec3::Zero());
+    if (!(p.region_max.array() > p.region_min.array()).all()) box.fail("max", "each component must exceed min");
+    box.finish();
+  }
+  map.finish();
+  return p;
+}
+
+PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("walls[{}]", index));
+  PlaneWallSpec w;
+  w.location = map.location();
+  w.name = map.string("name", fmt::format("wall{}", index));
+  w.material = map.string("material", "");
+  if (w.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  const YAML::Node plane = map.node("plane");
+  if (!plane) map.fail("plane", "missing: {point: [x,y,z], normal: [x,y,z]} (the only wall kind so far)");
+  MapReader p(plane, file, map.key_path("plane"));
+  w.point = p.vec3("point", w.point);
+  w.normal = p.vec3("normal", w.normal);
+  if (w.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
+  w.normal.normalize();
+  p.finish();
+  map.finish();
+  return w;
+}
+
+SimulationSpec read_simulation(const YAML::Node& node, const std::string& file) {
+  SimulationSpec s;
+  if (!node) return s;
+  MapReader map(node, file, "simulation");
+  s.duration = map.required_number("duration", 0.0, 1e6, "s");
+  const YAML::Node step = map.node("time_step");
+  if (step && !(step.IsScalar() && step.Scalar() == "auto")) s.time_step = map.number("time_step", 0.0, 1e-12, 1.0, "s");
+  s.rayleigh_fraction = map.number("rayleigh_fraction", s.rayleigh_fraction, 0.01, 1.0);
+  s.refuse_unsafe_step = map.string("unsafe_time_step", "refuse", {"refuse", "warn"}) == "refuse";
+  s.characteristic_velocity = map.number("characteristic_velocity", 0.0, 0.0, 1e4, "m/s");
+  s.gravity = map.vec3("gravity", s.gravity);
+  s.seed = static_cast<uint64_t>(map.integer("seed", 1, 0, std::numeric_limits<int32_t>::max()));
+  s.threads = static_cast<int>(map.integer("threads", 0, 0, 1024));
+  s.skin = map.number("skin", 0.0, 0.0, 10.0, "m");
+  if (const YAML::Node domain = map.node("domain")) {
+    MapReader box(domain, file, "simulation.domain");
+    s.has_domain = true;
+    s.domain_min = box.vec3("min", Vec3::Zero());
+    s.domain_max = box.vec3("max", Vec3::Zero());
+    if (!(s.domain_max.array() > s.domain_min.array()).all()) box.fail("max", "each component must exceed min");
+    box.finish();
+  }
+  map.finish();
+  return s;
+}
+
+OutputSpec read_output(const YAML::Node& node, const std::string& file, const std::string& case_path) {
+  OutputSpec o;
+  o.directory = "out/" + std::filesystem::path(case_path).stem().string();
+  if (!node) return o;
+  MapReader map(node, file, "output");
+  o.directory = map.string("directory", o.directory);
+  o.scalars_every = map.integer("scalars_every", 0, 0, std::numeric_limits<int32_t>::max());
+  o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
+  map.finish();
+  return o;
+}
+
+CaseSpec read_case(const YAML::Node& root, const std::string& file) {
+  MapReader top(root, file, "");
+  CaseSpec spec;
+  spec.path = file;
+  spec.title = top.string("title", "");
+  spec.simulation = read_simulation(top.node("simulation"), file);
+  if (!top.has("simulation")) top.fail("simulation", "missing: give at least {duration: SECONDS}");
+
+  const YAML::Node materials = top.node("materials");
+  if (!materials || !materials.IsMap() || materials.size() == 0)
+    top.fail("materials", "missing: a map of material names to {density, youngs_modulus, ...}");
+  for (const auto& kv : materials) spec.materials.push_back(read_material(kv.first.as<std::string>(), kv.second, file));
+
+  if (const YAML::Node list = top.node("interactions")) {
+    if (!list.IsSequence()) top.fail("interactions", "must be a list of {materials: [A, B], KEY: VALUE}");
+    for (size_t k = 0; k < list.size(); ++k) {
+      MapReader map(list[k], file, fmt::format("interactions[{}]", k));
+      InteractionSpec in;
+      in.location = map.location();
+      const YAML::Node pair = map.node("materials");
+      if (!pair || !pair.IsSequence() || pair.size() != 2) map.fail("materials", "must name two materials, [A, B]");
+      in.material_a = pair[0].as<std::string>();
+      in.material_b = pair[1].as<std::string>();
+      read_effect_params(map, {"materials"}, in.params, in.where);
+      spec.interactions.push_back(std::move(in));
+    }
+  }
+  spec.contact = read_contact(top.node("contact"), file);
+  if (const YAML::Node walls = top.node("walls")) {
+    if (!walls.IsSequence()) top.fail("walls", "must be a list of walls");
+    for (size_t k = 0; k < walls.size(); ++k) spec.planes.push_back(read_wall(walls[k], file, k));
+  }
+  const YAML::Node particles = top.node("particles");
+  if (!particles || !particles.IsSequence() || particles.size() == 0)
+    top.fail("particles", "missing: a list of particle sets {material, diameter, count + region | positions}");
+  for (size_t k = 0; k < particles.size(); ++k) spec.particles.push_back(read_particles(particles[k], file, k));
+  spec.output = read_output(top.node("output"), file, file);
+  top.finish();
+  return spec;
+}
+
+YAML::Node load_yaml(const std::string& text, const std::string& name) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+}
+
+}  // namespace
+
+double SizeDistributionSpec::largest() const {
+  switch (kind) {
+    case Kind::fixed: return value;
+    case Kind::normal:
+    case Kind::uniform: return max;
+    case Kind::discrete: return *std::max_element(values.begin(), values.end());
+  }
+  return value;
+}
+
+double SizeDistributionSpec::smallest() const {
+  switch (kind) {
+    case Kind::fixed: return value;
+    case Kind::normal:
+    case Kind::uniform: return min;
+    case Kind::discrete: return *std::min_element(values.begin(), values.end());
+  }
+  return value;
+}
+
+CaseSpec parse_case_text(const std::string& text, const std::string& name) {
+  try {
+    return read_case(load_yaml(text, name), name);
+  } catch (const YAML::Exception& e) {
+    throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+}
+
+CaseSpec parse_case_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw CaseError(fmt::format("{}: cannot open the case file", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_case_text(text.str(), path);
+}
+
+}  // namespace dem

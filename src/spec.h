@@ -1,0 +1,129 @@
+// The authoring form of a case: what a YAML file says, with units (SI) and defaults filled in and
+// every key checked. `parse_case` reads it; `compile` (model.h) turns it into an immutable Model.
+// Tests build a spec from inline YAML text and edit its fields before compiling.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "vec3.h"
+
+namespace dem {
+
+/// Where a value came from, for error messages: "cases/x.yaml:12:5".
+struct SourceLocation {
+  std::string file;
+  int line = 0;    ///< 1-based; 0 when unknown
+  int column = 0;  ///< 1-based
+  std::string str() const;
+};
+
+/// A case that cannot be run as written. The message names file, line, key and what is valid.
+class CaseError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct MaterialSpec {
+  std::string name;
+  double density = 2500.0;        // [kg/m^3]
+  double youngs_modulus = 5e7;    // [Pa]; +inf: rigid
+  double poisson_ratio = 0.25;    // [-]
+  std::map<std::string, double> params;  ///< effect parameters given in the file, by key
+  std::map<std::string, SourceLocation> where;  ///< location of each given key
+  SourceLocation location;
+};
+
+/// Parameters for one unlike pair that replace the mixing rule.
+struct InteractionSpec {
+  std::string material_a, material_b;
+  std::map<std::string, double> params;
+  std::map<std::string, SourceLocation> where;
+  SourceLocation location;
+};
+
+/// The effects a case switches on, by stage, with their options.
+struct ContactSpec {
+  struct Choice {
+    std::string model;  ///< effect name; "none" switches the stage off
+    std::map<std::string, std::string> options;
+    SourceLocation location;
+  };
+  Choice normal{"hertz", {}, {}}, damping{"restitution", {}, {}}, tangential{"mindlin", {}, {}}, rolling{"none", {}, {}},
+      twisting{"none", {}, {}};
+  std::vector<Choice> adhesion, extra;
+};
+
+struct PlaneWallSpec {
+  std::string name;
+  Vec3 point{0, 0, 0};   // [m]
+  Vec3 normal{0, 0, 1};  // points into the region particles live in
+  std::string material;
+  SourceLocation location;
+};
+
+/// Particle diameters: fixed, or drawn from a truncated distribution.
+struct SizeDistributionSpec {
+  enum class Kind { fixed, normal, uniform, discrete } kind = Kind::fixed;
+  double value = 0.004;               // [m] fixed diameter
+  double mean = 0.0, std_dev = 0.0;   // [m] normal (by number)
+  double min = 0.0, max = 0.0;        // [m] truncation (normal) or range (uniform)
+  std::vector<double> values;         // [m] discrete diameters
+  std::vector<double> mass_fractions; // [-] discrete, sum to 1
+  double largest() const;
+  double smallest() const;
+};
+
+struct ParticleSetSpec {
+  std::string material;
+  SizeDistributionSpec diameter;
+  std::vector<Vec3> positions;  ///< explicit centres [m]; else `count` random in `region`
+  int64_t count = 0;
+  Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m] box
+  Vec3 velocity{0, 0, 0};          // [m/s]
+  Vec3 angular_velocity{0, 0, 0};  // [rad/s]
+  SourceLocation location;
+};
+
+struct SimulationSpec {
+  double duration = 1.0;          // [s]
+  double time_step = 0.0;         // [s]; 0: chosen by the advisor
+  double rayleigh_fraction = 0.2; // auto step as a fraction of the Rayleigh time
+  bool refuse_unsafe_step = true; // false: warn and run
+  double characteristic_velocity = 0.0;  // [m/s] impact speed for the contact-time check; 0: estimate
+  Vec3 gravity{0, 0, -9.81};      // [m/s^2]
+  uint64_t seed = 1;
+  int threads = 0;                // 0: OpenMP default
+  double skin = 0.0;              // [m] Verlet skin; 0: a quarter of the smallest diameter
+  bool has_domain = false;        // particles leaving the domain box are removed and counted
+  Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
+};
+
+struct OutputSpec {
+  std::string directory = "out";  ///< relative to the working directory
+  int64_t scalars_every = 0;      ///< steps between rows of scalars.csv; 0: about 200 rows
+  double progress_seconds = 2.0;  ///< wall-clock seconds between progress lines
+};
+
+struct CaseSpec {
+  std::string path;  ///< the file it was read from ("<inline>" for text)
+  std::string title;
+  SimulationSpec simulation;
+  std::vector<MaterialSpec> materials;
+  std::vector<InteractionSpec> interactions;
+  ContactSpec contact;
+  std::vector<PlaneWallSpec> planes;
+  std::vector<ParticleSetSpec> particles;
+  OutputSpec output;
+};
+
+/// Reads and checks a case file. Throws CaseError naming file, line and key.
+CaseSpec parse_case_file(const std::string& path);
+/// Same for YAML text (tests keep their model inline); `name` stands in for the file name.
+CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>");
+
+}  // namespace dem

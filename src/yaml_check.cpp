@@ -1,0 +1,183 @@
+#include "yaml_check.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dem {
+
+std::string SourceLocation::str() const {
+  if (line <= 0) return file;
+  return fmt::format("{}:{}:{}", file, line, column);
+}
+
+namespace {
+
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+std::string format_range(double min, double max) {
+  return fmt::format("[{:g}, {:g}]", min, max);
+}
+
+}  // namespace
+
+std::string nearest_word(std::string_view word, const std::vector<std::string>& valid) {
+  std::string best;
+  size_t best_distance = std::numeric_limits<size_t>::max();
+  for (const auto& v : valid) {
+    const size_t d = edit_distance(word, v);
+    if (d < best_distance) best_distance = d, best = v;
+  }
+  // Close enough to be a typo: at most a third of the word wrong.
+  if (best_distance <= std::max<size_t>(2, word.size() / 3)) return best;
+  return "";
+}
+
+MapReader::MapReader(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {
+  if (!node_.IsMap()) {
+    throw CaseError(fmt::format("{}: '{}' must be a map of keys to values", at(node_).str(),
+                                path_.empty() ? "the case" : path_));
+  }
+}
+
+SourceLocation MapReader::at(const YAML::Node& n) const {
+  const YAML::Mark mark = n.Mark();
+  if (mark.is_null()) return {file_, 0, 0};
+  return {file_, mark.line + 1, mark.column + 1};
+}
+
+bool MapReader::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+
+SourceLocation MapReader::where(const std::string& key) const {
+  const YAML::Node n = node_[key];
+  return n ? at(n) : at(node_);
+}
+
+std::vector<std::string> MapReader::keys() const {
+  std::vector<std::string> out;
+  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
+void MapReader::fail(const std::string& key, const std::string& message) const {
+  throw CaseError(fmt::format("{}: {}: {}", where(key).str(), key_path(key), message));
+}
+
+double MapReader::scalar_number(const YAML::Node& n, const MapReader& ctx, const std::string& key) {
+  if (!n.IsScalar()) ctx.fail(key, "must be a number");
+  const std::string text = n.Scalar();
+  if (text == "rigid" || text == "inf" || text == ".inf") return std::numeric_limits<double>::infinity();
+  try {
+    size_t used = 0;
+    const double value = std::stod(text, &used);
+    if (used != text.size()) throw std::invalid_argument(text);
+    return value;
+  } catch (const std::exception&) {
+    ctx.fail(key, fmt::format("'{}' is not a number", text));
+  }
+}
+
+double MapReader::number(const std::string& key, double fallback, double min, double max, std::string_view unit) {
+  used_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) return fallback;
+  const double value = scalar_number(n, *this, key);
+  if (std::isnan(value) || value < min || value > max) {
+    fail(key, fmt::format("{:g}{}{} is out of range; valid: {}{}", value, unit.empty() ? "" : " ", unit,
+                          format_range(min, max), unit.empty() ? "" : fmt::format(" {}", unit)));
+  }
+  return value;
+}
+
+double MapReader::required_number(const std::string& key, double min, double max, std::string_view unit) {
+  if (!has(key)) {
+    throw CaseError(fmt::format("{}: {}: missing; give a number in {}{}", at(node_).str(), key_path(key),
+                                format_range(min, max), unit.empty() ? "" : fmt::format(" {}", unit)));
+  }
+  return number(key, 0.0, min, max, unit);
+}
+
+int64_t MapReader::integer(const std::string& key, int64_t fallback, int64_t min, int64_t max) {
+  const double value = number(key, static_cast<double>(fallback), static_cast<double>(min), static_cast<double>(max));
+  if (value != std::floor(value)) fail(key, fmt::format("{:g} must be a whole number", value));
+  return static_cast<int64_t>(value);
+}
+
+bool MapReader::boolean(const std::string& key, bool fallback) {
+  used_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) return fallback;
+  const std::string text = n.IsScalar() ? n.Scalar() : "";
+  if (text == "true" || text == "yes" || text == "on") return true;
+  if (text == "false" || text == "no" || text == "off") return false;
+  fail(key, fmt::format("'{}' must be true or false", text));
+}
+
+std::string MapReader::string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+  used_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) return fallback;
+  if (!n.IsScalar()) fail(key, "must be a single word or text");
+  const std::string value = n.Scalar();
+  if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), value) == allowed.end()) {
+    const std::string hint = nearest_word(value, allowed);
+    fail(key, fmt::format("'{}' is not valid{}; valid: {}", value,
+                          hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), join(allowed)));
+  }
+  return value;
+}
+
+Vec3 MapReader::vec3(const std::string& key, const Vec3& fallback) {
+  used_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) return fallback;
+  if (!n.IsSequence() || n.size() != 3) fail(key, "must be a list of three numbers, e.g. [0, 0, -9.81]");
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) {
+    v[k] = scalar_number(n[k], *this, key);
+    if (!std::isfinite(v[k])) fail(key, "components must be finite numbers");
+  }
+  return v;
+}
+
+YAML::Node MapReader::node(const std::string& key) {
+  used_.insert(key);
+  return node_[key];
+}
+
+void MapReader::finish(const std::vector<std::string>& extra_valid) const {
+  std::vector<std::string> valid(used_.begin(), used_.end());
+  valid.insert(valid.end(), extra_valid.begin(), extra_valid.end());
+  std::sort(valid.begin(), valid.end());
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (used_.count(key) || std::find(extra_valid.begin(), extra_valid.end(), key) != extra_valid.end()) continue;
+    const std::string hint = nearest_word(key, valid);
+    throw CaseError(fmt::format("{}: {}: unknown key{}; valid keys here: {}", at(kv.first).str(), key_path(key),
+                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), join(valid)));
+  }
+}
+
+}  // namespace dem

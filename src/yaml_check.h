@@ -1,0 +1,62 @@
+// Checked reading of YAML maps: every key is looked up by name, every value is range-checked,
+// and keys nobody asked for are errors that suggest the nearest valid key. Messages name the
+// file, line, column and the full key path ("materials.glass.restitution").
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <initializer_list>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "spec.h"
+
+namespace dem {
+
+/// The valid word closest to `word` (edit distance), or "" when none is close.
+std::string nearest_word(std::string_view word, const std::vector<std::string>& valid);
+
+class MapReader {
+ public:
+  /// `path` is the key path of this map ("" at the top). Throws CaseError unless a map.
+  MapReader(const YAML::Node& node, std::string file, std::string path);
+
+  bool has(const std::string& key) const;
+  SourceLocation where(const std::string& key) const;  ///< of the value, or of the map
+  SourceLocation location() const { return at(node_); }
+  std::string key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  /// A number in [min, max]; `fallback` when absent.
+  double number(const std::string& key, double fallback, double min, double max, std::string_view unit = "");
+  /// A number that must be given.
+  double required_number(const std::string& key, double min, double max, std::string_view unit = "");
+  int64_t integer(const std::string& key, int64_t fallback, int64_t min, int64_t max);
+  bool boolean(const std::string& key, bool fallback);
+  /// A string; when `allowed` is not empty it must be one of them.
+  std::string string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed = {});
+  Vec3 vec3(const std::string& key, const Vec3& fallback);
+  /// The raw node (marks the key used); empty node when absent.
+  YAML::Node node(const std::string& key);
+  /// All keys, in file order.
+  std::vector<std::string> keys() const;
+
+  /// Error for a value of `key`, with location.
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  /// Throws for every key not read, naming the nearest of `valid` (or of the keys read).
+  void finish(const std::vector<std::string>& extra_valid = {}) const;
+
+  const std::string& file() const { return file_; }
+
+  SourceLocation at(const YAML::Node& n) const;
+  static double scalar_number(const YAML::Node& n, const MapReader& ctx, const std::string& key);
+
+ private:
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+  mutable std::set<std::string> used_;
+};
+
+}  // namespace dem

@@ -1,0 +1,48 @@
+// Every shipped case reads, compiles and runs (shortened to a few hundred steps).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+
+#include "run.h"
+#include "sim.h"
+
+namespace dem::test {
+namespace {
+
+std::vector<std::string> shipped_cases() {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(DEMDESIGN_SOURCE_DIR) + "/cases"))
+    if (entry.path().extension() == ".yaml") names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class ShippedCase : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ShippedCase, RunsShortened) {
+  const CaseSpec spec = load_case(GetParam());
+  const Model model = compile(spec);
+  State state = initial_state(model);
+  Workspace work;
+  RunOptions options;
+  options.max_steps = 300;
+  options.write_files = false;
+  options.progress = false;
+  std::ostringstream log;
+  const RunSummary summary = run(model, state, work, options, log);
+  EXPECT_GT(summary.steps, 0);
+  EXPECT_GT(state.size(), 0u);
+  EXPECT_TRUE(std::isfinite(summary.scalars.back().kinetic_translation)) << log.str();
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, ShippedCase, ::testing::ValuesIn(shipped_cases()),
+                         [](const auto& param_info) {
+                           std::string name = param_info.param.substr(0, param_info.param.size() - 5);
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace dem::test

@@ -1,0 +1,215 @@
+// Engine properties: energy conservation, determinism, contact history across rebuilds and
+// re-sorting, particle generation, the time-step advisor.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "neighbors.h"
+#include "sim.h"
+#include "timestep.h"
+
+namespace dem::test {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// Kinetic plus Hertz elastic energy 2/5 k delta^(5/2) of every touching contact [J].
+double total_energy(const Sim& sim) {
+  const State& s = sim.state;
+  const Model& m = sim.model;
+  double energy = 0;
+  for (size_t p = 0; p < s.size(); ++p) {
+    energy += 0.5 / s.inv_mass[p] * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
+    energy += 0.5 / s.inv_inertia[p] * (s.wx[p] * s.wx[p] + s.wy[p] * s.wy[p] + s.wz[p] * s.wz[p]);
+  }
+  const double E = m.pair_row(0)[0];
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
+    const size_t i = s.pairs.i[k], j = s.pairs.j[k];
+    const double d = overlap_of(s, i, j);
+    const double r = s.radius[i] * s.radius[j] / (s.radius[i] + s.radius[j]);
+    if (d > 0) energy += 0.4 * 4.0 / 3.0 * E * std::sqrt(r) * std::pow(d, 2.5);
+  }
+  for (size_t k = 0; k < s.wall_pairs.size(); ++k) {
+    const size_t i = s.wall_pairs.i[k];
+    const PlaneWall& w = m.planes[s.wall_pairs.j[k]];
+    const double d = s.radius[i] - ((s.x[i] - w.point[0]) * w.normal[0] + (s.y[i] - w.point[1]) * w.normal[1] +
+                                    (s.z[i] - w.point[2]) * w.normal[2]);
+    if (d > 0) energy += 0.4 * 4.0 / 3.0 * E * std::sqrt(s.radius[i]) * std::pow(d, 2.5);
+  }
+  return energy;
+}
+
+TEST(Energy, ElasticGranularGasConservesEnergyOverManyCollisions) {
+  // e = 1, mu = 0, no gravity: velocity Verlet keeps kinetic + elastic energy constant; the
+  // drift over thousands of collisions must stay below 1e-3 of the total.
+  Sim sim(load_case("elastic_gas.yaml"));
+  const double e0 = total_energy(sim);
+  std::set<std::pair<std::int64_t, std::int64_t>> touching;
+  long collisions = 0;
+  double worst = 0;
+  while (sim.state.time < 0.25) {
+    sim.advance();
+    std::set<std::pair<std::int64_t, std::int64_t>> now;
+    const State& s = sim.state;
+    for (size_t k = 0; k < s.pairs.size(); ++k)
+      if (overlap_of(s, s.pairs.i[k], s.pairs.j[k]) > 0)
+        now.insert({std::min(s.id[s.pairs.i[k]], s.id[s.pairs.j[k]]), std::max(s.id[s.pairs.i[k]], s.id[s.pairs.j[k]])});
+    for (const auto& c : now) collisions += !touching.count(c);
+    touching.swap(now);
+    if (sim.state.step % 50 == 0) worst = std::max(worst, std::abs(total_energy(sim) - e0) / e0);
+  }
+  EXPECT_GT(collisions, 2000);
+  EXPECT_LT(worst, 1e-3) << collisions << " particle collisions";
+}
+
+std::uint64_t settle_hash(int threads, int steps) {
+  omp_set_num_threads(threads);
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 1500;
+  Sim sim(spec);
+  for (int k = 0; k < steps; ++k) sim.advance();
+  return state_hash(sim.state, sim.model.history_width);
+}
+
+TEST(Determinism, SameHashOnRerunAndForOneAndTwoThreads) {
+  const int saved = omp_get_max_threads();
+  const std::uint64_t one = settle_hash(1, 1500);
+  const std::uint64_t two = settle_hash(2, 1500);
+  const std::uint64_t again = settle_hash(2, 1500);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(two, again) << "rerun";
+  EXPECT_EQ(one, two) << "1 versus 2 threads";
+}
+
+TEST(Neighbors, HistoryFollowsParticlesThroughRebuildAndResort) {
+  // Give every listed contact a history row unique to its particle ids, shuffle the particles'
+  // positions in memory by rebuilding after a move, and find each row again by ids.
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 3000;
+  Sim sim(spec);
+  for (int k = 0; k < 200; ++k) sim.advance();  // particles fall, lists are rebuilt and re-sorted
+  State& s = sim.state;
+  const int width = sim.model.history_width;
+  ASSERT_GT(width, 0);
+  std::map<std::pair<std::int64_t, std::int64_t>, double> expected;
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
+    const auto a = s.id[s.pairs.i[k]], b = s.id[s.pairs.j[k]];
+    const double tag = 1.0 + static_cast<double>(std::min(a, b) * 100000 + std::max(a, b));
+    for (int q = 0; q < width; ++q) s.pairs.history[k * width + q] = tag + q;
+    expected[{std::min(a, b), std::max(a, b)}] = tag;
+  }
+  ASSERT_GT(expected.size(), 100u);
+  // Reverse the particles' x order so the cell sort must move nearly every particle.
+  for (size_t p = 0; p < s.size(); ++p) s.x[p] = 0.08 - s.x[p];
+  rebuild_contacts(sim.model, s, sim.work);
+  size_t found = 0;
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
+    const auto a = s.id[s.pairs.i[k]], b = s.id[s.pairs.j[k]];
+    const auto it = expected.find({std::min(a, b), std::max(a, b)});
+    if (it == expected.end()) continue;
+    ++found;
+    for (int q = 0; q < width; ++q) ASSERT_EQ(s.pairs.history[k * width + q], it->second + q);
+  }
+  EXPECT_EQ(found, expected.size()) << "every pair still within reach keeps its history";
+}
+
+TEST(Particles, DiscreteDistributionHonoursMassFractions) {
+  SizeDistributionSpec d;
+  d.kind = SizeDistributionSpec::Kind::discrete;
+  d.values = {0.002, 0.004, 0.008};
+  d.mass_fractions = {0.2, 0.3, 0.5};
+  Random random(3);
+  std::map<double, double> mass;
+  double total = 0;
+  for (int k = 0; k < 200000; ++k) {
+    const double x = draw_diameter(d, random);
+    mass[x] += x * x * x, total += x * x * x;
+  }
+  for (size_t k = 0; k < d.values.size(); ++k) EXPECT_NEAR(mass[d.values[k]] / total, d.mass_fractions[k], 0.02);
+}
+
+TEST(Particles, TruncatedNormalStaysInBoundsWithTheRightMean) {
+  SizeDistributionSpec d;
+  d.kind = SizeDistributionSpec::Kind::normal;
+  d.mean = 0.004, d.std_dev = 0.0005, d.min = 0.003, d.max = 0.005;
+  Random random(5);
+  double sum = 0;
+  for (int k = 0; k < 100000; ++k) {
+    const double x = draw_diameter(d, random);
+    ASSERT_GE(x, d.min);
+    ASSERT_LE(x, d.max);
+    sum += x;
+  }
+  EXPECT_NEAR(sum / 100000, 0.004, 2e-5);
+}
+
+TEST(Particles, PlacementIsReproducibleAndWithoutOverlap) {
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 3000;
+  const Model model = compile(spec);
+  const State a = initial_state(model), b = initial_state(model);
+  EXPECT_EQ(state_hash(a, 0), state_hash(b, 0));
+  Workspace work;
+  State s = a;
+  rebuild_contacts(model, s, work);
+  for (size_t k = 0; k < s.pairs.size(); ++k) ASSERT_LE(overlap_of(s, s.pairs.i[k], s.pairs.j[k]), 0.0);
+  spec.simulation.seed = 43;
+  EXPECT_NE(state_hash(initial_state(compile(spec)), 0), state_hash(a, 0));
+}
+
+TEST(Particles, OverfullRegionIsAClearError) {
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 200000;
+  try {
+    initial_state(compile(spec));
+    FAIL() << "expected an error";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("particles[0]: placed"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TimeStep, RayleighTimeOfBenchmarkB1) {
+  // B1 spec: R = 2 mm, rho 2500, E 5e7, nu 0.25 -> T_R = 7.66e-5 s.
+  EXPECT_NEAR(rayleigh_time(0.002, 2500, 5e7, 0.25), 7.66e-5, 0.005 * 7.66e-5);
+  // Hertz contact time equals the CO-1 closed form (glass pair): 40.34 us.
+  const double m = 2800 * 4.0 / 3.0 * kPi * 1e-6;
+  const double e_star = 1.0 / (2 * (1 - 0.04) / 4.8e10);
+  EXPECT_NEAR(hertz_contact_time(0.5 * m, 0.005, e_star, 20.0), 40.34e-6, 0.005 * 40.34e-6);
+}
+
+TEST(TimeStep, UnsafeStepIsRefusedOrWarnedAsAsked) {
+  CaseSpec spec = load_case("hello_sphere.yaml");
+  spec.simulation.time_step = 1e-5;  // ~5 x the Rayleigh time of a 4 mm glass bead
+  EXPECT_THROW(compile(spec), CaseError);
+  spec.simulation.refuse_unsafe_step = false;
+  const Model model = compile(spec);
+  EXPECT_FALSE(model.advice.safe);
+  EXPECT_FALSE(model.notes.empty());
+}
+
+TEST(Numerics, BlowUpIsDetectedAndExplained) {
+  CaseSpec spec = load_case("hello_sphere.yaml");
+  spec.simulation.time_step = 2e-4;  // the bead moves half its radius per step
+  spec.simulation.refuse_unsafe_step = false;
+  spec.particles[0].velocity = Vec3(0, 0, -10);
+  spec.particles[0].positions[0] = Vec3(0, 0, 0.00201);
+  Sim sim(spec);
+  try {
+    for (int k = 0; k < 100; ++k) {
+      sim.advance();
+      check_numerics(sim.model, sim.state, sim.work);
+    }
+    FAIL() << "expected numerical trouble";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("particle 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("time step"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace dem::test
