@@ -2,6 +2,7 @@
 // then sums its contacts in list order, so the result is bitwise the same for any thread count.
 // Rejected alternative: atomics or thread-private force arrays; both make the summation order
 // (and so the last bits of every trajectory) depend on the number of threads.
+#include "parallel.h"
 #include "forces.h"
 
 #include <cmath>
@@ -160,7 +161,7 @@ void evaluate_effects(const Model& model, ContactBatch& b) {
 
 void compute_forces(const Model& model, State& s, Workspace& work) {
   const long n = static_cast<long>(s.size());
-#pragma omp parallel
+#pragma omp parallel if (n >= kParallelMin)
   {
     Batch batch;
     batch.b.count = 0;
@@ -176,7 +177,7 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
   const ContactForces& pf = work.pair_forces;
   const ContactForces& wf = work.wall_forces;
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
     double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
     for (std::int32_t k = work.pair_begin[p]; k < work.pair_begin[p + 1]; ++k) {

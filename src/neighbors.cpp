@@ -1,5 +1,7 @@
 #include "neighbors.h"
 
+#include "parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -105,7 +107,7 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work) {
   const double limit2 = 0.25 * model.skin * model.skin;
   const long n = static_cast<long>(s.size());
   int moved = 0;
-#pragma omp parallel for reduction(| : moved) schedule(static)
+#pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
     const double dx = s.x[p] - work.x_built[p], dy = s.y[p] - work.y_built[p], dz = s.z[p] - work.z_built[p];
     moved |= (dx * dx + dy * dy + dz * dz > limit2);
@@ -169,7 +171,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     }
   };
   const long nl = static_cast<long>(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
   for (long i = 0; i < nl; ++i) {
     std::int32_t k = 0;
     visit(static_cast<size_t>(i), [&](int) { ++k; });
@@ -180,7 +182,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const size_t n_pairs = static_cast<size_t>(work.pair_begin[n]);
   s.pairs.i.resize(n_pairs);
   s.pairs.j.resize(n_pairs);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
   for (long i = 0; i < nl; ++i) {
     std::int32_t k = work.pair_begin[i];
     visit(static_cast<size_t>(i), [&](int j) {

@@ -1,5 +1,7 @@
 #include "step.h"
 
+#include "parallel.h"
+
 #include "forces.h"
 #include "neighbors.h"
 
@@ -10,7 +12,7 @@ namespace {
 /// v += h F / m, w += h T / I.
 void kick(State& s, double h) {
   const long n = static_cast<long>(s.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
     const double a = h * s.inv_mass[p], b = h * s.inv_inertia[p];
     s.vx[p] += a * s.fx[p], s.vy[p] += a * s.fy[p], s.vz[p] += a * s.fz[p];
@@ -21,7 +23,7 @@ void kick(State& s, double h) {
 /// x += h v.
 void drift(State& s, double h) {
   const long n = static_cast<long>(s.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
 }
 
