@@ -170,7 +170,8 @@ std::size_t particle_bytes_held(const dem::State& s) {
   for (const auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty,
                         &s.tz, &s.radius, &s.inv_mass, &s.inv_inertia})
     b += bytes(*c);
-  return b + bytes(s.material) + bytes(s.id);
+  for (const auto* c : {&s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built, &s.z_built}) b += bytes(*c);
+  return b + bytes(s.material) + bytes(s.id) + bytes(s.body);
 }
 
 std::size_t contact_list_bytes(const dem::ContactList& c) { return bytes(c.i) + bytes(c.j) + bytes(c.history); }
@@ -181,7 +182,7 @@ std::size_t contact_forces_bytes(const dem::ContactForces& f) {
 }
 
 std::size_t workspace_bytes(const dem::Workspace& w) {
-  return bytes(w.x_built) + bytes(w.y_built) + bytes(w.z_built) + bytes(w.pair_begin) + bytes(w.incoming_begin) +
+  return bytes(w.pair_begin) + bytes(w.incoming_begin) +
          bytes(w.incoming) + bytes(w.wall_begin) + contact_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order);
 }

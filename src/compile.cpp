@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "model.h"
+#include "clump_geometry.h"
 #include "timestep.h"
 #include "yaml_check.h"
 
@@ -114,6 +115,21 @@ Model compile(const CaseSpec& spec) {
 
   for (const MaterialSpec& m : spec.materials)
     model.materials.push_back({m.name, m.density, m.youngs_modulus, m.poisson_ratio});
+  // Mass scaling and reduced stiffness act on the materials particles are made of.
+  model.mass_scaling = spec.simulation.mass_scaling;
+  model.stiffness_scaling = spec.simulation.stiffness_scaling;
+  {
+    std::vector<std::uint8_t> particle_material(model.materials.size(), 0);
+    for (const auto& p : spec.particles)
+      if (const int k = model.material_index(p.material); k >= 0) particle_material[k] = 1;
+    for (const auto& in : spec.inlets)
+      if (const int k = model.material_index(in.material); k >= 0) particle_material[k] = 1;
+    for (size_t k = 0; k < model.materials.size(); ++k) {
+      if (!particle_material[k]) continue;
+      model.materials[k].density *= model.mass_scaling;
+      model.materials[k].youngs_modulus *= model.stiffness_scaling;
+    }
+  }
   auto material_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
     const int index = model.material_index(name);
     if (index >= 0) return index;
@@ -183,19 +199,77 @@ Model compile(const CaseSpec& spec) {
     for (const ActiveEffect& e : model.effects)
       if (e.spec->derive) e.spec->derive(model.pair_table.data() + static_cast<size_t>(t) * model.pair_stride + e.param_offset);
 
-  // Walls and particle sources.
+  // Walls.
   for (size_t k = 0; k < spec.planes.size(); ++k) {
     const PlaneWallSpec& w = spec.planes[k];
-    model.planes.push_back({w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
-                            material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))});
+    PlaneWall wall{w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
+                   {w.velocity.x(), w.velocity.y(), w.velocity.z()},
+                   material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))};
+    wall.servo = w.has_servo;
+    wall.target_stress = w.servo.target_stress;
+    wall.servo_area = w.servo.area;
+    wall.servo_max_speed = w.servo.max_speed;
+    model.planes.push_back(wall);
   }
+
+  // Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
+  for (const ClumpTemplateSpec& clump : spec.clumps) {
+    std::vector<ClumpSphere> spheres;
+    for (size_t k = 0; k < clump.radii.size(); ++k) spheres.push_back({clump.centres[k], clump.radii[k]});
+    const ClumpMassProperties props = clump_mass_properties(spheres, 1.0);
+    const double scale = 1.0 / std::cbrt(6.0 * props.volume / std::numbers::pi);  // to d_eq = 1 m
+    ClumpTemplate t;
+    t.name = clump.name;
+    for (size_t k = 0; k < spheres.size(); ++k) {
+      const Vec3 local = props.principal_axes.transpose() * (spheres[k].centre - props.centre_of_mass) * scale;
+      t.centres.push_back({local.x(), local.y(), local.z()});
+      t.radii.push_back(spheres[k].radius * scale);
+    }
+    const double s5 = std::pow(scale, 5);
+    t.inertia_per_density = {props.principal_moments.x() * s5, props.principal_moments.y() * s5, props.principal_moments.z() * s5};
+    t.volume = props.volume * scale * scale * scale;
+    t.bounding_radius = props.bounding_radius * scale;
+    model.clumps.push_back(std::move(t));
+  }
+  auto clump_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
+    if (name.empty()) return -1;
+    for (size_t k = 0; k < model.clumps.size(); ++k)
+      if (model.clumps[k].name == name) return static_cast<int>(k);
+    std::vector<std::string> names;
+    for (const auto& known : model.clumps) names.push_back(known.name);
+    const std::string hint = nearest_word(name, names);
+    throw CaseError(fmt::format("{}: {}: unknown clump template '{}'{}; define it under `clumps:`", where.str(), key, name,
+                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
+  };
+  // Largest and smallest sphere a size distribution can create, for a sphere or a clump.
   model.radius_min = std::numeric_limits<double>::infinity();
+  auto extend_radii = [&](const SizeDistributionSpec& d, int clump) {
+    double big = 0.5, small = 0.5;
+    if (clump >= 0) {
+      const auto& radii = model.clumps[clump].radii;
+      big = *std::max_element(radii.begin(), radii.end());
+      small = *std::min_element(radii.begin(), radii.end());
+    }
+    model.radius_max = std::max(model.radius_max, big * d.largest());
+    model.radius_min = std::min(model.radius_min, small * d.smallest());
+  };
   for (size_t k = 0; k < spec.particles.size(); ++k) {
     const ParticleSetSpec& p = spec.particles[k];
-    model.sources.push_back({p, material_or_fail(p.material, p.location, fmt::format("particles[{}].material", k))});
-    model.radius_max = std::max(model.radius_max, 0.5 * p.diameter.largest());
-    model.radius_min = std::min(model.radius_min, 0.5 * p.diameter.smallest());
+    const std::string key = fmt::format("particles[{}]", k);
+    ParticleSource source{p, material_or_fail(p.material, p.location, key + ".material"),
+                          clump_or_fail(p.clump, p.location, key + ".clump")};
+    extend_radii(p.diameter, source.clump);
+    model.sources.push_back(std::move(source));
   }
+  const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());
+  for (size_t k = 0; k < spec.inlets.size(); ++k) {
+    const InletSpec& in = spec.inlets[k];
+    const std::string key = fmt::format("inlets[{}]", k);
+    Inlet inlet{in, material_or_fail(in.material, in.location, key + ".material"), clump_or_fail(in.clump, in.location, key + ".clump"), in.interval};
+    extend_radii(in.diameter, inlet.clump);
+    model.inlets.push_back(std::move(inlet));
+  }
+  model.outlets = spec.outlets;
 
   // Options.
   const SimulationSpec& s = spec.simulation;
@@ -208,6 +282,8 @@ Model compile(const CaseSpec& spec) {
   model.domain_min = {s.domain_min.x(), s.domain_min.y(), s.domain_min.z()};
   model.domain_max = {s.domain_max.x(), s.domain_max.y(), s.domain_max.z()};
   model.output = spec.output;
+  for (int a = 0; a < 3; ++a)
+    if (s.periodic[a]) model.period[a] = s.domain_max[a] - s.domain_min[a];
   for (const ActiveEffect& e : model.effects) {
     if (!e.spec->range) continue;
     for (int t = 0; t < n * n; ++t) {
@@ -223,6 +299,39 @@ Model compile(const CaseSpec& spec) {
                                 "Use a smaller step, `time_step: auto`, or `unsafe_time_step: warn` to run anyway.",
                                 spec.path, model.dt, model.advice.report));
   if (!model.advice.safe) model.notes.push_back("time step is unsafe (unsafe_time_step: warn):\n" + model.advice.report);
+
+  // Inlets insert in batches: often enough that a batch is a thin layer of the region.
+  for (Inlet& inlet : model.inlets) {
+    if (inlet.interval > 0) continue;
+    const Vec3 extent = inlet.spec.region_max - inlet.spec.region_min;
+    const double speed = inlet.spec.velocity.norm();
+    const double clear = speed > 0 ? 0.25 * extent.maxCoeff() / speed
+                                   : (g_norm > 0 ? 0.25 * std::sqrt(2.0 * extent.maxCoeff() / g_norm) : 0.01);
+    inlet.interval = std::clamp(clear, 20.0 * model.dt, 0.05);
+  }
+  // Servo walls: area from the periodic cross-section, speed limit from the step.
+  for (size_t k = 0; k < model.planes.size(); ++k) {
+    PlaneWall& w = model.planes[k];
+    if (!w.servo) continue;
+    if (w.servo_area <= 0) {
+      double area = 1.0;
+      int axes = 0;
+      for (int a = 0; a < 3; ++a)
+        if (std::abs(w.normal[a]) < 1e-12 && model.period[a] > 0) area *= model.period[a], ++axes;
+      if (axes != 2)
+        throw CaseError(fmt::format("{}: walls[{}].servo.area: needed unless the wall's normal is an axis and the two "
+                                    "other axes are periodic", spec.planes[k].location.str(), k));
+      w.servo_area = area;
+    }
+    if (w.servo_max_speed <= 0) w.servo_max_speed = 0.002 * model.radius_min / model.dt;
+  }
+  // Periodic axes: the minimum image is unique only if a period spans three cells.
+  const double cell = 2.0 * model.radius_max + model.interaction_range + model.skin;
+  for (int a = 0; a < 3; ++a)
+    if (model.period[a] > 0 && model.period[a] < 3.0 * cell)
+      throw CaseError(fmt::format("{}: simulation.domain: the periodic length along {} is {:g} m; it must be at least "
+                                  "three neighbour cells, {:g} m (2 x largest radius + interaction range + skin, x 3)",
+                                  spec.path, "xyz"[a], model.period[a], 3.0 * cell));
 
   // Hash of what determines the physics (checkpoints refuse a different model).
   std::uint64_t h = 0xcbf29ce484222325ULL;

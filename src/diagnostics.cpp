@@ -1,5 +1,8 @@
 #include "diagnostics.h"
 
+#include "neighbors.h"
+#include "rigid_body.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,15 +13,24 @@ namespace dem {
 
 namespace {
 
-double pair_overlap(const State& s, size_t i, size_t j) {
-  const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
-  return s.radius[i] + s.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
+double pair_overlap(const Model& m, const State& s, size_t i, size_t j) {
+  double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
+  minimum_image(m, d);
+  return s.radius[i] + s.radius[j] - std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
 double wall_overlap(const Model& m, const State& s, size_t i, size_t w) {
   const PlaneWall& wall = m.planes[w];
-  return s.radius[i] - ((s.x[i] - wall.point[0]) * wall.normal[0] + (s.y[i] - wall.point[1]) * wall.normal[1] +
-                        (s.z[i] - wall.point[2]) * wall.normal[2]);
+  return s.radius[i] - ((s.x[i] - s.walls.px[w]) * wall.normal[0] + (s.y[i] - s.walls.py[w]) * wall.normal[1] +
+                        (s.z[i] - s.walls.pz[w]) * wall.normal[2]);
+}
+
+double body_rotational_energy(const State& s, size_t k) {
+  const Bodies& b = s.bodies;
+  const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]};
+  double pi[3];
+  rotate_back({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, pi);
+  return 0.5 * (pi[0] * pi[0] / b.ix[k] + pi[1] * pi[1] / b.iy[k] + pi[2] * pi[2] / b.iz[k]);
 }
 
 std::uint64_t mix(std::uint64_t h, double v) {
@@ -37,9 +49,15 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
   out.dt = model.dt;
   out.lost = s.lost;
   for (size_t p = 0; p < s.size(); ++p) {
+    if (s.body[p] >= 0) continue;  // counted with its body
     const double m = 1.0 / s.inv_mass[p], inertia = 1.0 / s.inv_inertia[p];
     out.kinetic_translation += 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
     out.kinetic_rotation += 0.5 * inertia * (s.wx[p] * s.wx[p] + s.wy[p] * s.wy[p] + s.wz[p] * s.wz[p]);
+  }
+  const Bodies& b = s.bodies;
+  for (size_t k = 0; k < b.size(); ++k) {
+    out.kinetic_translation += 0.5 * b.mass[k] * (b.vx[k] * b.vx[k] + b.vy[k] * b.vy[k] + b.vz[k] * b.vz[k]);
+    out.kinetic_rotation += body_rotational_energy(s, k);
   }
   double sum = 0;
   auto count = [&](double overlap, double radius) {
@@ -49,10 +67,16 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
     out.max_overlap_ratio = std::max(out.max_overlap_ratio, overlap / radius);
   };
   for (size_t k = 0; k < s.pairs.size(); ++k)
-    count(pair_overlap(s, s.pairs.i[k], s.pairs.j[k]), std::min(s.radius[s.pairs.i[k]], s.radius[s.pairs.j[k]]));
+    count(pair_overlap(model, s, s.pairs.i[k], s.pairs.j[k]), std::min(s.radius[s.pairs.i[k]], s.radius[s.pairs.j[k]]));
   for (size_t k = 0; k < s.wall_pairs.size(); ++k)
     count(wall_overlap(model, s, s.wall_pairs.i[k], s.wall_pairs.j[k]), s.radius[s.wall_pairs.i[k]]);
   out.mean_overlap_ratio = out.contacts ? sum / static_cast<double>(out.contacts) : 0.0;
+  for (const InletState& in : s.inlets) out.inserted_mass += in.inserted_mass;
+  for (const OutletState& o : s.outlets) out.removed_mass += o.removed_mass, out.outlet_mass.push_back(o.removed_mass);
+  for (size_t w = 0; w < model.planes.size(); ++w) {
+    const auto& n = model.planes[w].normal;
+    out.wall_normal_force.push_back(-(s.walls.fx[w] * n[0] + s.walls.fy[w] * n[1] + s.walls.fz[w] * n[2]));
+  }
   return out;
 }
 
@@ -63,6 +87,11 @@ std::uint64_t state_hash(const State& s, int width) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   for (size_t p : by_id)
     for (double v : {s.x[p], s.y[p], s.z[p], s.vx[p], s.vy[p], s.vz[p], s.wx[p], s.wy[p], s.wz[p]}) h = mix(h, v);
+  const Bodies& bodies = s.bodies;
+  for (size_t k = 0; k < bodies.size(); ++k)
+    for (double v : {bodies.x[k], bodies.y[k], bodies.z[k], bodies.vx[k], bodies.vy[k], bodies.vz[k], bodies.qw[k],
+                     bodies.qx[k], bodies.qy[k], bodies.qz[k], bodies.lx[k], bodies.ly[k], bodies.lz[k]})
+      h = mix(h, v);
   // Contact histories keyed by (id, id) in sorted order.
   std::vector<std::tuple<std::int64_t, std::int64_t, size_t>> keys;
   for (size_t k = 0; k < s.pairs.size(); ++k) {
@@ -88,7 +117,7 @@ void check_numerics(const Model& model, const State& s, const Workspace& work, d
   }
   for (size_t k = 0; k < s.pairs.size(); ++k) {
     const size_t i = s.pairs.i[k], j = s.pairs.j[k];
-    const double ratio = pair_overlap(s, i, j) / std::min(s.radius[i], s.radius[j]);
+    const double ratio = pair_overlap(model, s, i, j) / std::min(s.radius[i], s.radius[j]);
     if (ratio > max_overlap_ratio)
       throw NumericalError(fmt::format(
           "t = {:.6g} s, step {}: particles {} and {} overlap by {:.0f} % of the smaller radius at [{:.4g}, {:.4g}, {:.4g}] m "

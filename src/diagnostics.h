@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "model.h"
 #include "state.h"
@@ -23,6 +24,10 @@ struct Scalars {
   double mean_overlap_ratio = 0;   ///< over touching contacts
   double dt = 0;                   // [s]
   std::int64_t lost = 0;
+  double inserted_mass = 0;        // [kg] by all inlets so far
+  double removed_mass = 0;         // [kg] by all outlets so far
+  std::vector<double> outlet_mass;       // [kg] per outlet, cumulative
+  std::vector<double> wall_normal_force; // [N] per wall, pushing the wall along -normal
 };
 
 Scalars measure(const Model& model, const State& state, const Workspace& work);

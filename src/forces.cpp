@@ -5,7 +5,10 @@
 #include "parallel.h"
 #include "forces.h"
 
+#include "neighbors.h"
+
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 
 namespace dem {
@@ -77,11 +80,14 @@ inline void fill_motion(ContactBatch& b, int c, const State& s, size_t i, double
 
 void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i) {
   const int width = model.history_width;
+  const bool periodic = model.periodic();
   const double range = model.interaction_range;
   ContactBatch& b = batch.b;
   for (std::int32_t k = work.pair_begin[i]; k < work.pair_begin[i + 1]; ++k) {
     const std::int32_t j = s.pairs.j[k];
-    const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
+    double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
+    if (periodic) minimum_image(model, d);
+    const double dx = d[0], dy = d[1], dz = d[2];
     const double dist2 = dx * dx + dy * dy + dz * dz;
     const double reach = s.radius[i] + s.radius[j] + range;
     if (dist2 >= reach * reach) {
@@ -120,16 +126,17 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   const double range = model.interaction_range;
   ContactBatch& b = batch.b;
   for (std::int32_t k = work.wall_begin[i]; k < work.wall_begin[i + 1]; ++k) {
-    const PlaneWall& wall = model.planes[s.wall_pairs.j[k]];
+    const std::int32_t w = s.wall_pairs.j[k];
+    const PlaneWall& wall = model.planes[w];
     const double nx = wall.normal[0], ny = wall.normal[1], nz = wall.normal[2];
-    const double dist = (s.x[i] - wall.point[0]) * nx + (s.y[i] - wall.point[1]) * ny + (s.z[i] - wall.point[2]) * nz;
+    const double dist = (s.x[i] - s.walls.px[w]) * nx + (s.y[i] - s.walls.py[w]) * ny + (s.z[i] - s.walls.pz[w]) * nz;
     const double overlap = s.radius[i] - dist;
     if (overlap <= -range || dist <= 0.0) {
       forget(s.wall_pairs, work.wall_forces, k, width);
       continue;
     }
     const int c = b.count;
-    fill_motion(b, c, s, i, nx, ny, nz, dist, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    fill_motion(b, c, s, i, nx, ny, nz, dist, s.walls.vx[w], s.walls.vy[w], s.walls.vz[w], 0.0, 0.0, 0.0);
     b.pair_type[c] = model.pair_type(s.material[i], wall.material);
     b.overlap[c] = overlap;
     b.radius_i[c] = s.radius[i];
@@ -196,9 +203,35 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
       fx += wf.fx[k], fy += wf.fy[k], fz += wf.fz[k];
       tx += wf.tix[k], ty += wf.tiy[k], tz += wf.tiz[k];
     }
-    const double mass = 1.0 / s.inv_mass[p];
+    const double mass = s.body[p] >= 0 ? 0.0 : 1.0 / s.inv_mass[p];  // a body carries its own weight
     s.fx[p] = fx + mass * gx, s.fy[p] = fy + mass * gy, s.fz[p] = fz + mass * gz;
     s.tx[p] = tx, s.ty[p] = ty, s.tz[p] = tz;
+  }
+
+  // Bodies: force and torque about the centre of mass from their spheres, plus weight.
+  Bodies& bodies = s.bodies;
+  const long nb = static_cast<long>(bodies.size());
+#pragma omp parallel for schedule(static) if (nb >= kParallelMin)
+  for (long b = 0; b < nb; ++b) {
+    double fx = bodies.mass[b] * gx, fy = bodies.mass[b] * gy, fz = bodies.mass[b] * gz, tx = 0, ty = 0, tz = 0;
+    for (std::int32_t q = work.body_begin[b]; q < work.body_begin[b + 1]; ++q) {
+      const std::int32_t p = work.body_members[q];
+      const double rx = s.x[p] - bodies.x[b], ry = s.y[p] - bodies.y[b], rz = s.z[p] - bodies.z[b];
+      fx += s.fx[p], fy += s.fy[p], fz += s.fz[p];
+      tx += s.tx[p] + ry * s.fz[p] - rz * s.fy[p];
+      ty += s.ty[p] + rz * s.fx[p] - rx * s.fz[p];
+      tz += s.tz[p] + rx * s.fy[p] - ry * s.fx[p];
+    }
+    bodies.fx[b] = fx, bodies.fy[b] = fy, bodies.fz[b] = fz;
+    bodies.tx[b] = tx, bodies.ty[b] = ty, bodies.tz[b] = tz;
+  }
+
+  // Force on each wall (reaction of its contacts), summed in list order.
+  for (auto* column : {&s.walls.fx, &s.walls.fy, &s.walls.fz}) std::fill(column->begin(), column->end(), 0.0);
+  for (size_t k = 0; k < s.wall_pairs.size(); ++k) {
+    if (!wf.active[k]) continue;
+    const std::int32_t w = s.wall_pairs.j[k];
+    s.walls.fx[w] -= wf.fx[k], s.walls.fy[w] -= wf.fy[k], s.walls.fz[w] -= wf.fz[k];
   }
 }
 

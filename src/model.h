@@ -28,18 +28,42 @@ struct ActiveEffect {
   std::array<std::uint8_t, 4> options{};  ///< chosen value index per OptionSpec
 };
 
-/// Infinite plane; particles live on the side the normal points to.
+/// Infinite plane; particles live on the side the normal points to. Where it is now is State.
 struct PlaneWall {
   std::string name;
-  std::array<double, 3> point;   // [m]
-  std::array<double, 3> normal;  // unit
+  std::array<double, 3> point;     // [m] at t = 0
+  std::array<double, 3> normal;    // unit
+  std::array<double, 3> velocity;  // [m/s] set velocity (a servo adds its normal speed)
   int material;
+  bool servo = false;
+  double target_stress = 0;  // [Pa]
+  double servo_area = 0;     // [m^2]
+  double servo_max_speed = 0;  // [m/s]
+};
+
+/// A clump template in its principal frame with the centre of mass at the origin, scaled to a
+/// volume-equivalent diameter of 1 m; an instance of diameter d scales lengths by d.
+struct ClumpTemplate {
+  std::string name;
+  std::vector<std::array<double, 3>> centres;  // [m per m of diameter]
+  std::vector<double> radii;                   // [m per m of diameter]
+  std::array<double, 3> inertia_per_density;   // [m^5] principal moments / density, d = 1 m
+  double volume;                               // [m^3] pi/6 by construction
+  double bounding_radius;                      // [m per m of diameter]
 };
 
 /// A set of particles to create at t = 0, with its material resolved.
 struct ParticleSource {
   ParticleSetSpec spec;
   int material;
+  int clump = -1;  ///< template index, -1: spheres
+};
+
+struct Inlet {
+  InletSpec spec;
+  int material;
+  int clump = -1;
+  double interval;  // [s] between insertions
 };
 
 /// What the time-step advisor found; printed at start and written with results.
@@ -66,7 +90,10 @@ struct Model {
   double interaction_range = 0;    ///< [m] largest gap at which any effect acts
 
   std::vector<PlaneWall> planes;
+  std::vector<ClumpTemplate> clumps;
   std::vector<ParticleSource> sources;
+  std::vector<Inlet> inlets;
+  std::vector<OutletSpec> outlets;
 
   double dt = 0;                  // [s]
   double duration = 0;            // [s]
@@ -78,6 +105,10 @@ struct Model {
   int threads = 0;
   bool has_domain = false;
   std::array<double, 3> domain_min{}, domain_max{};  // [m]
+  std::array<double, 3> period{};  ///< [m] length of each periodic axis, 0 when not periodic
+  double mass_scaling = 1.0;       ///< [-] applied to particle densities (reported, never silent)
+  double stiffness_scaling = 1.0;  ///< [-] applied to particle Young's moduli (reported)
+  bool periodic() const { return period[0] > 0 || period[1] > 0 || period[2] > 0; }
   TimeStepAdvice advice;
   OutputSpec output;
   std::vector<std::string> notes;  ///< warnings found while compiling (unused parameters, ...)

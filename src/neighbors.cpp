@@ -34,35 +34,76 @@ std::vector<CarriedHistory> collect(const ContactList& list, const State& state,
   return out;
 }
 
+/// Removes spheres that left the domain (along non-periodic axes) or entered an outlet, with
+/// the whole body they belong to, and counts them.
 void remove_lost(const Model& model, State& state) {
-  if (!model.has_domain) return;
+  if (!model.has_domain && model.outlets.empty()) return;
   const size_t n = state.size();
   std::vector<std::uint8_t> keep(n, 1);
-  size_t lost = 0;
+  std::vector<std::int32_t> body_outlet(state.bodies.size(), -2);  // -2 kept, -1 lost, k outlet
+  auto inside = [](double x, double y, double z, const auto& lo, const auto& hi) {
+    return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
+  };
+  bool any = false;
   for (size_t p = 0; p < n; ++p) {
-    const bool inside = state.x[p] >= model.domain_min[0] && state.x[p] <= model.domain_max[0] &&
-                        state.y[p] >= model.domain_min[1] && state.y[p] <= model.domain_max[1] &&
-                        state.z[p] >= model.domain_min[2] && state.z[p] <= model.domain_max[2];
-    if (!inside) keep[p] = 0, ++lost;
+    int verdict = -2;
+    for (size_t k = 0; k < model.outlets.size() && verdict == -2; ++k)
+      if (inside(state.x[p], state.y[p], state.z[p], model.outlets[k].region_min, model.outlets[k].region_max))
+        verdict = static_cast<int>(k);
+    if (verdict == -2 && model.has_domain) {
+      for (int a = 0; a < 3; ++a) {
+        if (model.period[a] > 0) continue;
+        const double c = a == 0 ? state.x[p] : a == 1 ? state.y[p] : state.z[p];
+        if (c < model.domain_min[a] || c > model.domain_max[a]) verdict = -1;
+      }
+    }
+    if (verdict == -2) continue;
+    any = true;
+    if (state.body[p] >= 0) {
+      std::int32_t& b = body_outlet[state.body[p]];
+      if (b == -2 || verdict >= 0) b = verdict;
+    } else {
+      keep[p] = 0;
+      if (verdict >= 0) {
+        state.outlets[verdict].removed_mass += 1.0 / state.inv_mass[p];
+        ++state.outlets[verdict].removed;
+      } else {
+        ++state.lost;
+      }
+    }
   }
-  if (lost == 0) return;
+  if (!any) return;
+  for (size_t b = 0; b < body_outlet.size(); ++b) {
+    if (body_outlet[b] == -2) continue;
+    if (body_outlet[b] >= 0) {
+      state.outlets[body_outlet[b]].removed_mass += state.bodies.mass[b];
+      ++state.outlets[body_outlet[b]].removed;
+    } else {
+      ++state.lost;
+    }
+  }
+  for (size_t p = 0; p < n; ++p)
+    if (state.body[p] >= 0 && body_outlet[state.body[p]] != -2) keep[p] = 0;
   state.compact(keep);
-  state.lost += static_cast<std::int64_t>(lost);
 }
 
+/// Cells along each axis; periodic axes span exactly one period, others the particles' extent.
 struct Grid {
   double origin[3];
-  double cell;
+  double cell[3];
   int dims[3];
+  bool wrap[3];
+  double period[3];
+  int axis_index(int a, double v) const {
+    if (wrap[a]) v -= period[a] * std::floor((v - origin[a]) / period[a]);
+    return std::clamp(static_cast<int>((v - origin[a]) / cell[a]), 0, dims[a] - 1);
+  }
   int index(double x, double y, double z) const {
-    const int cx = std::clamp(static_cast<int>((x - origin[0]) / cell), 0, dims[0] - 1);
-    const int cy = std::clamp(static_cast<int>((y - origin[1]) / cell), 0, dims[1] - 1);
-    const int cz = std::clamp(static_cast<int>((z - origin[2]) / cell), 0, dims[2] - 1);
-    return (cz * dims[1] + cy) * dims[0] + cx;
+    return (axis_index(2, z) * dims[1] + axis_index(1, y)) * dims[0] + axis_index(0, x);
   }
 };
 
-Grid make_grid(const State& s, double cell) {
+Grid make_grid(const Model& model, const State& s, double cell) {
   double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                   std::numeric_limits<double>::infinity()};
   double hi[3] = {-lo[0], -lo[1], -lo[2]};
@@ -72,21 +113,59 @@ Grid make_grid(const State& s, double cell) {
     lo[2] = std::min(lo[2], s.z[p]), hi[2] = std::max(hi[2], s.z[p]);
   }
   Grid g;
+  for (int a = 0; a < 3; ++a) {
+    g.wrap[a] = model.period[a] > 0;
+    g.period[a] = model.period[a];
+    if (g.wrap[a]) lo[a] = model.domain_min[a], hi[a] = model.domain_max[a];
+  }
   // Cap the number of cells near 4 per particle: a few particles flung far away must not make
-  // the grid huge. Larger cells stay correct, only slower.
+  // the grid huge. Larger cells stay correct, only slower. Periodic axes keep whole periods.
   const double cap = 4.0 * static_cast<double>(s.size()) + 64.0;
   for (;;) {
     double cells = 1.0;
-    for (int a = 0; a < 3; ++a) cells *= std::floor((hi[a] - lo[a]) / cell) + 1.0;
+    for (int a = 0; a < 3; ++a) {
+      g.dims[a] = g.wrap[a] ? std::max(1, static_cast<int>(std::floor(g.period[a] / cell)))
+                            : static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
+      g.cell[a] = g.wrap[a] ? g.period[a] / g.dims[a] : cell;
+      g.origin[a] = lo[a];
+      cells *= g.dims[a];
+    }
     if (cells <= cap) break;
     cell *= 1.26;
   }
-  g.cell = cell;
-  for (int a = 0; a < 3; ++a) {
-    g.origin[a] = lo[a];
-    g.dims[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
-  }
   return g;
+}
+
+/// Moves free spheres and body centres that crossed a periodic boundary back into the period
+/// (member spheres follow their body and may stick out; distances use the minimum image).
+void wrap_into_period(const Model& model, State& s) {
+  if (!model.periodic()) return;
+  for (int a = 0; a < 3; ++a) {
+    const double period = model.period[a];
+    if (period <= 0) continue;
+    const double lo = model.domain_min[a];
+    auto wrap = [&](double& v) { v -= period * std::floor((v - lo) / period); };
+    std::vector<double>& column = a == 0 ? s.x : a == 1 ? s.y : s.z;
+    std::vector<double>& built = a == 0 ? s.x_built : a == 1 ? s.y_built : s.z_built;
+    for (size_t p = 0; p < s.size(); ++p) {
+      if (s.body[p] >= 0) continue;
+      const double before = column[p];
+      wrap(column[p]);
+      if (p < built.size()) built[p] += column[p] - before;
+    }
+    std::vector<double>& centre = a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z;
+    std::vector<double> shift(s.bodies.size());
+    for (size_t b = 0; b < s.bodies.size(); ++b) {
+      const double before = centre[b];
+      wrap(centre[b]);
+      shift[b] = centre[b] - before;
+    }
+    for (size_t p = 0; p < s.size(); ++p) {
+      if (s.body[p] < 0 || shift[s.body[p]] == 0.0) continue;
+      column[p] += shift[s.body[p]];
+      if (p < built.size()) built[p] += shift[s.body[p]];
+    }
+  }
 }
 
 void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>& owner, size_t n) {
@@ -102,14 +181,46 @@ void ContactForces::resize(std::size_t n) {
   active.assign(n, 0);
 }
 
+void minimum_image(const Model& model, double d[3]) {
+  for (int a = 0; a < 3; ++a)
+    if (model.period[a] > 0) d[a] -= model.period[a] * std::nearbyint(d[a] / model.period[a]);
+}
+
+void index_contacts(const Model& model, const State& s, Workspace& work) {
+  const size_t n = s.size();
+  build_csr(work.pair_begin, s.pairs.i, n);
+  build_csr(work.wall_begin, s.wall_pairs.i, n);
+  // Incoming index: pairs in which slot p is j, in pair order.
+  build_csr(work.incoming_begin, s.pairs.j, n);
+  work.incoming.resize(s.pairs.size());
+  {
+    std::vector<std::int32_t> cursor(work.incoming_begin.begin(), work.incoming_begin.end() - 1);
+    for (size_t k = 0; k < s.pairs.size(); ++k) work.incoming[cursor[s.pairs.j[k]]++] = static_cast<std::int32_t>(k);
+  }
+  // Spheres of each body, in slot order.
+  std::vector<std::int32_t> owner;
+  for (size_t p = 0; p < n; ++p)
+    if (s.body[p] >= 0) owner.push_back(s.body[p]);
+  build_csr(work.body_begin, owner, s.bodies.size());
+  work.body_members.resize(owner.size());
+  {
+    std::vector<std::int32_t> cursor(work.body_begin.begin(), work.body_begin.end() - 1);
+    for (size_t p = 0; p < n; ++p)
+      if (s.body[p] >= 0) work.body_members[cursor[s.body[p]]++] = static_cast<std::int32_t>(p);
+  }
+  work.pair_forces.resize(s.pairs.size());
+  work.wall_forces.resize(s.wall_pairs.size());
+  work.valid = true;
+}
+
 bool needs_rebuild(const Model& model, const State& s, const Workspace& work) {
-  if (!work.valid || work.x_built.size() != s.size()) return true;
+  if (!work.valid || s.x_built.size() != s.size()) return true;
   const double limit2 = 0.25 * model.skin * model.skin;
   const long n = static_cast<long>(s.size());
   int moved = 0;
 #pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
-    const double dx = s.x[p] - work.x_built[p], dy = s.y[p] - work.y_built[p], dz = s.z[p] - work.z_built[p];
+    const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
     moved |= (dx * dx + dy * dy + dz * dz > limit2);
   }
   return moved != 0;
@@ -129,7 +240,15 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
 
   // Sort slots by cell (counting sort); cells are at least one pair reach wide.
-  const Grid grid = make_grid(s, std::max(2.0 * radius_max + reach, 1e-12));
+  wrap_into_period(model, s);
+  if (n == 0) {  // nothing yet (an inlet will bring particles) or everything left
+    s.pairs.clear(), s.wall_pairs.clear();
+    s.x_built.clear(), s.y_built.clear(), s.z_built.clear();
+    index_contacts(model, s, work);
+    ++work.rebuilds;
+    return;
+  }
+  const Grid grid = make_grid(model, s, std::max(2.0 * radius_max + reach, 1e-12));
   const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
   work.cell_of.resize(n);
   work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
@@ -148,27 +267,34 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
 
   // Particle pairs: each slot lists partners j > i in the 27 cells around it.
   std::vector<std::int32_t> count(n + 1, 0);
+  // The up to 27 distinct cells around a cell (fewer where a periodic axis has < 3 cells).
   auto visit = [&](size_t i, auto&& emit) {
     const int c = work.cell_of[i];
-    const int cx = c % grid.dims[0], cy = (c / grid.dims[0]) % grid.dims[1], cz = c / (grid.dims[0] * grid.dims[1]);
-    for (int dz = -1; dz <= 1; ++dz) {
-      const int z = cz + dz;
-      if (z < 0 || z >= grid.dims[2]) continue;
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int y = cy + dy;
-        if (y < 0 || y >= grid.dims[1]) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int x = cx + dx;
-          if (x < 0 || x >= grid.dims[0]) continue;
-          const int cell = (z * grid.dims[1] + y) * grid.dims[0] + x;
-          for (int j = std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1); j < work.cell_start[cell + 1]; ++j) {
-            const double ddx = s.x[i] - s.x[j], ddy = s.y[i] - s.y[j], ddz = s.z[i] - s.z[j];
-            const double cut = s.radius[i] + s.radius[j] + reach;
-            if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) emit(j);
-          }
-        }
+    const int at[3] = {c % grid.dims[0], (c / grid.dims[0]) % grid.dims[1], c / (grid.dims[0] * grid.dims[1])};
+    int axis_cells[3][3] = {}, axis_count[3] = {};
+    for (int a = 0; a < 3; ++a) {
+      axis_count[a] = 0;
+      for (int d = -1; d <= 1; ++d) {
+        int v = at[a] + d;
+        if (grid.wrap[a]) v = (v + grid.dims[a]) % grid.dims[a];
+        else if (v < 0 || v >= grid.dims[a]) continue;
+        bool seen = false;
+        for (int q = 0; q < axis_count[a]; ++q) seen |= axis_cells[a][q] == v;
+        if (!seen) axis_cells[a][axis_count[a]++] = v;
       }
     }
+    for (int iz = 0; iz < axis_count[2]; ++iz)
+      for (int iy = 0; iy < axis_count[1]; ++iy)
+        for (int ix = 0; ix < axis_count[0]; ++ix) {
+          const int cell = (axis_cells[2][iz] * grid.dims[1] + axis_cells[1][iy]) * grid.dims[0] + axis_cells[0][ix];
+          for (int j = std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1); j < work.cell_start[cell + 1]; ++j) {
+            if (s.body[i] >= 0 && s.body[i] == s.body[j]) continue;  // spheres of one clump
+            double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
+            minimum_image(model, d);
+            const double cut = s.radius[i] + s.radius[j] + reach;
+            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) emit(j);
+          }
+        }
   };
   const long nl = static_cast<long>(n);
 #pragma omp parallel for schedule(static) if (nl >= kParallelMin)
@@ -197,22 +323,13 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   for (size_t p = 0; p < n; ++p) {
     for (size_t w = 0; w < model.planes.size(); ++w) {
       const PlaneWall& wall = model.planes[w];
-      const double d = (s.x[p] - wall.point[0]) * wall.normal[0] + (s.y[p] - wall.point[1]) * wall.normal[1] +
-                       (s.z[p] - wall.point[2]) * wall.normal[2];
+      const double d = (s.x[p] - s.walls.px[w]) * wall.normal[0] + (s.y[p] - s.walls.py[w]) * wall.normal[1] +
+                       (s.z[p] - s.walls.pz[w]) * wall.normal[2];
       if (d < s.radius[p] + reach && d > -s.radius[p]) {
         s.wall_pairs.i.push_back(static_cast<std::int32_t>(p));
         s.wall_pairs.j.push_back(static_cast<std::int32_t>(w));
       }
     }
-  }
-  build_csr(work.wall_begin, s.wall_pairs.i, n);
-
-  // Incoming index: pairs in which slot p is j, in pair order.
-  build_csr(work.incoming_begin, s.pairs.j, n);
-  work.incoming.resize(n_pairs);
-  {
-    std::vector<std::int32_t> cursor(work.incoming_begin.begin(), work.incoming_begin.end() - 1);
-    for (size_t k = 0; k < n_pairs; ++k) work.incoming[cursor[s.pairs.j[k]]++] = static_cast<std::int32_t>(k);
   }
 
   // Carry histories to the new lists by particle id.
@@ -250,12 +367,10 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     }
   }
 
-  work.pair_forces.resize(n_pairs);
-  work.wall_forces.resize(s.wall_pairs.size());
-  work.x_built = s.x;
-  work.y_built = s.y;
-  work.z_built = s.z;
-  work.valid = true;
+  s.x_built = s.x;
+  s.y_built = s.y;
+  s.z_built = s.z;
+  index_contacts(model, s, work);
   ++work.rebuilds;
 }
 

@@ -14,5 +14,10 @@ namespace dem {
 bool needs_rebuild(const Model& model, const State& state, const Workspace& work);
 /// Rebuilds the contact lists (see above).
 void rebuild_contacts(const Model& model, State& state, Workspace& work);
+/// Rebuilds the workspace's indexing of the state's contact lists without changing them (after
+/// a restart, so the run continues exactly as it would have).
+void index_contacts(const Model& model, const State& state, Workspace& work);
+/// Replaces d by its minimum image along the periodic axes.
+void minimum_image(const Model& model, double d[3]);
 
 }  // namespace dem

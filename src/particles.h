@@ -22,8 +22,17 @@ struct Random {
 /// One diameter drawn from a size distribution [m].
 double draw_diameter(const SizeDistributionSpec& d, Random& random);
 
-/// The state at t = 0: every particle source of the model, placed. Throws CaseError when a
-/// region cannot hold its particles.
+/// The state at t = 0: walls where the model puts them, every particle source placed (clumps
+/// with random orientation). Throws CaseError when a region cannot hold its particles.
 State initial_state(const Model& model);
+
+/// Inserts what inlet `k` owes by its next insertion (mass rate x time since start), at random
+/// places in its region that overlap nothing. Returns the number of particles (or clumps) inserted.
+std::int64_t run_inlet(const Model& model, State& state, int k);
+
+/// Places the spheres of every body from its centre and orientation, with the body's velocity
+/// (v + w x r) and angular velocity.
+void place_body_spheres(const Model& model, State& state, const std::vector<std::int32_t>& body_begin,
+                        const std::vector<std::int32_t>& body_members);
 
 }  // namespace dem

@@ -4,17 +4,26 @@
 #include <fmt/ostream.h>
 #include <omp.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <ostream>
+#include <sstream>
 
+#include "checkpoint.h"
+#include "results_hdf5.h"
 #include "step.h"
 
 namespace dem {
 
 namespace {
+
+std::atomic<int> stop_signal{0};
+extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
 
 std::string format_duration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
@@ -24,15 +33,92 @@ std::string format_duration(double seconds) {
   return fmt::format("{}s", s);
 }
 
-std::string scalars_csv(const std::vector<Scalars>& rows) {
+std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
   std::string out =
       "time_s,step,particles,kinetic_translation_J,kinetic_rotation_J,contacts,max_overlap_ratio,mean_overlap_ratio,"
-      "dt_s,lost\n";
-  for (const Scalars& r : rows)
-    out += fmt::format("{:.9g},{},{},{:.9g},{:.9g},{},{:.6g},{:.6g},{:.6g},{}\n", r.time, r.step, r.particles,
+      "dt_s,lost,inserted_mass_kg,removed_mass_kg";
+  for (const OutletSpec& o : model.outlets) out += fmt::format(",outlet_{}_kg", o.name);
+  for (const PlaneWall& w : model.planes) out += fmt::format(",wall_{}_normal_force_N", w.name);
+  out += "\n";
+  for (const Scalars& r : rows) {
+    out += fmt::format("{:.9g},{},{},{:.9g},{:.9g},{},{:.6g},{:.6g},{:.6g},{},{:.9g},{:.9g}", r.time, r.step, r.particles,
                        r.kinetic_translation, r.kinetic_rotation, r.contacts, r.max_overlap_ratio, r.mean_overlap_ratio,
-                       r.dt, r.lost);
+                       r.dt, r.lost, r.inserted_mass, r.removed_mass);
+    for (double m : r.outlet_mass) out += fmt::format(",{:.9g}", m);
+    for (double f : r.wall_normal_force) out += fmt::format(",{:.9g}", f);
+    out += "\n";
+  }
   return out;
+}
+
+/// Rows of an earlier scalars.csv up to `time` (a resumed run keeps what it had computed).
+std::vector<Scalars> read_scalars(const std::string& path, double time) {
+  std::vector<Scalars> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::stringstream fields(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(fields, cell, ',')) v.push_back(std::stod(cell));
+    if (v.size() < 12 || v[0] > time + 1e-12) break;
+    Scalars r;
+    r.time = v[0], r.step = static_cast<std::int64_t>(v[1]), r.particles = static_cast<size_t>(v[2]);
+    r.kinetic_translation = v[3], r.kinetic_rotation = v[4], r.contacts = static_cast<size_t>(v[5]);
+    r.max_overlap_ratio = v[6], r.mean_overlap_ratio = v[7], r.dt = v[8], r.lost = static_cast<std::int64_t>(v[9]);
+    r.inserted_mass = v[10], r.removed_mass = v[11];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+/// The run's set-up as YAML, so every result can be traced to its inputs.
+std::string run_info(const Model& model) {
+  std::string out = fmt::format(
+      "software: demdesign {}\ncase: {}\nmodel_hash: {:016x}\ntime_step_s: {:.9g}\nmass_scaling: {:g}\n"
+      "stiffness_scaling: {:g}\nrayleigh_time_s: {:.6g}\ncontact_time_s: {:.6g}\ncontact_law:\n",
+      DEMDESIGN_VERSION, model.source, model.hash, model.dt, model.mass_scaling, model.stiffness_scaling,
+      model.advice.rayleigh_time, model.advice.contact_time);
+  for (const ActiveEffect& e : model.effects)
+    out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", kStageKeys[static_cast<int>(e.spec->stage)],
+                       e.spec->name, e.spec->citation);
+  out += "materials:\n";
+  for (const Material& m : model.materials)
+    out += fmt::format("  {}: {{density: {:.9g}, youngs_modulus: {:.9g}, poisson_ratio: {:g}}}\n", m.name, m.density,
+                       m.youngs_modulus, m.poisson_ratio);
+  return out;
+}
+
+FrameWriter make_frame_writer(const Model& model, const std::string& directory) {
+  std::vector<std::string> names;
+  for (const Material& m : model.materials) names.push_back(m.name);
+  return FrameWriter(directory, names,
+                     {{"software", fmt::format("demdesign {}", DEMDESIGN_VERSION)},
+                      {"case", model.source},
+                      {"mass_scaling", fmt::format("{:g}", model.mass_scaling)},
+                      {"stiffness_scaling", fmt::format("{:g}", model.stiffness_scaling)},
+                      {"time_step_s", fmt::format("{:.9g}", model.dt)}});
+}
+
+void write_frame(FrameWriter& writer, const State& s) {
+  // Orientation per sphere: its body's, identity for free spheres.
+  const size_t n = s.size();
+  std::vector<double> qw(n, 1.0), qx(n, 0.0), qy(n, 0.0), qz(n, 0.0);
+  for (size_t p = 0; p < n; ++p) {
+    const std::int32_t b = s.body[p];
+    if (b < 0) continue;
+    qw[p] = s.bodies.qw[b], qx[p] = s.bodies.qx[b], qy[p] = s.bodies.qy[b], qz[p] = s.bodies.qz[b];
+  }
+  ParticleFrame frame;
+  frame.time = s.time, frame.step = s.step, frame.count = n;
+  frame.id = s.id.data();
+  frame.x = s.x.data(), frame.y = s.y.data(), frame.z = s.z.data();
+  frame.vx = s.vx.data(), frame.vy = s.vy.data(), frame.vz = s.vz.data();
+  frame.wx = s.wx.data(), frame.wy = s.wy.data(), frame.wz = s.wz.data();
+  frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
+  frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
+  writer.write_frame(frame);
 }
 
 }  // namespace
@@ -51,15 +137,25 @@ void write_file_atomically(const std::string& path, const std::string& content) 
 }
 
 void print_setup(const Model& model, const State& state, std::ostream& log) {
-  fmt::print(log, "demdesign: {}{}\n", model.source, model.title.empty() ? "" : " - " + model.title);
-  fmt::print(log, "  {} particles, {} materials, {} plane walls, {} threads\n", state.size(), model.materials.size(),
-             model.planes.size(), omp_get_max_threads());
+  fmt::print(log, "demdesign {}: {}{}\n", DEMDESIGN_VERSION, model.source, model.title.empty() ? "" : " - " + model.title);
+  fmt::print(log, "  {} spheres ({} clumps), {} materials, {} plane walls, {} inlets, {} outlets, {} threads\n",
+             state.size(), state.bodies.size(), model.materials.size(), model.planes.size(), model.inlets.size(),
+             model.outlets.size(), omp_get_max_threads());
   std::string law;
   for (const ActiveEffect& e : model.effects)
     law += fmt::format("{}{}: {}", law.empty() ? "" : ", ", kStageKeys[static_cast<int>(e.spec->stage)], e.spec->name);
   fmt::print(log, "  contact law: {}\n", law);
   for (const ActiveEffect& e : model.effects) fmt::print(log, "    {}: {}\n", e.spec->name, e.spec->citation);
   fmt::print(log, "{}\n", model.advice.report);
+  if (model.mass_scaling != 1.0 || model.stiffness_scaling != 1.0)
+    fmt::print(log, "  SCALING: particle density x {:g} (mass scaling), particle Young's modulus x {:g} (reduced "
+                    "stiffness); both are written with every result\n",
+               model.mass_scaling, model.stiffness_scaling);
+  else
+    fmt::print(log, "  scaling: none (mass x 1, stiffness x 1)\n");
+  if (model.periodic())
+    fmt::print(log, "  periodic: {}{}{} (periods {:g} {:g} {:g} m)\n", model.period[0] > 0 ? "x" : "", model.period[1] > 0 ? "y" : "",
+               model.period[2] > 0 ? "z" : "", model.period[0], model.period[1], model.period[2]);
   fmt::print(log, "  neighbour skin {:.3g} m, interaction range {:.3g} m\n", model.skin, model.interaction_range);
   for (const std::string& note : model.notes) fmt::print(log, "  note: {}\n", note);
 }
@@ -67,51 +163,99 @@ void print_setup(const Model& model, const State& state, std::ostream& log) {
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log) {
   RunSummary summary;
   summary.output_directory = options.output_directory.empty() ? model.output.directory : options.output_directory;
+  const std::string out = summary.output_directory;
+  const std::string checkpoint_path = out + "/checkpoint.bin";
   const double duration = options.duration >= 0 ? options.duration : model.duration;
-  std::int64_t total_steps = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
-  if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
-  const std::int64_t every =
-      model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, total_steps / 200);
+  const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
 
+  if (options.resume) {
+    state = load_checkpoint(checkpoint_path, model);
+    summary.scalars = read_scalars(out + "/scalars.csv", state.time);
+    fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
+  }
   print_setup(model, state, log);
   prepare(model, state, work);
-  summary.scalars.push_back(measure(model, state, work));
+  if (!options.resume) summary.scalars.push_back(measure(model, state, work));
+
+  const std::int64_t first_step = state.step;
+  std::int64_t last_step = end_step;
+  if (options.max_steps >= 0) last_step = std::min(last_step, first_step + options.max_steps);
+  const std::int64_t total = std::max<std::int64_t>(last_step - first_step, 0);
+  const std::int64_t every =
+      model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, end_step / 200);
+  const std::int64_t frame_every = std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::llround((model.output.frames_every > 0 ? model.output.frames_every : duration / 20) / model.dt)));
+  const std::int64_t checkpoint_every =
+      model.output.checkpoint_every > 0 ? std::max<std::int64_t>(1, std::llround(model.output.checkpoint_every / model.dt)) : 0;
+
+  std::optional<FrameWriter> frames;
+  if (options.write_files) {
+    write_file_atomically(out + "/run_info.yaml", run_info(model));
+    frames.emplace(make_frame_writer(model, out));
+    if (options.resume) frames->adopt_existing();
+    else write_frame(*frames, state);
+  }
+  stop_signal = 0;
+  auto previous_int = std::signal(SIGINT, on_stop_signal);
+  auto previous_term = std::signal(SIGTERM, on_stop_signal);
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto last_progress = start;
   std::int64_t particle_steps = 0;
-  for (std::int64_t k = 1; k <= total_steps; ++k) {
+  while (state.step < last_step) {
     step(model, state, work);
     particle_steps += static_cast<std::int64_t>(state.size());
-    if (k % every == 0 || k == total_steps) {
+    const bool last = state.step == last_step;
+    if (state.step % every == 0 || last) {
       check_numerics(model, state, work);
       summary.scalars.push_back(measure(model, state, work));
+    }
+    if (frames && (state.step % frame_every == 0 || last)) write_frame(*frames, state);
+    if (options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stop_signal)) {
+      save_checkpoint(checkpoint_path, model, state);
+      write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    }
+    if (stop_signal) {
+      fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
+                 state.time);
+      break;
     }
     const auto now = Clock::now();
     if (options.progress && std::chrono::duration<double>(now - last_progress).count() >= model.output.progress_seconds) {
       last_progress = now;
       const double elapsed = std::chrono::duration<double>(now - start).count();
-      const double left = elapsed / static_cast<double>(k) * static_cast<double>(total_steps - k);
+      const std::int64_t done = state.step - first_step;
+      const double left = elapsed / static_cast<double>(done) * static_cast<double>(last_step - state.step);
       fmt::print(log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
-                 state.time, duration, 100.0 * k / total_steps, state.size(), particle_steps / elapsed, format_duration(left));
+                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), state.size(), particle_steps / elapsed,
+                 format_duration(left));
       log.flush();
     }
   }
-  summary.steps = total_steps;
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  summary.steps = state.step - first_step;
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
 
-  const Scalars& last = summary.scalars.back();
+  const Scalars& final_row = summary.scalars.back();
   fmt::print(log, "  done: {} steps to t = {:.6g} s in {:.2f} s ({:.3g} particle-steps/s, {} neighbour-list rebuilds)\n",
              summary.steps, state.time, summary.wall_seconds, summary.particle_steps_per_second, work.rebuilds);
   fmt::print(log, "  end: {} particles, {} contacts, kinetic energy {:.4g} J, max overlap {:.2g} % of radius{}\n",
-             last.particles, last.contacts, last.kinetic_translation + last.kinetic_rotation, 100 * last.max_overlap_ratio,
-             state.lost ? fmt::format(", {} particles left the domain", state.lost) : "");
+             final_row.particles, final_row.contacts, final_row.kinetic_translation + final_row.kinetic_rotation,
+             100 * final_row.max_overlap_ratio, state.lost ? fmt::format(", {} particles left the domain", state.lost) : "");
+  for (size_t k = 0; k < model.inlets.size(); ++k)
+    fmt::print(log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, state.inlets[k].inserted,
+               state.inlets[k].inserted_mass,
+               state.inlets[k].failed ? fmt::format(" ({} insertions found the region full)", state.inlets[k].failed) : "");
+  for (size_t k = 0; k < model.outlets.size(); ++k)
+    fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, state.outlets[k].removed,
+               state.outlets[k].removed_mass);
   if (options.write_files) {
-    const std::string path = summary.output_directory + "/scalars.csv";
-    write_file_atomically(path, scalars_csv(summary.scalars));
-    fmt::print(log, "  wrote {}\n", path);
+    write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml\n", out,
+               frames ? frames->frames().size() : 0);
   }
   return summary;
 }

@@ -20,6 +20,7 @@ struct RunOptions {
   std::string output_directory;   ///< overrides the case's when not empty
   bool write_files = true;
   bool progress = true;
+  bool resume = false;            ///< continue from OUT/checkpoint.bin
 };
 
 struct RunSummary {
@@ -33,8 +34,9 @@ struct RunSummary {
 /// Prints the model's set-up (effects, time-step advice, notes) to `log`.
 void print_setup(const Model& model, const State& state, std::ostream& log);
 
-/// Runs from the state as it is (prepare() is called here). `log` gets the set-up, progress
-/// and summary lines.
+/// Runs from the state as it is (prepare() is called here) to the model's end time. With
+/// options.resume the state is replaced by OUT/checkpoint.bin. `log` gets the set-up, progress
+/// and summary lines. SIGINT and SIGTERM stop the run after the current step with a checkpoint.
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
 
 /// Writes `content` to `path` through a temporary file and a rename, so a reader never sees a

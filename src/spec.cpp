@@ -175,12 +175,73 @@ SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
   return d;
 }
 
+/// A box {min: [x,y,z], max: [x,y,z]} under `key` of `map`.
+void read_box(MapReader& map, const std::string& key, const std::string& file, Vec3& lo, Vec3& hi) {
+  const YAML::Node node = map.node(key);
+  if (!node) map.fail(key, "missing: the box {min: [x,y,z], max: [x,y,z]}");
+  MapReader box(node, file, map.key_path(key));
+  lo = box.vec3("min", Vec3::Zero());
+  hi = box.vec3("max", Vec3::Zero());
+  if (!(hi.array() > lo.array()).all()) box.fail("max", "each component must exceed min");
+  box.finish();
+}
+
+ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, const std::string& file) {
+  MapReader map(node, file, "clumps." + name);
+  ClumpTemplateSpec c;
+  c.name = name;
+  c.location = map.location();
+  const YAML::Node spheres = map.node("spheres");
+  if (!spheres || !spheres.IsSequence() || spheres.size() == 0)
+    map.fail("spheres", "must be a list of {centre: [x,y,z], diameter: D} in the clump's own frame [m]");
+  for (size_t k = 0; k < spheres.size(); ++k) {
+    MapReader sphere(spheres[k], file, fmt::format("clumps.{}.spheres[{}]", name, k));
+    c.centres.push_back(sphere.vec3("centre", Vec3::Zero()));
+    c.radii.push_back(0.5 * sphere.required_number("diameter", 1e-7, 10, "m"));
+    sphere.finish();
+  }
+  map.finish();
+  return c;
+}
+
+InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("inlets[{}]", index));
+  InletSpec in;
+  in.location = map.location();
+  in.name = map.string("name", fmt::format("inlet{}", index));
+  in.material = map.string("material", "");
+  if (in.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  in.clump = map.string("clump", "");
+  in.diameter = read_diameter(map, file);
+  const bool tph = map.has("mass_rate_tph"), kgs = map.has("mass_rate_kgs");
+  if (tph == kgs) map.fail("mass_rate_tph", "give exactly one of mass_rate_tph [t/h] or mass_rate_kgs [kg/s]");
+  in.mass_rate = tph ? map.number("mass_rate_tph", 0, 1e-9, 1e6, "t/h") / 3.6 : map.number("mass_rate_kgs", 0, 1e-12, 1e6, "kg/s");
+  read_box(map, "region", file, in.region_min, in.region_max);
+  in.velocity = map.vec3("velocity", in.velocity);
+  in.start = map.number("start", 0.0, 0.0, 1e9, "s");
+  in.stop = map.number("stop", 1e300, in.start, 1e300, "s");
+  in.interval = map.number("interval", 0.0, 0.0, 1e6, "s");
+  map.finish();
+  return in;
+}
+
+OutletSpec read_outlet(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("outlets[{}]", index));
+  OutletSpec out;
+  out.location = map.location();
+  out.name = map.string("name", fmt::format("outlet{}", index));
+  read_box(map, "region", file, out.region_min, out.region_max);
+  map.finish();
+  return out;
+}
+
 ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, size_t index) {
   MapReader map(node, file, fmt::format("particles[{}]", index));
   ParticleSetSpec p;
   p.location = map.location();
   p.material = map.string("material", "");
   if (p.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  p.clump = map.string("clump", "");
   p.diameter = read_diameter(map, file);
   p.velocity = map.vec3("velocity", p.velocity);
   p.angular_velocity = map.vec3("angular_velocity", p.angular_velocity);
@@ -197,13 +258,7 @@ ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, 
   } else {
     p.count = map.integer("count", 0, 1, 100'000'000);
     if (p.count == 0) map.fail("count", "missing: give `count` with a `region`, or explicit `positions`");
-    const YAML::Node region = map.node("region");
-    if (!region) map.fail("region", "missing: the box {min: [x,y,z], max: [x,y,z]} to place the particles in");
-    MapReader box(region, file, map.key_path("region"));
-    p.region_min = box.vec3("min", Vec3::Zero());
-    p.region_max = box.vec3("max", Vec3::Zero());
-    if (!(p.region_max.array() > p.region_min.array()).all()) box.fail("max", "each component must exceed min");
-    box.finish();
+    read_box(map, "region", file, p.region_min, p.region_max);
   }
   map.finish();
   return p;
@@ -224,6 +279,16 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
   if (w.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
   w.normal.normalize();
   p.finish();
+  w.velocity = map.vec3("velocity", w.velocity);
+  if (const YAML::Node servo = map.node("servo")) {
+    MapReader sv(servo, file, map.key_path("servo"));
+    w.has_servo = true;
+    w.servo.target_stress = sv.required_number("target_stress", 1e-6, 1e12, "Pa");
+    w.servo.area = sv.number("area", 0.0, 0.0, 1e6, "m^2");
+    w.servo.max_speed = sv.number("max_speed", 0.0, 0.0, 1e3, "m/s");
+    sv.finish();
+    if (std::abs(w.velocity.dot(w.normal)) > 0) map.fail("velocity", "a servo wall sets its own normal speed; give only a tangential velocity");
+  }
   map.finish();
   return w;
 }
@@ -250,6 +315,17 @@ SimulationSpec read_simulation(const YAML::Node& node, const std::string& file) 
     if (!(s.domain_max.array() > s.domain_min.array()).all()) box.fail("max", "each component must exceed min");
     box.finish();
   }
+  if (const YAML::Node periodic = map.node("periodic")) {
+    if (!periodic.IsSequence()) map.fail("periodic", "must be a list of axes, e.g. [x, y]");
+    for (const auto& axis : periodic) {
+      const std::string a = axis.IsScalar() ? axis.Scalar() : "";
+      if (a != "x" && a != "y" && a != "z") map.fail("periodic", fmt::format("'{}' is not an axis; valid: x, y, z", a));
+      s.periodic[a[0] - 'x'] = true;
+    }
+    if (!s.has_domain) map.fail("periodic", "needs a `domain` box: its size along each periodic axis is the period");
+  }
+  s.mass_scaling = map.number("mass_scaling", 1.0, 1e-6, 1e12);
+  s.stiffness_scaling = map.number("stiffness_scaling", 1.0, 1e-9, 1e3);
   map.finish();
   return s;
 }
@@ -262,6 +338,8 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   o.directory = map.string("directory", o.directory);
   o.scalars_every = map.integer("scalars_every", 0, 0, std::numeric_limits<int32_t>::max());
   o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
+  o.frames_every = map.number("frames_every", 0.0, 0.0, 1e9, "s");
+  o.checkpoint_every = map.number("checkpoint_every", 0.0, 0.0, 1e9, "s");
   map.finish();
   return o;
 }
@@ -298,10 +376,24 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     if (!walls.IsSequence()) top.fail("walls", "must be a list of walls");
     for (size_t k = 0; k < walls.size(); ++k) spec.planes.push_back(read_wall(walls[k], file, k));
   }
+  if (const YAML::Node clumps = top.node("clumps")) {
+    if (!clumps.IsMap()) top.fail("clumps", "must be a map of template names to {spheres: [...]}");
+    for (const auto& kv : clumps) spec.clumps.push_back(read_clump(kv.first.as<std::string>(), kv.second, file));
+  }
+  if (const YAML::Node inlets = top.node("inlets")) {
+    if (!inlets.IsSequence()) top.fail("inlets", "must be a list of inlets");
+    for (size_t k = 0; k < inlets.size(); ++k) spec.inlets.push_back(read_inlet(inlets[k], file, k));
+  }
+  if (const YAML::Node outlets = top.node("outlets")) {
+    if (!outlets.IsSequence()) top.fail("outlets", "must be a list of outlets");
+    for (size_t k = 0; k < outlets.size(); ++k) spec.outlets.push_back(read_outlet(outlets[k], file, k));
+  }
   const YAML::Node particles = top.node("particles");
-  if (!particles || !particles.IsSequence() || particles.size() == 0)
-    top.fail("particles", "missing: a list of particle sets {material, diameter, count + region | positions}");
-  for (size_t k = 0; k < particles.size(); ++k) spec.particles.push_back(read_particles(particles[k], file, k));
+  if (particles && !particles.IsSequence()) top.fail("particles", "must be a list of particle sets");
+  if ((!particles || particles.size() == 0) && spec.inlets.empty())
+    top.fail("particles", "missing: a list of particle sets {material, diameter, count + region | positions}, or inlets");
+  if (particles)
+    for (size_t k = 0; k < particles.size(); ++k) spec.particles.push_back(read_particles(particles[k], file, k));
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;

@@ -58,14 +58,6 @@ struct ContactSpec {
   std::vector<Choice> adhesion, extra;
 };
 
-struct PlaneWallSpec {
-  std::string name;
-  Vec3 point{0, 0, 0};   // [m]
-  Vec3 normal{0, 0, 1};  // points into the region particles live in
-  std::string material;
-  SourceLocation location;
-};
-
 /// Particle diameters: fixed, or drawn from a truncated distribution.
 struct SizeDistributionSpec {
   enum class Kind { fixed, normal, uniform, discrete } kind = Kind::fixed;
@@ -78,8 +70,56 @@ struct SizeDistributionSpec {
   double smallest() const;
 };
 
+/// A plane that holds a normal stress by moving along its normal (servo control).
+struct ServoSpec {
+  double target_stress = 0;  // [Pa] compressive normal stress the wall holds
+  double area = 0;           // [m^2] area the stress acts on; 0: the periodic cross-section
+  double max_speed = 0;      // [m/s] speed at 100 % stress error; 0: 0.2 % of the smallest radius per step
+};
+
+struct PlaneWallSpec {
+  std::string name;
+  Vec3 point{0, 0, 0};   // [m]
+  Vec3 normal{0, 0, 1};  // points into the region particles live in
+  Vec3 velocity{0, 0, 0};  // [m/s] constant; a tangential part moves the surface, not the plane
+  bool has_servo = false;
+  ServoSpec servo;
+  std::string material;
+  SourceLocation location;
+};
+
+/// A rigid particle made of overlapping spheres (the source paper's sphere conglomerates).
+struct ClumpTemplateSpec {
+  std::string name;
+  std::vector<Vec3> centres;    // [m] in the template's frame
+  std::vector<double> radii;    // [m]
+  SourceLocation location;
+};
+
+/// Inserts particles at a mass rate inside a box, without overlaps.
+struct InletSpec {
+  std::string name;
+  std::string material;
+  SizeDistributionSpec diameter;
+  std::string clump;              ///< template name, or "" for spheres
+  double mass_rate = 0;           // [kg/s] (YAML: mass_rate_tph in t/h, or mass_rate_kgs)
+  Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m]
+  Vec3 velocity{0, 0, 0};         // [m/s]
+  double start = 0, stop = 1e300; // [s]
+  double interval = 0;            // [s] between insertions; 0: automatic
+  SourceLocation location;
+};
+
+/// Removes particles whose centre enters a box and counts them.
+struct OutletSpec {
+  std::string name;
+  Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m]
+  SourceLocation location;
+};
+
 struct ParticleSetSpec {
   std::string material;
+  std::string clump;  ///< template name, or "" for spheres; diameter then scales the template
   SizeDistributionSpec diameter;
   std::vector<Vec3> positions;  ///< explicit centres [m]; else `count` random in `region`
   int64_t count = 0;
@@ -101,12 +141,17 @@ struct SimulationSpec {
   double skin = 0.0;              // [m] Verlet skin; 0: a quarter of the smallest diameter
   bool has_domain = false;        // particles leaving the domain box are removed and counted
   Vec3 domain_min{0, 0, 0}, domain_max{0, 0, 0};
+  bool periodic[3] = {false, false, false};  // along x, y, z: the domain wraps around
+  double mass_scaling = 1.0;      // [-] particle densities multiplied by this (quasi-static tests)
+  double stiffness_scaling = 1.0; // [-] Young's moduli of particle materials multiplied by this
 };
 
 struct OutputSpec {
   std::string directory = "out";  ///< relative to the working directory
   int64_t scalars_every = 0;      ///< steps between rows of scalars.csv; 0: about 200 rows
   double progress_seconds = 2.0;  ///< wall-clock seconds between progress lines
+  double frames_every = 0;        ///< [s] simulated time between HDF5 particle frames; 0: 20 frames
+  double checkpoint_every = 0;    ///< [s] simulated time between checkpoints; 0: none
 };
 
 struct CaseSpec {
@@ -117,7 +162,10 @@ struct CaseSpec {
   std::vector<InteractionSpec> interactions;
   ContactSpec contact;
   std::vector<PlaneWallSpec> planes;
+  std::vector<ClumpTemplateSpec> clumps;
   std::vector<ParticleSetSpec> particles;
+  std::vector<InletSpec> inlets;
+  std::vector<OutletSpec> outlets;
   OutputSpec output;
 };
 

@@ -32,15 +32,36 @@ std::size_t State::add_sphere(double px, double py, double pz, double r, double 
   inv_inertia.push_back(1.0 / (0.4 * mass * r * r));
   material.push_back(mat);
   id.push_back(next_id++);
+  body.push_back(-1);
+  offset_x.push_back(0.0), offset_y.push_back(0.0), offset_z.push_back(0.0);
   return x.size() - 1;
+}
+
+std::size_t State::add_body(double px, double py, double pz, const double q[4], double m, const double principal[3]) {
+  Bodies& b = bodies;
+  b.x.push_back(px), b.y.push_back(py), b.z.push_back(pz);
+  for (auto* c : {&b.vx, &b.vy, &b.vz, &b.lx, &b.ly, &b.lz, &b.fx, &b.fy, &b.fz, &b.tx, &b.ty, &b.tz}) c->push_back(0.0);
+  b.qw.push_back(q[0]), b.qx.push_back(q[1]), b.qy.push_back(q[2]), b.qz.push_back(q[3]);
+  b.mass.push_back(m);
+  b.ix.push_back(principal[0]), b.iy.push_back(principal[1]), b.iz.push_back(principal[2]);
+  b.id.push_back(next_id++);
+  return b.size() - 1;
+}
+
+void State::attach(std::size_t sphere, std::size_t b, double ox, double oy, double oz) {
+  body[sphere] = static_cast<std::int32_t>(b);
+  offset_x[sphere] = ox, offset_y[sphere] = oy, offset_z[sphere] = oz;
+  inv_mass[sphere] = 1.0 / bodies.mass[b];  // contacts see the body's mass
 }
 
 void State::permute(const std::vector<std::int32_t>& order) {
   std::vector<double> scratch;
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
     apply_order(*c, order, scratch);
+  for (auto* c : {&offset_x, &offset_y, &offset_z}) apply_order(*c, order, scratch);
   std::vector<std::int32_t> s32;
   apply_order(material, order, s32);
+  apply_order(body, order, s32);
   std::vector<std::int64_t> s64;
   apply_order(id, order, s64);
 }
@@ -48,8 +69,26 @@ void State::permute(const std::vector<std::int32_t>& order) {
 void State::compact(const std::vector<std::uint8_t>& keep) {
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
     keep_only(*c, keep);
+  for (auto* c : {&offset_x, &offset_y, &offset_z}) keep_only(*c, keep);
   keep_only(material, keep);
   keep_only(id, keep);
+  keep_only(body, keep);
+  if (bodies.size() == 0) return;
+  // Remove bodies none of whose spheres remain; renumber the others.
+  std::vector<std::uint8_t> body_kept(bodies.size(), 0);
+  for (std::int32_t b : body)
+    if (b >= 0) body_kept[b] = 1;
+  std::vector<std::int32_t> renumber(bodies.size(), -1);
+  std::int32_t next = 0;
+  for (size_t b = 0; b < bodies.size(); ++b)
+    if (body_kept[b]) renumber[b] = next++;
+  for (std::int32_t& b : body)
+    if (b >= 0) b = renumber[b];
+  Bodies& d = bodies;
+  for (auto* c : {&d.x, &d.y, &d.z, &d.vx, &d.vy, &d.vz, &d.qw, &d.qx, &d.qy, &d.qz, &d.lx, &d.ly, &d.lz, &d.fx, &d.fy,
+                  &d.fz, &d.tx, &d.ty, &d.tz, &d.mass, &d.ix, &d.iy, &d.iz})
+    keep_only(*c, body_kept);
+  keep_only(d.id, body_kept);
 }
 
 }  // namespace dem

@@ -18,6 +18,43 @@ struct ContactList {
   void clear() { i.clear(), j.clear(), history.clear(); }
 };
 
+/// Rigid bodies made of several spheres (clumps); free spheres are not bodies. Per body:
+/// 21 doubles + 8 bytes = 176 bytes.
+struct Bodies {
+  std::vector<double> x, y, z;          // [m] centre of mass
+  std::vector<double> vx, vy, vz;       // [m/s]
+  std::vector<double> qw, qx, qy, qz;   // orientation, principal frame -> world (unit quaternion)
+  std::vector<double> lx, ly, lz;       // [kg m^2/s] angular momentum about the centre, world frame
+  std::vector<double> fx, fy, fz;       // [N] total force at the last evaluation
+  std::vector<double> tx, ty, tz;       // [N m] total torque about the centre
+  std::vector<double> mass;             // [kg]
+  std::vector<double> ix, iy, iz;       // [kg m^2] principal moments
+  std::vector<std::int64_t> id;
+  std::size_t size() const { return x.size(); }
+};
+
+/// Plane walls as they are now (the model holds where they started). Per wall: 9 doubles.
+struct WallStates {
+  std::vector<double> px, py, pz;  // [m] a point on the plane
+  std::vector<double> vx, vy, vz;  // [m/s] velocity of the surface
+  std::vector<double> fx, fy, fz;  // [N] force the particles exert on the wall, last evaluation
+};
+
+/// Bookkeeping of an inlet: reproducible draws and the mass delivered so far.
+struct InletState {
+  std::uint64_t random;       ///< splitmix64 state
+  double inserted_mass = 0;   // [kg]
+  std::int64_t inserted = 0;  ///< particles
+  double next_time = 0;       // [s]
+  double pending_diameter = 0;  // [m] drawn, not yet placed (0: none)
+  std::int64_t failed = 0;    ///< insertions given up because the region was full
+};
+
+struct OutletState {
+  double removed_mass = 0;  // [kg]
+  std::int64_t removed = 0;
+};
+
 struct State {
   double time = 0.0;  // [s]
   std::int64_t step = 0;
@@ -35,17 +72,32 @@ struct State {
   std::vector<double> inv_inertia; // [1/(kg m^2)]
   std::vector<std::int32_t> material;
   std::vector<std::int64_t> id;    ///< persistent, never reused
+  std::vector<std::int32_t> body;  ///< clump index, -1 for a free sphere
+  std::vector<double> offset_x, offset_y, offset_z;  // [m] centre in the body's principal frame
+
+  Bodies bodies;
+  WallStates walls;
+  std::vector<InletState> inlets;
+  std::vector<OutletState> outlets;
 
   ContactList pairs;       ///< particle-particle
   ContactList wall_pairs;  ///< particle-plane wall
+  /// Positions at the last rebuild of the contact lists: the lists stay valid until a sphere
+  /// has moved half the skin from here. Part of the state so a restart rebuilds when the
+  /// uninterrupted run would.
+  std::vector<double> x_built, y_built, z_built;
 
   std::size_t size() const { return x.size(); }
   /// Appends a sphere at rest state; returns its slot.
   std::size_t add_sphere(double px, double py, double pz, double r, double density, int mat);
   /// Reorders particle slots: new slot k holds old slot order[k]. Contact lists are not touched.
   void permute(const std::vector<std::int32_t>& order);
-  /// Keeps only slots with keep[k] != 0 (contact lists are not touched).
+  /// Keeps only slots with keep[k] != 0 (contact lists are not touched). Bodies none of whose
+  /// spheres remain are removed and the others renumbered.
   void compact(const std::vector<std::uint8_t>& keep);
+  /// Appends a clump body; its spheres are added with add_sphere and `attach`ed.
+  std::size_t add_body(double px, double py, double pz, const double q[4], double mass, const double principal[3]);
+  void attach(std::size_t sphere, std::size_t body, double ox, double oy, double oz);
 };
 
 }  // namespace dem

@@ -1,47 +1,96 @@
 #include "step.h"
 
-#include "parallel.h"
+#include <algorithm>
+#include <cmath>
 
 #include "forces.h"
 #include "neighbors.h"
+#include "parallel.h"
+#include "particles.h"
+#include "rigid_body.h"
 
 namespace dem {
 
 namespace {
 
-/// v += h F / m, w += h T / I.
+/// v += h F / m, w += h T / I for free spheres; V += h F / M, L += h T for bodies.
 void kick(State& s, double h) {
   const long n = static_cast<long>(s.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
+    if (s.body[p] >= 0) continue;  // moved by its body
     const double a = h * s.inv_mass[p], b = h * s.inv_inertia[p];
     s.vx[p] += a * s.fx[p], s.vy[p] += a * s.fy[p], s.vz[p] += a * s.fz[p];
     s.wx[p] += b * s.tx[p], s.wy[p] += b * s.ty[p], s.wz[p] += b * s.tz[p];
   }
+  Bodies& b = s.bodies;
+  for (size_t k = 0; k < b.size(); ++k) {
+    const double a = h / b.mass[k];
+    b.vx[k] += a * b.fx[k], b.vy[k] += a * b.fy[k], b.vz[k] += a * b.fz[k];
+    b.lx[k] += h * b.tx[k], b.ly[k] += h * b.ty[k], b.lz[k] += h * b.tz[k];
+  }
 }
 
-/// x += h v.
-void drift(State& s, double h) {
+/// x += h v for free spheres; bodies translate and rotate freely, then place their spheres.
+void drift(State& s, const Workspace& work, const Model& model, double h) {
   const long n = static_cast<long>(s.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
+  Bodies& b = s.bodies;
+  if (b.size() == 0) return;
+  for (size_t k = 0; k < b.size(); ++k) {
+    b.x[k] += h * b.vx[k], b.y[k] += h * b.vy[k], b.z[k] += h * b.vz[k];
+    const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inertia[3] = {b.ix[k], b.iy[k], b.iz[k]};
+    const Quaternion q = free_rotation({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, inertia, h);
+    b.qw[k] = q.w, b.qx[k] = q.x, b.qy[k] = q.y, b.qz[k] = q.z;
+  }
+  place_body_spheres(model, s, work.body_begin, work.body_members);
+}
+
+/// Walls move at their set velocity; servo walls add the normal speed that drives their
+/// stress towards the target: v_n = -clamp((sigma - target)/target, -1, 1) * max_speed.
+void move_walls(const Model& model, State& s, double h) {
+  for (size_t w = 0; w < model.planes.size(); ++w) {
+    const PlaneWall& wall = model.planes[w];
+    double v[3] = {wall.velocity[0], wall.velocity[1], wall.velocity[2]};
+    if (wall.servo) {
+      const double stress = -(s.walls.fx[w] * wall.normal[0] + s.walls.fy[w] * wall.normal[1] + s.walls.fz[w] * wall.normal[2]) /
+                            wall.servo_area;  // [Pa] compressive
+      const double error = std::clamp((stress - wall.target_stress) / wall.target_stress, -1.0, 1.0);
+      for (int a = 0; a < 3; ++a) v[a] -= error * wall.servo_max_speed * wall.normal[a];
+    }
+    s.walls.vx[w] = v[0], s.walls.vy[w] = v[1], s.walls.vz[w] = v[2];
+    s.walls.px[w] += h * v[0], s.walls.py[w] += h * v[1], s.walls.pz[w] += h * v[2];
+  }
+}
+
+/// After the closing kick: sphere velocities of bodies follow the bodies.
+void refresh_body_spheres(const Model& model, State& s, const Workspace& work) {
+  if (s.bodies.size() > 0) place_body_spheres(model, s, work.body_begin, work.body_members);
 }
 
 }  // namespace
 
 void prepare(const Model& model, State& state, Workspace& work) {
-  work.valid = false;
-  rebuild_contacts(model, state, work);
+  if (state.x_built.size() == state.size() && state.size() > 0) {
+    index_contacts(model, state, work);  // restored from a checkpoint: keep its lists as they are
+  } else {
+    rebuild_contacts(model, state, work);
+  }
   compute_forces(model, state, work);
 }
 
 void step(const Model& model, State& state, Workspace& work) {
   const double dt = model.dt;
   kick(state, 0.5 * dt);
-  drift(state, dt);
+  drift(state, work, model, dt);
+  move_walls(model, state, dt);
+  for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
+    if (run_inlet(model, state, k) > 0) work.valid = false;
   if (needs_rebuild(model, state, work)) rebuild_contacts(model, state, work);
   compute_forces(model, state, work);
   kick(state, 0.5 * dt);
+  refresh_body_spheres(model, state, work);
   state.time += dt;
   ++state.step;
 }

@@ -51,14 +51,21 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
   advice.rayleigh_time = std::numeric_limits<double>::infinity();
   advice.contact_time = std::numeric_limits<double>::infinity();
   const bool hertz = !model.effects.empty() && model.effects.front().spec->name == "hertz";
-  for (const ParticleSource& s : model.sources) {
+  struct Kind { int material; double diameter; };
+  std::vector<Kind> kinds;
+  for (const ParticleSource& s : model.sources) kinds.push_back({s.material, s.spec.diameter.smallest()});
+  for (const Inlet& in : model.inlets) {
+    kinds.push_back({in.material, in.spec.diameter.smallest()});
+    speed = std::max(speed, in.spec.velocity.norm());
+  }
+  for (const Kind& s : kinds) {
     const Material& m = model.materials[s.material];
-    const double radius = 0.5 * s.spec.diameter.smallest();
+    const double radius = 0.5 * s.diameter;
     const double mass = m.density * 4.0 / 3.0 * kPi * radius * radius * radius;
     advice.rayleigh_time = std::min(advice.rayleigh_time, rayleigh_time(radius, m.density, m.youngs_modulus, m.poisson_ratio));
     std::vector<std::pair<int, bool>> partners{{s.material, false}};
     for (const PlaneWall& w : model.planes) partners.push_back({w.material, true});
-    for (const ParticleSource& o : model.sources) partners.push_back({o.material, false});
+    for (const Kind& o : kinds) partners.push_back({o.material, false});
     for (auto [other, wall] : partners) {
       const double m_eff = wall ? mass : 0.5 * mass, r_eff = wall ? radius : 0.5 * radius;
       const double* row = model.pair_row(model.pair_type(s.material, other));

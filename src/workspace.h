@@ -21,13 +21,15 @@ struct ContactForces {
 struct Workspace {
   bool valid = false;  ///< false: the next step rebuilds the lists
   std::int64_t rebuilds = 0;
-  std::vector<double> x_built, y_built, z_built;  // [m] positions at the last rebuild
 
   // Contact-list indexing (n + 1 entries each): pairs owned by slot p are
   // [pair_begin[p], pair_begin[p+1]); pairs where p is j are incoming[incoming_begin[p] ...].
   std::vector<std::int32_t> pair_begin, incoming_begin, incoming, wall_begin;
 
   ContactForces pair_forces, wall_forces;
+
+  // Spheres of each body: body_members[body_begin[b] ... body_begin[b+1]).
+  std::vector<std::int32_t> body_begin, body_members;
 
   // Cell grid scratch.
   std::vector<std::int32_t> cell_of, cell_start, order;

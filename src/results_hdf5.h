@@ -1,0 +1,90 @@
+// Results writer: particle frames as HDF5 files with an XDMF index beside them that ParaView opens
+// (File > Open particles.xdmf, "Xdmf3 Reader"). Depends only on the HDF5 C API, fmt and the standard
+// library, and not on the engine's State, so it can be tested and reused on its own.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dem {
+
+/// One particle frame, as columns (n particles). Pointers stay valid during write_frame.
+struct ParticleFrame {
+  double time = 0;  // [s]
+  std::int64_t step = 0;
+  std::size_t count = 0;
+  const std::int64_t* id = nullptr;
+  const double *x = nullptr, *y = nullptr, *z = nullptr;     // [m] sphere centres
+  const double *vx = nullptr, *vy = nullptr, *vz = nullptr;  // [m/s]
+  const double *wx = nullptr, *wy = nullptr, *wz = nullptr;  // [rad/s]
+  const double* radius = nullptr;                            // [m]
+  const std::int32_t* material = nullptr;
+  /// Clump (rigid body) index, -1 for a free sphere; may be nullptr -> all -1.
+  const std::int32_t* clump = nullptr;
+  /// Orientation quaternion of the body the sphere belongs to; all four nullptr -> identity.
+  const double *qw = nullptr, *qx = nullptr, *qy = nullptr, *qz = nullptr;
+};
+
+/// One frame listed in the XDMF; `file` is relative to the writer's directory.
+struct FrameInfo {
+  double time;  // [s]
+  std::int64_t step;
+  std::string file;
+  std::size_t count;
+};
+
+/// Writes DIR/frames/frame_NNNNNN.h5 (NNNNNN = step) and keeps DIR/particles.xdmf listing them as a
+/// temporal collection.
+///
+/// Each frame file holds, at its root: datasets `id` (int64, n), `position`, `velocity`,
+/// `angular_velocity` (float64, n x 3; m, m/s, rad/s), `radius` (float64, n; m), `material`, `clump`
+/// (int32, n), `orientation` (float64, n x 4; w x y z), `speed` (float64, n; |v| in m/s) and
+/// `connectivity` (int64, n; 0..n-1, the Polyvertex cells the XDMF needs so ParaView draws the points);
+/// string attributes `units` = "SI", `material_names` (comma-separated) and the constructor's
+/// attributes, plus `time` (float64, s) and `step` (int64).
+///
+/// Writes are atomic: a frame goes to `.h5.part` and is renamed to `.h5` after H5Fclose succeeded and
+/// the data reached the disk; the XDMF is replaced through a temporary file and a rename. A crash
+/// therefore leaves at worst an unlisted `.part` file; every listed frame stays readable.
+class FrameWriter {
+ public:
+  /// Frames go to DIR/frames/frame_000042.h5 and DIR/particles.xdmf. Nothing touches the disk before
+  /// the first write_frame. `attributes` (key -> value) are written as HDF5 string attributes on every
+  /// frame root (scaling factors, software version). Throws std::invalid_argument for a material name
+  /// with a comma, or an empty, repeated or reserved (time, step, units, material_names) key.
+  FrameWriter(std::string directory, std::vector<std::string> material_names,
+              std::vector<std::pair<std::string, std::string>> attributes);
+
+  /// Writes one frame and relists it in the XDMF. A frame whose step is not after the last listed one
+  /// (a run resumed from an earlier restart point) first drops the listed frames from that step on.
+  /// Throws std::invalid_argument for a missing column, std::runtime_error with the path on an I/O
+  /// failure (e.g. disk full); the XDMF then still lists the frames it listed before.
+  void write_frame(const ParticleFrame& frame);
+
+  const std::vector<FrameInfo>& frames() const { return frames_; }
+
+  /// Re-reads DIR/particles.xdmf's frame list (used after a restart, so a resumed run appends to the
+  /// same XDMF). No XDMF yet -> empty list. Throws std::runtime_error with the path if it cannot be
+  /// read or was not written by this class.
+  void adopt_existing();
+
+  const std::string& directory() const { return directory_; }
+
+ private:
+  void write_hdf5(const std::string& path, const ParticleFrame& frame);
+  void write_xdmf(const std::vector<FrameInfo>& frames) const;
+
+  std::string directory_;
+  std::string material_names_;  ///< comma-separated
+  std::vector<std::pair<std::string, std::string>> attributes_;
+  std::vector<FrameInfo> frames_;
+  // Scratch reused between frames: n x 3 interleaved vectors, n x 4 quaternions, n scalars.
+  std::vector<double> vec3_, quat_, scalar_;
+  std::vector<std::int32_t> int32_;
+  std::vector<std::int64_t> int64_;
+};
+
+}  // namespace dem

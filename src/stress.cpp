@@ -1,0 +1,33 @@
+#include "stress.h"
+
+#include "neighbors.h"
+
+namespace dem {
+
+Eigen::Matrix3d contact_stress(const Model& model, const State& s, const Workspace& work, double volume, bool with_walls) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();  // [N m]
+  const ContactForces& pf = work.pair_forces;
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
+    if (!pf.active[k]) continue;
+    const size_t i = s.pairs.i[k], j = s.pairs.j[k];
+    double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
+    minimum_image(model, d);
+    const Eigen::Vector3d branch(d[0], d[1], d[2]), force(pf.fx[k], pf.fy[k], pf.fz[k]);
+    sum += branch * force.transpose();
+  }
+  if (with_walls) {
+    const ContactForces& wf = work.wall_forces;
+    for (size_t k = 0; k < s.wall_pairs.size(); ++k) {
+      if (!wf.active[k]) continue;
+      const size_t i = s.wall_pairs.i[k];
+      const int w = s.wall_pairs.j[k];
+      const auto& n = model.planes[w].normal;
+      const double dist = (s.x[i] - s.walls.px[w]) * n[0] + (s.y[i] - s.walls.py[w]) * n[1] + (s.z[i] - s.walls.pz[w]) * n[2];
+      const Eigen::Vector3d branch(dist * n[0], dist * n[1], dist * n[2]), force(wf.fx[k], wf.fy[k], wf.fz[k]);
+      sum += branch * force.transpose();
+    }
+  }
+  return 0.5 * (sum + sum.transpose()) / volume;
+}
+
+}  // namespace dem
