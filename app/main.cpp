@@ -24,6 +24,7 @@ struct RunArgs {
   int threads = 0;
   std::string out;
   bool quiet = false;
+  bool resume = false;
 };
 
 int run_case(const RunArgs& args) {
@@ -38,6 +39,7 @@ int run_case(const RunArgs& args) {
   options.max_steps = args.max_steps;
   options.output_directory = args.out;
   options.progress = !args.quiet;
+  options.resume = args.resume;
   dem::run(model, state, work, options, std::cout);
   return 0;
 }
@@ -54,6 +56,7 @@ int main(int argc, char** argv) {
     cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)");
     cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
     cmd->add_flag("--quiet", args.quiet, "no progress lines");
+    cmd->add_flag("--resume", args.resume, "continue from OUT/checkpoint.bin (written every output.checkpoint_every, and on SIGINT/SIGTERM)");
   };
   app.add_option("case", args.case_path, "case file (YAML) to run");
   add_run_options(&app);

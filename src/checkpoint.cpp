@@ -13,7 +13,7 @@ namespace dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '2'};
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '3'};
 
 /// Every field of the State, in one order, for both directions.
 template <typename Io, typename S>
@@ -33,6 +33,17 @@ void visit(Io& io, S& s) {
   for (auto* c : {&w.px, &w.py, &w.pz, &w.vx, &w.vy, &w.vz, &w.fx, &w.fy, &w.fz}) io(*c);
   io(s.inlets), io(s.outlets);
   for (auto* list : {&s.pairs, &s.wall_pairs}) io(list->i), io(list->j), io(list->history);
+  io(s.has_meshes), io(s.mesh_history_width);
+  auto& mc = s.mesh_contacts;
+  io(mc.count), io(mc.mesh), io(mc.triangle), io(mc.px), io(mc.py), io(mc.pz), io(mc.history);
+  io(s.candidate_begin), io(s.mesh_candidates), io(s.lists_built_time);
+  std::uint64_t meshes = s.records.size();
+  io(meshes);
+  if constexpr (!std::is_const_v<S>) s.records.resize(meshes);
+  for (auto& r : s.records) io(r.normal_impulse), io(r.shear_impulse), io(r.shear_work), io(r.impacts), io(r.impact_energy);
+  for (auto* c : {&s.mesh_loads.fx, &s.mesh_loads.fy, &s.mesh_loads.fz, &s.mesh_loads.tx, &s.mesh_loads.ty, &s.mesh_loads.tz,
+                  &s.mesh_loads.power})
+    io(*c);
 }
 
 struct Writer {

@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 
+#include <Eigen/Geometry>
+
 #include "model.h"
 #include "clump_geometry.h"
 #include "timestep.h"
@@ -108,7 +110,7 @@ double Model::pair_param(int a, int b, std::string_view key) const {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-Model compile(const CaseSpec& spec) {
+Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   Model model;
   model.source = spec.path;
   model.title = spec.title;
@@ -210,6 +212,41 @@ Model compile(const CaseSpec& spec) {
     wall.servo_area = w.servo.area;
     wall.servo_max_speed = w.servo.max_speed;
     model.planes.push_back(wall);
+  }
+
+  // Mesh walls: triangles inline or from the loader, placed by their transform.
+  for (size_t k = 0; k < spec.meshes.size(); ++k) {
+    const MeshWallSpec& m = spec.meshes[k];
+    auto surface = std::make_shared<TriangleSurface>();
+    if (!m.triangles.empty()) {
+      const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(m.rotate_deg.z() * std::numbers::pi / 180, Vec3::UnitZ()) *
+                                        Eigen::AngleAxisd(m.rotate_deg.y() * std::numbers::pi / 180, Vec3::UnitY()) *
+                                        Eigen::AngleAxisd(m.rotate_deg.x() * std::numbers::pi / 180, Vec3::UnitX()))
+                                           .toRotationMatrix();
+      for (const auto& v : m.vertices) {
+        const Vec3 placed = rotation * (Vec3(v[0], v[1], v[2]) * m.unit_scale).cwiseProduct(m.scale) + m.translate;
+        surface->vertices.push_back({placed.x(), placed.y(), placed.z()});
+      }
+      surface->triangles = m.triangles;
+    } else {
+      if (!loader)
+        throw CaseError(fmt::format("{}: meshes[{}].file: reading mesh files needs the geometry library; run the case "
+                                    "with the demdesign program", m.location.str(), k));
+      TriangleSoup soup = loader(m);
+      surface->vertices = std::move(soup.vertices);
+      surface->triangles = std::move(soup.triangles);
+    }
+    if (surface->triangles.empty())
+      throw CaseError(fmt::format("{}: meshes[{}]: the mesh has no triangles", m.location.str(), k));
+    surface->build_topology();
+    MeshWall wall;
+    wall.name = m.name;
+    wall.material = material_or_fail(m.material, m.location, fmt::format("meshes[{}].material", k));
+    wall.surface = surface;
+    wall.bvh = std::make_shared<TriangleBvh>(*surface);
+    wall.motion = m.motion;
+    wall.surface_velocity = m.surface;
+    model.meshes.push_back(std::move(wall));
   }
 
   // Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.

@@ -70,6 +70,13 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
     count(pair_overlap(model, s, s.pairs.i[k], s.pairs.j[k]), std::min(s.radius[s.pairs.i[k]], s.radius[s.pairs.j[k]]));
   for (size_t k = 0; k < s.wall_pairs.size(); ++k)
     count(wall_overlap(model, s, s.wall_pairs.i[k], s.wall_pairs.j[k]), s.radius[s.wall_pairs.i[k]]);
+  if (s.has_meshes)  // mesh contacts of the last evaluation: overlap = r - distance to the contact point
+    for (size_t p = 0; p < s.size(); ++p)
+      for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
+        const size_t slot = p * MeshContacts::kSlots + k;
+        const double dx = s.x[p] - work.mesh_slots.cx[slot], dy = s.y[p] - work.mesh_slots.cy[slot], dz = s.z[p] - work.mesh_slots.cz[slot];
+        count(s.radius[p] - std::sqrt(dx * dx + dy * dy + dz * dz), s.radius[p]);
+      }
   out.mean_overlap_ratio = out.contacts ? sum / static_cast<double>(out.contacts) : 0.0;
   for (const InletState& in : s.inlets) out.inserted_mass += in.inserted_mass;
   for (const OutletState& o : s.outlets) out.removed_mass += o.removed_mass, out.outlet_mass.push_back(o.removed_mass);

@@ -5,6 +5,7 @@
 #include "parallel.h"
 #include "forces.h"
 
+#include "mesh_contacts.h"
 #include "neighbors.h"
 
 #include <cmath>
@@ -180,7 +181,11 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
     if (batch.b.count) flush(model, batch, work.wall_forces);
   }
 
-  // Sum per particle in list order: own pairs, incoming pairs, walls; then gravity.
+  mesh_contact_forces(model, s, work);
+
+  // Sum per particle in list order: own pairs, incoming pairs, walls, meshes; then gravity.
+  const ContactForces& mf = work.mesh_forces;
+  const bool meshes = !model.meshes.empty();
   const ContactForces& pf = work.pair_forces;
   const ContactForces& wf = work.wall_forces;
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
@@ -202,6 +207,14 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
       if (!wf.active[k]) continue;
       fx += wf.fx[k], fy += wf.fy[k], fz += wf.fz[k];
       tx += wf.tix[k], ty += wf.tiy[k], tz += wf.tiz[k];
+    }
+    if (meshes) {
+      for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
+        const size_t slot = static_cast<size_t>(p) * MeshContacts::kSlots + k;
+        if (!mf.active[slot]) continue;
+        fx += mf.fx[slot], fy += mf.fy[slot], fz += mf.fz[slot];
+        tx += mf.tix[slot], ty += mf.tiy[slot], tz += mf.tiz[slot];
+      }
     }
     const double mass = s.body[p] >= 0 ? 0.0 : 1.0 / s.inv_mass[p];  // a body carries its own weight
     s.fx[p] = fx + mass * gx, s.fy[p] = fy + mass * gy, s.fz[p] = fz + mass * gz;

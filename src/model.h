@@ -5,10 +5,14 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "effect.h"
+#include "kinematics.h"
+#include "mesh.h"
 #include "spec.h"
 
 namespace dem {
@@ -39,6 +43,16 @@ struct PlaneWall {
   double target_stress = 0;  // [Pa]
   double servo_area = 0;     // [m^2]
   double servo_max_speed = 0;  // [m/s]
+};
+
+/// A triangulated wall: its surface in the mesh's own frame, the BVH over it, how it moves.
+struct MeshWall {
+  std::string name;
+  int material;
+  std::shared_ptr<const TriangleSurface> surface;
+  std::shared_ptr<const TriangleBvh> bvh;
+  Motion motion;
+  SurfaceVelocitySpec surface_velocity;
 };
 
 /// A clump template in its principal frame with the centre of mass at the origin, scaled to a
@@ -90,6 +104,7 @@ struct Model {
   double interaction_range = 0;    ///< [m] largest gap at which any effect acts
 
   std::vector<PlaneWall> planes;
+  std::vector<MeshWall> meshes;
   std::vector<ClumpTemplate> clumps;
   std::vector<ParticleSource> sources;
   std::vector<Inlet> inlets;
@@ -122,8 +137,17 @@ struct Model {
   int material_index(std::string_view name) const;  ///< -1 when absent
 };
 
-/// Checks the spec and builds the model. Throws CaseError naming file, line and key.
-Model compile(const CaseSpec& spec);
+/// Triangles of a mesh wall given by file (the geometry library imports, checks and repairs it;
+/// the engine does not read CAD itself).
+struct TriangleSoup {
+  std::vector<std::array<double, 3>> vertices;  // [m]
+  std::vector<std::array<std::int32_t, 3>> triangles;
+};
+using MeshLoader = std::function<TriangleSoup(const MeshWallSpec&)>;
+
+/// Checks the spec and builds the model. Throws CaseError naming file, line and key. Meshes
+/// given by file need `loader`; inline meshes do not.
+Model compile(const CaseSpec& spec, const MeshLoader& loader = {});
 
 /// The effect documentation table (`demdesign effects`).
 std::string describe_effects();

@@ -1,5 +1,7 @@
 #include "neighbors.h"
 
+#include "mesh_contacts.h"
+
 #include "parallel.h"
 
 #include <algorithm>
@@ -223,7 +225,9 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work) {
     const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
     moved |= (dx * dx + dy * dy + dz * dz > limit2);
   }
-  return moved != 0;
+  if (moved) return true;
+  // Meshes move too: each side may use half the skin.
+  return !model.meshes.empty() && mesh_displacement_since_build(model, s, work.mesh_time) > 0.5 * model.skin;
 }
 
 void rebuild_contacts(const Model& model, State& s, Workspace& work) {
@@ -243,6 +247,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   wrap_into_period(model, s);
   if (n == 0) {  // nothing yet (an inlet will bring particles) or everything left
     s.pairs.clear(), s.wall_pairs.clear();
+    s.candidate_begin.assign(1, 0), s.mesh_candidates.clear();
     s.x_built.clear(), s.y_built.clear(), s.z_built.clear();
     index_contacts(model, s, work);
     ++work.rebuilds;
@@ -367,6 +372,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     }
   }
 
+  find_mesh_candidates(model, s, work, reach);
   s.x_built = s.x;
   s.y_built = s.y;
   s.z_built = s.z;

@@ -193,6 +193,13 @@ bool try_place(const Model& model, State& state, PlacementGrid& grid, Random& ra
 
 State initial_state(const Model& model) {
   State state;
+  state.has_meshes = !model.meshes.empty();
+  state.mesh_history_width = static_cast<size_t>(model.history_width);
+  for (const MeshWall& mesh : model.meshes) {
+    TriangleRecords r;
+    for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) c->assign(mesh.surface->size(), 0.0);
+    state.records.push_back(std::move(r));
+  }
   for (const PlaneWall& w : model.planes) {
     state.walls.px.push_back(w.point[0]), state.walls.py.push_back(w.point[1]), state.walls.pz.push_back(w.point[2]);
     state.walls.vx.push_back(w.velocity[0]), state.walls.vy.push_back(w.velocity[1]), state.walls.vz.push_back(w.velocity[2]);

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <limits>
+#include <numbers>
 
 #include "effect.h"
 #include "yaml_check.h"
@@ -235,6 +236,70 @@ OutletSpec read_outlet(const YAML::Node& node, const std::string& file, size_t i
   return out;
 }
 
+MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("meshes[{}]", index));
+  MeshWallSpec m;
+  m.location = map.location();
+  m.name = map.string("name", fmt::format("mesh{}", index));
+  m.material = map.string("material", "");
+  if (m.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  const std::string base_dir = std::filesystem::path(file).parent_path().string();
+  m.file = map.string("file", "");
+  if (!m.file.empty() && std::filesystem::path(m.file).is_relative() && !base_dir.empty())
+    m.file = (std::filesystem::path(base_dir) / m.file).string();
+  m.unit_scale = map.number("unit_scale", 1.0, 1e-9, 1e9);
+  m.scale = map.vec3("scale", m.scale);
+  m.rotate_deg = map.vec3("rotate_deg", m.rotate_deg);
+  m.translate = map.vec3("translate", m.translate);
+  const YAML::Node vertices = map.node("vertices"), triangles = map.node("triangles");
+  if (vertices || triangles) {
+    if (!m.file.empty()) map.fail("vertices", "give either `file` or inline `vertices` and `triangles`, not both");
+    if (!vertices || !vertices.IsSequence() || !triangles || !triangles.IsSequence())
+      map.fail("triangles", "inline meshes need `vertices: [[x,y,z], ...]` and `triangles: [[i,j,k], ...]`");
+    for (const auto& v : vertices) {
+      if (!v.IsSequence() || v.size() != 3) map.fail("vertices", "each vertex must be [x, y, z]");
+      m.vertices.push_back({MapReader::scalar_number(v[0], map, "vertices"), MapReader::scalar_number(v[1], map, "vertices"),
+                            MapReader::scalar_number(v[2], map, "vertices")});
+    }
+    for (const auto& t : triangles) {
+      if (!t.IsSequence() || t.size() != 3) map.fail("triangles", "each triangle must be three vertex indices [i, j, k]");
+      std::array<std::int32_t, 3> tri;
+      for (int k = 0; k < 3; ++k) {
+        const double v = MapReader::scalar_number(t[k], map, "triangles");
+        if (v < 0 || v >= static_cast<double>(m.vertices.size()) || v != std::floor(v))
+          map.fail("triangles", fmt::format("vertex index {:g} is not one of the {} vertices (0-based)", v, m.vertices.size()));
+        tri[k] = static_cast<std::int32_t>(v);
+      }
+      m.triangles.push_back(tri);
+    }
+  } else if (m.file.empty()) {
+    map.fail("file", "missing: a mesh file (STL, OBJ, PLY, glTF, 3MF, ...) or inline vertices and triangles");
+  }
+  if (const YAML::Node motion = map.node("motion")) m.motion = read_motion(motion, file, map.key_path("motion"), base_dir);
+  if (const YAML::Node surface = map.node("surface_velocity")) {
+    MapReader sv(surface, file, map.key_path("surface_velocity"));
+    if (sv.has("linear")) {
+      m.surface.kind = SurfaceVelocitySpec::Kind::linear;
+      m.surface.velocity = sv.vec3("linear", Vec3::Zero());
+    } else if (const YAML::Node rotation = sv.node("rotation")) {
+      MapReader r(rotation, file, sv.key_path("rotation"));
+      m.surface.kind = SurfaceVelocitySpec::Kind::rotation;
+      m.surface.axis = r.vec3("axis", Vec3(0, 0, 1));
+      if (m.surface.axis.norm() < 1e-12) r.fail("axis", "must not be zero");
+      m.surface.axis.normalize();
+      m.surface.point = r.vec3("point", Vec3::Zero());
+      if (r.has("rpm") == r.has("rad_per_s")) r.fail("rpm", "give exactly one of rpm or rad_per_s");
+      m.surface.angular_speed = r.has("rpm") ? r.number("rpm", 0, -1e5, 1e5) * 2 * std::numbers::pi / 60 : r.number("rad_per_s", 0, -1e5, 1e5);
+      r.finish();
+    } else {
+      sv.fail("linear", "give {linear: [vx, vy, vz]} (a belt) or {rotation: {axis, point, rpm}} (a pulley or drum surface)");
+    }
+    sv.finish();
+  }
+  map.finish();
+  return m;
+}
+
 ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, size_t index) {
   MapReader map(node, file, fmt::format("particles[{}]", index));
   ParticleSetSpec p;
@@ -375,6 +440,10 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   if (const YAML::Node walls = top.node("walls")) {
     if (!walls.IsSequence()) top.fail("walls", "must be a list of walls");
     for (size_t k = 0; k < walls.size(); ++k) spec.planes.push_back(read_wall(walls[k], file, k));
+  }
+  if (const YAML::Node meshes = top.node("meshes")) {
+    if (!meshes.IsSequence()) top.fail("meshes", "must be a list of mesh walls");
+    for (size_t k = 0; k < meshes.size(); ++k) spec.meshes.push_back(read_mesh(meshes[k], file, k));
   }
   if (const YAML::Node clumps = top.node("clumps")) {
     if (!clumps.IsMap()) top.fail("clumps", "must be a map of template names to {spheres: [...]}");

@@ -10,6 +10,9 @@
 #include <string>
 #include <vector>
 
+#include <array>
+
+#include "kinematics.h"
 #include "vec3.h"
 
 namespace dem {
@@ -88,6 +91,32 @@ struct PlaneWallSpec {
   SourceLocation location;
 };
 
+/// How the surface of a static wall moves (conveyor belts, pulleys): it changes the contact
+/// velocity, not the geometry.
+struct SurfaceVelocitySpec {
+  enum class Kind { none, linear, rotation } kind = Kind::none;
+  Vec3 velocity{0, 0, 0};  // [m/s] linear: belt velocity, projected on each triangle's plane
+  Vec3 axis{0, 0, 1};      // rotation: unit axis
+  Vec3 point{0, 0, 0};     // [m] a point on the axis
+  double angular_speed = 0;  // [rad/s]
+};
+
+/// A triangulated wall: a CAD file (read by the geometry library) or triangles given inline.
+struct MeshWallSpec {
+  std::string name;
+  std::string file;                       ///< resolved against the case file's folder
+  double unit_scale = 1.0;                // file units -> m (0.001 for mm)
+  Vec3 scale{1, 1, 1};                    // [-] after unit_scale
+  Vec3 rotate_deg{0, 0, 0};               // [deg] about x, then y, then z
+  Vec3 translate{0, 0, 0};                // [m] applied last
+  std::vector<std::array<double, 3>> vertices;         ///< inline (or generated) triangles [m]
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::string material;
+  Motion motion;                          ///< rigid motion of the whole mesh
+  SurfaceVelocitySpec surface;
+  SourceLocation location;
+};
+
 /// A rigid particle made of overlapping spheres (the source paper's sphere conglomerates).
 struct ClumpTemplateSpec {
   std::string name;
@@ -162,6 +191,7 @@ struct CaseSpec {
   std::vector<InteractionSpec> interactions;
   ContactSpec contact;
   std::vector<PlaneWallSpec> planes;
+  std::vector<MeshWallSpec> meshes;
   std::vector<ClumpTemplateSpec> clumps;
   std::vector<ParticleSetSpec> particles;
   std::vector<InletSpec> inlets;

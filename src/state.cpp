@@ -1,5 +1,6 @@
 #include "state.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <numbers>
 
@@ -14,6 +15,24 @@ void apply_order(std::vector<T>& column, const std::vector<std::int32_t>& order,
   for (size_t k = 0; k < order.size(); ++k) scratch[k] = column[order[k]];
   column.swap(scratch);
 }
+/// Same for columns with `stride` entries per particle.
+template <typename T>
+void apply_order_strided(std::vector<T>& column, const std::vector<std::int32_t>& order, size_t stride) {
+  if (stride == 0) return;
+  std::vector<T> out(order.size() * stride);
+  for (size_t k = 0; k < order.size(); ++k)
+    std::copy_n(column.begin() + static_cast<std::ptrdiff_t>(order[k] * stride), stride, out.begin() + static_cast<std::ptrdiff_t>(k * stride));
+  column.swap(out);
+}
+template <typename T>
+void keep_only_strided(std::vector<T>& column, const std::vector<std::uint8_t>& keep, size_t stride) {
+  if (stride == 0) return;
+  size_t out = 0;
+  for (size_t k = 0; k < keep.size(); ++k)
+    if (keep[k]) std::copy_n(column.begin() + static_cast<std::ptrdiff_t>(k * stride), stride, column.begin() + static_cast<std::ptrdiff_t>(out++ * stride));
+  column.resize(out * stride);
+}
+
 template <typename T>
 void keep_only(std::vector<T>& column, const std::vector<std::uint8_t>& keep) {
   size_t out = 0;
@@ -34,6 +53,14 @@ std::size_t State::add_sphere(double px, double py, double pz, double r, double 
   id.push_back(next_id++);
   body.push_back(-1);
   offset_x.push_back(0.0), offset_y.push_back(0.0), offset_z.push_back(0.0);
+  MeshContacts& mc = mesh_contacts;
+  if (!has_meshes) return x.size() - 1;
+  mc.count.push_back(0);
+  for (int k = 0; k < MeshContacts::kSlots; ++k) {
+    mc.mesh.push_back(-1), mc.triangle.push_back(-1);
+    mc.px.push_back(0.0), mc.py.push_back(0.0), mc.pz.push_back(0.0);
+  }
+  mc.history.resize(mc.history.size() + MeshContacts::kSlots * mesh_history_width, 0.0);
   return x.size() - 1;
 }
 
@@ -64,6 +91,14 @@ void State::permute(const std::vector<std::int32_t>& order) {
   apply_order(body, order, s32);
   std::vector<std::int64_t> s64;
   apply_order(id, order, s64);
+  MeshContacts& mc = mesh_contacts;
+  if (!has_meshes) return;
+  std::vector<std::uint8_t> s8;
+  apply_order(mc.count, order, s8);
+  const size_t slots = MeshContacts::kSlots;
+  apply_order_strided(mc.mesh, order, slots), apply_order_strided(mc.triangle, order, slots);
+  apply_order_strided(mc.px, order, slots), apply_order_strided(mc.py, order, slots), apply_order_strided(mc.pz, order, slots);
+  apply_order_strided(mc.history, order, slots * mesh_history_width);
 }
 
 void State::compact(const std::vector<std::uint8_t>& keep) {
@@ -73,6 +108,14 @@ void State::compact(const std::vector<std::uint8_t>& keep) {
   keep_only(material, keep);
   keep_only(id, keep);
   keep_only(body, keep);
+  if (has_meshes) {
+    MeshContacts& mc = mesh_contacts;
+    keep_only(mc.count, keep);
+    const size_t slots = MeshContacts::kSlots;
+    keep_only_strided(mc.mesh, keep, slots), keep_only_strided(mc.triangle, keep, slots);
+    keep_only_strided(mc.px, keep, slots), keep_only_strided(mc.py, keep, slots), keep_only_strided(mc.pz, keep, slots);
+    keep_only_strided(mc.history, keep, slots * mesh_history_width);
+  }
   if (bodies.size() == 0) return;
   // Remove bodies none of whose spheres remain; renumber the others.
   std::vector<std::uint8_t> body_kept(bodies.size(), 0);

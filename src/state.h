@@ -3,6 +3,7 @@
 // so anything that must follow a particle uses its `id`.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -55,6 +56,34 @@ struct OutletState {
   std::int64_t removed = 0;
 };
 
+/// Contacts of each particle with mesh walls: up to kSlots per particle, each with the
+/// triangle, the contact point in the mesh's frame (to recognise the contact next step, also
+/// on a neighbouring triangle) and its history. Per particle: 1 + 6 x (8 + 24 + 8 w) bytes.
+struct MeshContacts {
+  static constexpr int kSlots = 6;
+  std::vector<std::uint8_t> count;           // (n)
+  std::vector<std::int32_t> mesh, triangle;  // (n x kSlots)
+  std::vector<double> px, py, pz;            // [m] (n x kSlots), mesh frame
+  std::vector<double> history;               // (n x kSlots x history_width)
+};
+
+/// What each mesh triangle has received, summed over the run (differences between two times
+/// give the rates over that interval). Per triangle: 5 doubles.
+struct TriangleRecords {
+  std::vector<double> normal_impulse;  // [N s] integral of the normal force
+  std::vector<double> shear_impulse;   // [N s] integral of the tangential force magnitude
+  std::vector<double> shear_work;      // [J] friction work, sum |Ft . v_slip| dt (Archard wear input)
+  std::vector<double> impacts;         // [-] contacts that started on the triangle
+  std::vector<double> impact_energy;   // [J] sum of 1/2 m* vn^2 at the start of each contact
+};
+
+/// Per mesh, from the last force evaluation.
+struct MeshLoads {
+  std::vector<double> fx, fy, fz;  // [N] force of the particles on the mesh
+  std::vector<double> tx, ty, tz;  // [N m] torque about the mesh's motion origin
+  std::vector<double> power;       // [W] rate of work the mesh does on the particles
+};
+
 struct State {
   double time = 0.0;  // [s]
   std::int64_t step = 0;
@@ -82,10 +111,23 @@ struct State {
 
   ContactList pairs;       ///< particle-particle
   ContactList wall_pairs;  ///< particle-plane wall
+  MeshContacts mesh_contacts;
+  /// Triangles near each particle at the last rebuild: (mesh, triangle) entries
+  /// mesh_candidates[candidate_begin[p] .. candidate_begin[p+1]).
+  std::vector<std::int32_t> candidate_begin;
+  std::vector<std::array<std::int32_t, 2>> mesh_candidates;
+  double lists_built_time = 0;  ///< [s] time of the last rebuild (meshes move)
+  std::vector<TriangleRecords> records;  ///< per mesh
+  MeshLoads mesh_loads;
   /// Positions at the last rebuild of the contact lists: the lists stay valid until a sphere
   /// has moved half the skin from here. Part of the state so a restart rebuilds when the
   /// uninterrupted run would.
   std::vector<double> x_built, y_built, z_built;
+
+  /// Whether particles carry mesh-contact slots (only when the model has meshes), and the
+  /// doubles of history per slot; set by initial_state.
+  bool has_meshes = false;
+  std::size_t mesh_history_width = 0;
 
   std::size_t size() const { return x.size(); }
   /// Appends a sphere at rest state; returns its slot.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "forces.h"
+#include "mesh_contacts.h"
 #include "neighbors.h"
 #include "parallel.h"
 #include "particles.h"
@@ -72,6 +73,7 @@ void refresh_body_spheres(const Model& model, State& s, const Workspace& work) {
 }  // namespace
 
 void prepare(const Model& model, State& state, Workspace& work) {
+  place_meshes(model, state.time, work);
   if (state.x_built.size() == state.size() && state.size() > 0) {
     index_contacts(model, state, work);  // restored from a checkpoint: keep its lists as they are
   } else {
@@ -85,6 +87,7 @@ void step(const Model& model, State& state, Workspace& work) {
   kick(state, 0.5 * dt);
   drift(state, work, model, dt);
   move_walls(model, state, dt);
+  place_meshes(model, state.time + dt, work);
   for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
     if (run_inlet(model, state, k) > 0) work.valid = false;
   if (needs_rebuild(model, state, work)) rebuild_contacts(model, state, work);

@@ -65,6 +65,7 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
     advice.rayleigh_time = std::min(advice.rayleigh_time, rayleigh_time(radius, m.density, m.youngs_modulus, m.poisson_ratio));
     std::vector<std::pair<int, bool>> partners{{s.material, false}};
     for (const PlaneWall& w : model.planes) partners.push_back({w.material, true});
+    for (const MeshWall& w : model.meshes) partners.push_back({w.material, true});
     for (const Kind& o : kinds) partners.push_back({o.material, false});
     for (auto [other, wall] : partners) {
       const double m_eff = wall ? mass : 0.5 * mass, r_eff = wall ? radius : 0.5 * radius;

@@ -2,6 +2,7 @@
 // indexing, per-contact force buffers. Never part of a checkpoint.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -18,6 +19,19 @@ struct ContactForces {
   void resize(std::size_t n);
 };
 
+/// Per mesh-contact slot, what the records of triangles and meshes need from the evaluation.
+struct MeshSlotResults {
+  std::vector<double> fn;             // [N] normal force
+  std::vector<double> shear_power;    // [W] |Ft . v_slip|
+  std::vector<double> cx, cy, cz;     // [m] contact point, world
+  std::vector<double> vx, vy, vz;     // [m/s] wall velocity at the contact
+  std::vector<double> impact_energy;  // [J] 1/2 m* vn^2 when the contact started this step, else -1
+  void resize(std::size_t n) {
+    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &vx, &vy, &vz}) c->assign(n, 0.0);
+    impact_energy.assign(n, -1.0);
+  }
+};
+
 struct Workspace {
   bool valid = false;  ///< false: the next step rebuilds the lists
   std::int64_t rebuilds = 0;
@@ -27,6 +41,14 @@ struct Workspace {
   std::vector<std::int32_t> pair_begin, incoming_begin, incoming, wall_begin;
 
   ContactForces pair_forces, wall_forces;
+
+  // Meshes where they are at the time forces are evaluated: x_world = R x_local + T, and the
+  // rigid velocity field. (n_meshes)
+  double mesh_time = -1;  // [s]
+  std::vector<std::array<double, 9>> mesh_rotation;  // row-major R
+  std::vector<std::array<double, 3>> mesh_translation, mesh_linear, mesh_angular, mesh_origin;
+  ContactForces mesh_forces;  ///< per particle slot (n x MeshContacts::kSlots)
+  MeshSlotResults mesh_slots;
 
   // Spheres of each body: body_members[body_begin[b] ... body_begin[b+1]).
   std::vector<std::int32_t> body_begin, body_members;
