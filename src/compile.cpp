@@ -207,6 +207,8 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     PlaneWall wall{w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
                    {w.velocity.x(), w.velocity.y(), w.velocity.z()},
                    material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))};
+    wall.cylinder = w.cylinder;
+    wall.radius = w.radius;
     wall.servo = w.has_servo;
     wall.target_stress = w.servo.target_stress;
     wall.servo_area = w.servo.area;

@@ -20,9 +20,9 @@ double pair_overlap(const Model& m, const State& s, size_t i, size_t j) {
 }
 
 double wall_overlap(const Model& m, const State& s, size_t i, size_t w) {
-  const PlaneWall& wall = m.planes[w];
-  return s.radius[i] - ((s.x[i] - s.walls.px[w]) * wall.normal[0] + (s.y[i] - s.walls.py[w]) * wall.normal[1] +
-                        (s.z[i] - s.walls.pz[w]) * wall.normal[2]);
+  const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
+  double normal[3];
+  return s.radius[i] - m.planes[w].distance(at, x, normal);
 }
 
 double body_rotational_energy(const State& s, size_t k) {

@@ -129,8 +129,10 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   for (std::int32_t k = work.wall_begin[i]; k < work.wall_begin[i + 1]; ++k) {
     const std::int32_t w = s.wall_pairs.j[k];
     const PlaneWall& wall = model.planes[w];
-    const double nx = wall.normal[0], ny = wall.normal[1], nz = wall.normal[2];
-    const double dist = (s.x[i] - s.walls.px[w]) * nx + (s.y[i] - s.walls.py[w]) * ny + (s.z[i] - s.walls.pz[w]) * nz;
+    const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
+    double normal[3];
+    const double dist = wall.distance(at, x, normal);
+    const double nx = normal[0], ny = normal[1], nz = normal[2];
     const double overlap = s.radius[i] - dist;
     if (overlap <= -range || dist <= 0.0) {
       forget(s.wall_pairs, work.wall_forces, k, width);

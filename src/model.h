@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -32,11 +33,40 @@ struct ActiveEffect {
   std::array<std::uint8_t, 4> options{};  ///< chosen value index per OptionSpec
 };
 
-/// Infinite plane; particles live on the side the normal points to. Where it is now is State.
+/// Analytic wall: an infinite plane (particles live on the side the normal points to) or the
+/// inside of an infinite cylinder (axis through `point` along `normal`, radius `radius`).
+/// Where it is now is State.
 struct PlaneWall {
   std::string name;
   std::array<double, 3> point;     // [m] at t = 0
-  std::array<double, 3> normal;    // unit
+  std::array<double, 3> normal;    // unit; a cylinder's axis
+  std::array<double, 3> velocity;  // [m/s] set velocity (a servo adds its normal speed)
+  int material;
+  bool cylinder = false;
+  double radius = 0;  // [m] cylinder
+  bool servo = false;
+  double target_stress = 0;  // [Pa]
+  double servo_area = 0;     // [m^2]
+  double servo_max_speed = 0;  // [m/s]
+
+  /// Distance [m] from the surface to x on the particles' side, and the unit normal there
+  /// (from the surface towards x); `at` is where the wall's point is now.
+  double distance(const double at[3], const double x[3], double n[3]) const {
+    const double d[3] = {x[0] - at[0], x[1] - at[1], x[2] - at[2]};
+    const double along = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
+    if (!cylinder) {
+      n[0] = normal[0], n[1] = normal[1], n[2] = normal[2];
+      return along;
+    }
+    const double r[3] = {d[0] - along * normal[0], d[1] - along * normal[1], d[2] - along * normal[2]};
+    const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (int a = 0; a < 3; ++a) n[a] = rho > 0 ? -r[a] / rho : 0.0;
+    return radius - rho;
+  }
+};
+
+struct PlaneWallUnused {
+  std::array<double, 3> normal;
   std::array<double, 3> velocity;  // [m/s] set velocity (a servo adds its normal speed)
   int material;
   bool servo = false;

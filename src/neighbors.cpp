@@ -327,9 +327,9 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   s.wall_pairs.j.clear();
   for (size_t p = 0; p < n; ++p) {
     for (size_t w = 0; w < model.planes.size(); ++w) {
-      const PlaneWall& wall = model.planes[w];
-      const double d = (s.x[p] - s.walls.px[w]) * wall.normal[0] + (s.y[p] - s.walls.py[w]) * wall.normal[1] +
-                       (s.z[p] - s.walls.pz[w]) * wall.normal[2];
+      const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[p], s.y[p], s.z[p]};
+      double normal[3];
+      const double d = model.planes[w].distance(at, x, normal);
       if (d < s.radius[p] + reach && d > -s.radius[p]) {
         s.wall_pairs.i.push_back(static_cast<std::int32_t>(p));
         s.wall_pairs.j.push_back(static_cast<std::int32_t>(w));

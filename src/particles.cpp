@@ -90,8 +90,9 @@ class PlacementGrid {
 
 bool clear_of_walls(const Model& model, const State& state, const Vec3& c, double r) {
   for (size_t w = 0; w < model.planes.size(); ++w) {
-    const double* n = model.planes[w].normal.data();
-    const double d = (c.x() - state.walls.px[w]) * n[0] + (c.y() - state.walls.py[w]) * n[1] + (c.z() - state.walls.pz[w]) * n[2];
+    const double at[3] = {state.walls.px[w], state.walls.py[w], state.walls.pz[w]}, x[3] = {c.x(), c.y(), c.z()};
+    double normal[3];
+    const double d = model.planes[w].distance(at, x, normal);
     if (d < r) return false;
   }
   return true;

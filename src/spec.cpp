@@ -336,16 +336,30 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
   w.name = map.string("name", fmt::format("wall{}", index));
   w.material = map.string("material", "");
   if (w.material.empty()) map.fail("material", "missing: name one of the case's materials");
-  const YAML::Node plane = map.node("plane");
-  if (!plane) map.fail("plane", "missing: {point: [x,y,z], normal: [x,y,z]} (the only wall kind so far)");
-  MapReader p(plane, file, map.key_path("plane"));
-  w.point = p.vec3("point", w.point);
-  w.normal = p.vec3("normal", w.normal);
-  if (w.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
-  w.normal.normalize();
-  p.finish();
+  const YAML::Node plane = map.node("plane"), cylinder = map.node("cylinder");
+  if (!plane == !cylinder)
+    map.fail("plane", "give one of plane: {point, normal} or cylinder: {point, axis, radius} (particles inside); "
+                      "CAD walls go under `meshes:`");
+  if (plane) {
+    MapReader p(plane, file, map.key_path("plane"));
+    w.point = p.vec3("point", w.point);
+    w.normal = p.vec3("normal", w.normal);
+    if (w.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
+    w.normal.normalize();
+    p.finish();
+  } else {
+    MapReader c(cylinder, file, map.key_path("cylinder"));
+    w.cylinder = true;
+    w.point = c.vec3("point", w.point);
+    w.normal = c.vec3("axis", w.normal);
+    if (w.normal.norm() < 1e-12) c.fail("axis", "must not be zero");
+    w.normal.normalize();
+    w.radius = c.required_number("radius", 1e-6, 1e4, "m");
+    c.finish();
+  }
   w.velocity = map.vec3("velocity", w.velocity);
   if (const YAML::Node servo = map.node("servo")) {
+    if (w.cylinder) map.fail("servo", "only plane walls can be servo-controlled");
     MapReader sv(servo, file, map.key_path("servo"));
     w.has_servo = true;
     w.servo.target_stress = sv.required_number("target_stress", 1e-6, 1e12, "Pa");

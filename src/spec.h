@@ -83,12 +83,14 @@ struct ServoSpec {
 struct PlaneWallSpec {
   std::string name;
   Vec3 point{0, 0, 0};   // [m]
-  Vec3 normal{0, 0, 1};  // points into the region particles live in
+  Vec3 normal{0, 0, 1};  // points into the region particles live in; a cylinder's axis
   Vec3 velocity{0, 0, 0};  // [m/s] constant; a tangential part moves the surface, not the plane
   bool has_servo = false;
   ServoSpec servo;
   std::string material;
   SourceLocation location;
+  bool cylinder = false;  ///< inside of a cylinder (axis through point along normal)
+  double radius = 0;      // [m] cylinder
 };
 
 /// How the surface of a static wall moves (conveyor belts, pulleys): it changes the contact

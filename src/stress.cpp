@@ -21,8 +21,9 @@ Eigen::Matrix3d contact_stress(const Model& model, const State& s, const Workspa
       if (!wf.active[k]) continue;
       const size_t i = s.wall_pairs.i[k];
       const int w = s.wall_pairs.j[k];
-      const auto& n = model.planes[w].normal;
-      const double dist = (s.x[i] - s.walls.px[w]) * n[0] + (s.y[i] - s.walls.py[w]) * n[1] + (s.z[i] - s.walls.pz[w]) * n[2];
+      const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
+      double n[3];
+      const double dist = model.planes[w].distance(at, x, n);
       const Eigen::Vector3d branch(dist * n[0], dist * n[1], dist * n[2]), force(wf.fx[k], wf.fy[k], wf.fz[k]);
       sum += branch * force.transpose();
     }
