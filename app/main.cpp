@@ -2,18 +2,26 @@
 // geometry -> src).
 //   demdesign CASE.yaml            run a case (same as `demdesign run CASE.yaml`)
 //   demdesign check CASE.yaml      read and compile a case, print its set-up, run nothing
+//   demdesign check-mesh FILE...   import, check and repair meshes, print their health reports
+//   demdesign render OUT           images of a run's saved frames
 //   demdesign effects              the table of contact effects and their parameters
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include "diagnostics.h"
+#include "flow_images.h"
+#include "mesh_health.h"
 #include "model.h"
 #include "particles.h"
+#include "results_hdf5.h"
 #include "run.h"
 #include "spec.h"
+#include "triangle_mesh.h"
 
 namespace {
 
@@ -27,9 +35,37 @@ struct RunArgs {
   bool resume = false;
 };
 
+/// Mesh files go through the geometry library: import, health check, safe repair. A mesh that
+/// cannot be simulated stops the run with its report.
+dem::TriangleSoup load_mesh(const dem::MeshWallSpec& spec, double particle_diameter) {
+  dem::geometry::ImportOptions options;
+  options.unit_scale = spec.unit_scale;
+  for (int a = 0; a < 3; ++a)
+    options.scale[a] = spec.scale[a], options.rotate_deg[a] = spec.rotate_deg[a], options.translate[a] = spec.translate[a];
+  dem::geometry::TriangleMesh mesh = dem::geometry::import_mesh(spec.file, options);
+  const dem::geometry::MeshReport report = dem::geometry::check_and_repair(mesh, particle_diameter);
+  if (!report.simulable())
+    throw dem::CaseError(fmt::format("{}: meshes '{}': the mesh cannot be simulated:\n{}", spec.location.str(), spec.name, report.text()));
+  for (const auto& issue : report.issues)
+    if (issue.severity != dem::geometry::MeshIssue::Severity::info)
+      std::cout << fmt::format("  mesh {}: {} ({})\n", spec.name, issue.what, issue.count);
+  return {std::move(mesh.vertices), std::move(mesh.triangles)};
+}
+
+dem::Model compile_case(const dem::CaseSpec& spec) {
+  double diameter = 0;
+  for (const auto& p : spec.particles) diameter = std::max(diameter, p.diameter.largest());
+  for (const auto& in : spec.inlets) diameter = std::max(diameter, in.diameter.largest());
+  return dem::compile(spec, [diameter](const dem::MeshWallSpec& m) { return load_mesh(m, diameter); });
+}
+
+dem::app::ImageOptions image_options(const dem::Model& model) {
+  return {model.output.render_camera, model.output.render_colour, model.output.render_width, model.output.render_height};
+}
+
 int run_case(const RunArgs& args) {
   const dem::CaseSpec spec = dem::parse_case_file(args.case_path);
-  const dem::Model model = dem::compile(spec);
+  const dem::Model model = compile_case(spec);
   const int threads = args.threads > 0 ? args.threads : model.threads;
   if (threads > 0) omp_set_num_threads(threads);
   dem::State state = dem::initial_state(model);
@@ -40,7 +76,57 @@ int run_case(const RunArgs& args) {
   options.output_directory = args.out;
   options.progress = !args.quiet;
   options.resume = args.resume;
+  // Images of the flow: every render_every-th frame, and always the last.
+  int frame_count = 0;
+  options.on_frame = [&](const dem::Model& m, const dem::State& s, const dem::Workspace&, const std::string& out, bool last) {
+    const bool due = m.output.render_every > 0 && frame_count % m.output.render_every == 0;
+    ++frame_count;
+    if (!due && !last) return;
+    const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, s.step);
+    std::filesystem::create_directories(out + "/renders");
+    dem::app::render_state(m, s, image_options(m), path);
+    if (last) std::cout << fmt::format("  rendered {}\n", path);
+  };
   dem::run(model, state, work, options, std::cout);
+  return 0;
+}
+
+/// Renders saved frames of a finished (or running) run: the case comes from run_info.yaml.
+int render_results(const std::string& out, const std::string& which, const dem::app::ImageOptions& given) {
+  std::ifstream info(out + "/run_info.yaml");
+  if (!info) throw std::runtime_error(fmt::format("{}/run_info.yaml: not a demdesign output folder", out));
+  std::string line, case_path;
+  while (std::getline(info, line))
+    if (line.rfind("case: ", 0) == 0) case_path = line.substr(6);
+  const dem::Model model = compile_case(dem::parse_case_file(case_path));
+  dem::FrameWriter frames(out, {}, {});
+  frames.adopt_existing();
+  if (frames.frames().empty()) throw std::runtime_error(fmt::format("{}: no frames listed in particles.xdmf", out));
+  std::vector<dem::FrameInfo> chosen;
+  if (which == "all") chosen = frames.frames();
+  else if (which == "last") chosen = {frames.frames().back()};
+  else {
+    const long index = std::stol(which);
+    if (index < 0 || index >= static_cast<long>(frames.frames().size()))
+      throw std::runtime_error(fmt::format("--frame {}: the run has frames 0 to {}", which, frames.frames().size() - 1));
+    chosen = {frames.frames()[index]};
+  }
+  std::filesystem::create_directories(out + "/renders");
+  for (const dem::FrameInfo& info_frame : chosen) {
+    const dem::StoredFrame f = dem::read_frame(out + "/" + info_frame.file);
+    dem::State s = dem::initial_state(model);  // walls where they start
+    s.time = f.time, s.step = f.step;
+    s.x.resize(f.size()), s.y.resize(f.size()), s.z.resize(f.size());
+    s.vx.resize(f.size()), s.vy.resize(f.size()), s.vz.resize(f.size());
+    s.radius = f.radius, s.material = f.material;
+    for (size_t p = 0; p < f.size(); ++p) {
+      s.x[p] = f.position[3 * p], s.y[p] = f.position[3 * p + 1], s.z[p] = f.position[3 * p + 2];
+      s.vx[p] = f.velocity[3 * p], s.vy[p] = f.velocity[3 * p + 1], s.vz[p] = f.velocity[3 * p + 2];
+    }
+    const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, f.step);
+    dem::app::render_state(model, s, given, path);
+    std::cout << fmt::format("rendered {}\n", path);
+  }
   return 0;
 }
 
@@ -66,6 +152,24 @@ int main(int argc, char** argv) {
   std::string check_path;
   CLI::App* check_cmd = app.add_subcommand("check", "read and compile a case and print its set-up");
   check_cmd->add_option("case", check_path, "case file (YAML)")->required();
+  std::vector<std::string> mesh_files;
+  dem::geometry::ImportOptions mesh_options;
+  double mesh_particle_diameter = 0;
+  CLI::App* mesh_cmd = app.add_subcommand("check-mesh", "import meshes (STL, OBJ, PLY, glTF, 3MF, ...), check and repair them");
+  mesh_cmd->add_option("files", mesh_files, "mesh files")->required();
+  mesh_cmd->add_option("--unit-scale", mesh_options.unit_scale, "file units to metres (0.001 for millimetres)");
+  mesh_cmd->add_option("--particle-diameter", mesh_particle_diameter, "[m] enables the triangle size checks");
+  std::string render_out, render_frame = "last";
+  dem::app::ImageOptions render_options;
+  CLI::App* render_cmd = app.add_subcommand("render", "render saved frames of a run to PNG (headless)");
+  render_cmd->add_option("results", render_out, "output folder of a run")->required();
+  render_cmd->add_option("--frame", render_frame, "frame index, last or all");
+  render_cmd->add_option("--color-by", render_options.colour, "speed, radius or material")
+      ->check(CLI::IsMember({"speed", "radius", "material"}));
+  render_cmd->add_option("--camera", render_options.camera, "side, front, top or iso")
+      ->check(CLI::IsMember({"side", "front", "top", "iso"}));
+  render_cmd->add_option("--width", render_options.width, "[px]");
+  render_cmd->add_option("--height", render_options.height, "[px]");
   CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
 
   CLI11_PARSE(app, argc, argv);
@@ -75,11 +179,13 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (check_cmd->parsed()) {
-      const dem::Model model = dem::compile(dem::parse_case_file(check_path));
+      const dem::Model model = compile_case(dem::parse_case_file(check_path));
       const dem::State state = dem::initial_state(model);
       dem::print_setup(model, state, std::cout);
       return 0;
     }
+    if (mesh_cmd->parsed()) return dem::geometry::check_mesh_command(mesh_files, mesh_options, mesh_particle_diameter, std::cout);
+    if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options);
     if (args.case_path.empty()) {
       std::cout << app.help();
       return 2;

@@ -411,4 +411,54 @@ void FrameWriter::adopt_existing() {
   frames_ = std::move(frames);
 }
 
+namespace {
+
+template <typename T>
+std::vector<T> read_dataset(hid_t file, const char* name, hid_t memory_type, size_t per_item, const std::string& path) {
+  const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
+  if (set < 0) throw std::runtime_error(fmt::format("{}: no dataset '{}' (not a demdesign frame?)", path, name));
+  const hid_t space = H5Dget_space(set);
+  const hssize_t points = H5Sget_simple_extent_npoints(space);
+  std::vector<T> out(static_cast<size_t>(std::max<hssize_t>(points, 0)));
+  herr_t status = 0;
+  if (!out.empty()) status = H5Dread(set, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
+  H5Sclose(space);
+  H5Dclose(set);
+  if (status < 0 || out.size() % per_item != 0) throw std::runtime_error(fmt::format("{}: cannot read '{}'", path, name));
+  return out;
+}
+
+double read_attribute(hid_t file, const char* name, hid_t type, const std::string& path) {
+  double value = 0;
+  std::int64_t integer = 0;
+  const hid_t attribute = H5Aopen(file, name, H5P_DEFAULT);
+  if (attribute < 0) throw std::runtime_error(fmt::format("{}: no attribute '{}'", path, name));
+  const herr_t status = H5Aread(attribute, type, type == H5T_NATIVE_DOUBLE ? static_cast<void*>(&value) : static_cast<void*>(&integer));
+  H5Aclose(attribute);
+  if (status < 0) throw std::runtime_error(fmt::format("{}: cannot read attribute '{}'", path, name));
+  return type == H5T_NATIVE_DOUBLE ? value : static_cast<double>(integer);
+}
+
+}  // namespace
+
+StoredFrame read_frame(const std::string& path) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) throw std::runtime_error(fmt::format("{}: cannot open the frame file", path));
+  StoredFrame frame;
+  try {
+    frame.time = read_attribute(file, "time", H5T_NATIVE_DOUBLE, path);
+    frame.step = static_cast<std::int64_t>(read_attribute(file, "step", H5T_NATIVE_INT64, path));
+    frame.id = read_dataset<std::int64_t>(file, "id", H5T_NATIVE_INT64, 1, path);
+    frame.position = read_dataset<double>(file, "position", H5T_NATIVE_DOUBLE, 3, path);
+    frame.velocity = read_dataset<double>(file, "velocity", H5T_NATIVE_DOUBLE, 3, path);
+    frame.radius = read_dataset<double>(file, "radius", H5T_NATIVE_DOUBLE, 1, path);
+    frame.material = read_dataset<std::int32_t>(file, "material", H5T_NATIVE_INT32, 1, path);
+  } catch (...) {
+    H5Fclose(file);
+    throw;
+  }
+  H5Fclose(file);
+  return frame;
+}
+
 }  // namespace dem

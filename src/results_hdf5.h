@@ -36,6 +36,20 @@ struct FrameInfo {
   std::size_t count;
 };
 
+/// A particle frame read back from a frame file (owning its columns).
+struct StoredFrame {
+  double time = 0;  // [s]
+  std::int64_t step = 0;
+  std::vector<std::int64_t> id;
+  std::vector<double> position, velocity;  // (n x 3) [m], [m/s]
+  std::vector<double> radius;              // [m]
+  std::vector<std::int32_t> material;
+  std::size_t size() const { return radius.size(); }
+};
+
+/// Reads a frame file written by FrameWriter; throws std::runtime_error naming the path.
+StoredFrame read_frame(const std::string& path);
+
 /// Writes DIR/frames/frame_NNNNNN.h5 (NNNNNN = step) and keeps DIR/particles.xdmf listing them as a
 /// temporal collection.
 ///

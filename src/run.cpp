@@ -211,7 +211,10 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       check_numerics(model, state, work);
       summary.scalars.push_back(measure(model, state, work));
     }
-    if (frames && (state.step % frame_every == 0 || last)) write_frame(*frames, state);
+    if (frames && (state.step % frame_every == 0 || last)) {
+      write_frame(*frames, state);
+      if (options.on_frame) options.on_frame(model, state, work, out, last);
+    }
     if (options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stop_signal)) {
       save_checkpoint(checkpoint_path, model, state);
       write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));

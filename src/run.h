@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -21,6 +22,9 @@ struct RunOptions {
   bool write_files = true;
   bool progress = true;
   bool resume = false;            ///< continue from OUT/checkpoint.bin
+  /// Called after each particle frame is written (the app renders images here; the engine
+  /// knows nothing of rendering). `last` is true for the final frame of the run.
+  std::function<void(const Model&, const State&, const Workspace&, const std::string& out, bool last)> on_frame;
 };
 
 struct RunSummary {

@@ -419,6 +419,15 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
   o.frames_every = map.number("frames_every", 0.0, 0.0, 1e9, "s");
   o.checkpoint_every = map.number("checkpoint_every", 0.0, 0.0, 1e9, "s");
+  if (const YAML::Node render = map.node("render")) {
+    MapReader r(render, file, "output.render");
+    o.render_every = static_cast<int>(r.integer("every", 0, 0, 1000000));
+    o.render_camera = r.string("camera", o.render_camera, {"side", "front", "top", "iso"});
+    o.render_colour = r.string("colour_by", o.render_colour, {"speed", "radius", "material"});
+    o.render_width = static_cast<int>(r.integer("width", o.render_width, 16, 8192));
+    o.render_height = static_cast<int>(r.integer("height", o.render_height, 16, 8192));
+    r.finish();
+  }
   map.finish();
   return o;
 }

@@ -183,6 +183,11 @@ struct OutputSpec {
   double progress_seconds = 2.0;  ///< wall-clock seconds between progress lines
   double frames_every = 0;        ///< [s] simulated time between HDF5 particle frames; 0: 20 frames
   double checkpoint_every = 0;    ///< [s] simulated time between checkpoints; 0: none
+  /// Images of the flow: every render_every-th particle frame (0: the last frame only).
+  int render_every = 0;
+  std::string render_camera = "iso";     ///< side, front, top, iso
+  std::string render_colour = "speed";   ///< speed, radius, material
+  int render_width = 1280, render_height = 720;  // [px]
 };
 
 struct CaseSpec {

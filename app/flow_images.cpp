@@ -1,0 +1,88 @@
+#include "flow_images.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "render/render.h"
+
+namespace dem::app {
+
+void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  // Particles and the field they are coloured by.
+  std::vector<float> value(s.size());
+  for (size_t p = 0; p < s.size(); ++p) {
+    if (options.colour == "radius") value[p] = static_cast<float>(2000.0 * s.radius[p]);
+    else if (options.colour == "material") value[p] = static_cast<float>(s.material[p]);
+    else value[p] = static_cast<float>(std::sqrt(s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]));
+  }
+  render::ParticleLayer particles;
+  particles.x = s.x, particles.y = s.y, particles.z = s.z, particles.radius = s.radius, particles.value = value;
+  frame.particles.push_back(particles);
+  render::ColourMap colours;
+  colours.label = options.colour == "radius" ? "diameter [mm]" : options.colour == "material" ? "material" : "speed [m/s]";
+  if (options.colour == "speed") colours.min = 0.0;
+  frame.particle_colours = colours;
+
+  // Bounding box of what matters: particles and meshes.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (size_t p = 0; p < s.size(); ++p) {
+    const Eigen::Vector3d c(s.x[p], s.y[p], s.z[p]);
+    lo = lo.cwiseMin(c - Eigen::Vector3d::Constant(s.radius[p])), hi = hi.cwiseMax(c + Eigen::Vector3d::Constant(s.radius[p]));
+  }
+  // Meshes at their pose now.
+  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const Pose pose = model.meshes[m].motion.pose(s.time);
+    for (const auto& v : model.meshes[m].surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      placed[m].push_back({w.x(), w.y(), w.z()});
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+  }
+  if (!std::isfinite(lo.x())) lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Constant(0.1);
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    render::MeshLayer layer;
+    layer.vertices = placed[m];
+    layer.triangles = model.meshes[m].surface->triangles;
+    layer.cutaway = true;
+    layer.opacity = 0.45f;
+    frame.meshes.push_back(layer);
+  }
+  // Planes as squares around the particles' extent (an infinite plane cannot be drawn).
+  std::vector<std::vector<std::array<double, 3>>> plane_vertices;
+  std::vector<std::array<std::int32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double half = 0.6 * (hi - lo).maxCoeff() + 1e-3;
+  for (size_t w = 0; w < model.planes.size(); ++w) {
+    const PlaneWall& wall = model.planes[w];
+    if (wall.cylinder) continue;
+    const Eigen::Vector3d n(wall.normal[0], wall.normal[1], wall.normal[2]);
+    const Eigen::Vector3d at(s.walls.px[w], s.walls.py[w], s.walls.pz[w]);
+    const Eigen::Vector3d foot = centre - (centre - at).dot(n) * n;
+    const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+    std::vector<std::array<double, 3>> corners;
+    for (auto [a, b] : {std::pair{-1, -1}, std::pair{1, -1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+      const Eigen::Vector3d c = foot + half * (a * u + b * v);
+      corners.push_back({c.x(), c.y(), c.z()});
+    }
+    plane_vertices.push_back(corners);
+  }
+  for (const auto& corners : plane_vertices) {
+    render::MeshLayer layer;
+    layer.vertices = corners;
+    layer.triangles = quad;
+    layer.cutaway = true;
+    layer.opacity = 0.35f;
+    frame.meshes.push_back(layer);
+  }
+  frame.camera = render::fit_camera(lo, hi, options.camera, double(frame.width) / frame.height);
+  frame.caption = fmt::format("{}   t = {:.3f} s   {} particles", model.title.empty() ? model.source : model.title, s.time, s.size());
+  render::render_png(frame, path);
+}
+
+}  // namespace dem::app

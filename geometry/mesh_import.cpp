@@ -1,0 +1,298 @@
+// Mesh import with assimp (https://assimp.org, Debian libassimp 5.2): one triangle soup in metres
+// from any mesh file. assimp is used only here, so no other file of the project sees its headers.
+#include "triangle_mesh.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+
+namespace dem::geometry {
+namespace {
+
+using Matrix3 = std::array<std::array<double, 3>, 3>;
+
+/// An affine map p -> linear p + offset, in double precision.
+struct Affine {
+  Matrix3 linear{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  std::array<double, 3> offset{0, 0, 0};
+
+  std::array<double, 3> apply(const std::array<double, 3>& p) const {
+    std::array<double, 3> out = offset;
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 3; ++col) out[row] += linear[row][col] * p[col];
+    return out;
+  }
+  double determinant() const {
+    const Matrix3& m = linear;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  }
+};
+
+/// outer(inner(p)): the composition of two affine maps.
+Affine compose(const Affine& outer, const Affine& inner) {
+  Affine out;
+  for (int row = 0; row < 3; ++row) {
+    out.offset[row] = outer.offset[row];
+    for (int col = 0; col < 3; ++col) {
+      out.linear[row][col] = 0;
+      for (int k = 0; k < 3; ++k) out.linear[row][col] += outer.linear[row][k] * inner.linear[k][col];
+      out.offset[row] += outer.linear[row][col] * inner.offset[col];
+    }
+  }
+  return out;
+}
+
+/// assimp's row-major 4x4 node matrix (translation in the fourth column) as an Affine.
+Affine from_assimp(const aiMatrix4x4& m) {
+  Affine out;
+  const ai_real* rows[3] = {&m.a1, &m.b1, &m.c1};
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) out.linear[row][col] = rows[row][col];
+    out.offset[row] = rows[row][3];
+  }
+  return out;
+}
+
+/// The user's placement: translate + Rz Ry Rx (scale * unit_scale * p).
+Affine from_options(const ImportOptions& options) {
+  const auto rotation = [](int axis, double degrees) {
+    const double angle = degrees * std::numbers::pi / 180.0;  // [rad]
+    const double c = std::cos(angle), s = std::sin(angle);
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;  // the plane the rotation turns
+    Affine r;
+    r.linear[a][a] = c;
+    r.linear[a][b] = -s;
+    r.linear[b][a] = s;
+    r.linear[b][b] = c;
+    return r;
+  };
+  Affine scaling;
+  for (int axis = 0; axis < 3; ++axis) scaling.linear[axis][axis] = options.unit_scale * options.scale[axis];
+  Affine placed = compose(rotation(2, options.rotate_deg[2]),
+                          compose(rotation(1, options.rotate_deg[1]), compose(rotation(0, options.rotate_deg[0]), scaling)));
+  placed.offset = options.translate;
+  return placed;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+bool is_brep_cad(const std::string& path) {
+  const std::string extension = lower_extension(path);
+  return extension == ".step" || extension == ".stp" || extension == ".iges" || extension == ".igs";
+}
+
+constexpr const char* kExportAdvice = "export the surface from the CAD program as a triangle mesh (STL, OBJ, PLY, 3MF or glTF)";
+
+/// Joins vertices at bitwise identical positions (after -0 is made +0), keeping first-seen order.
+class VertexWelder {
+ public:
+  explicit VertexWelder(std::vector<std::array<double, 3>>& vertices) : vertices_(vertices) {}
+  std::int32_t index_of(std::array<double, 3> p) {
+    for (double& x : p)
+      if (x == 0.0) x = 0.0;  // -0.0 == 0.0: one key for both
+    const auto [it, inserted] = index_.try_emplace(p, static_cast<std::int32_t>(vertices_.size()));
+    if (inserted) vertices_.push_back(p);
+    return it->second;
+  }
+
+ private:
+  struct Hash {
+    std::size_t operator()(const std::array<double, 3>& p) const {
+      std::size_t h = 1469598103934665603ull;
+      for (double x : p) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &x, sizeof bits);
+        h = (h ^ bits) * 1099511628211ull;
+        h ^= h >> 29;
+      }
+      return h;
+    }
+  };
+  std::vector<std::array<double, 3>>& vertices_;
+  std::unordered_map<std::array<double, 3>, std::int32_t, Hash> index_;
+};
+
+/// Appends the triangles of `mesh`, placed by `placement`, to `out`; returns how many faces were
+/// points or lines (dropped). A mirroring placement reverses the winding to keep it outward.
+std::size_t append_mesh(const aiMesh& mesh, const Affine& placement, VertexWelder& welder, TriangleMesh& out) {
+  std::size_t dropped = 0;
+  const bool mirrored = placement.determinant() < 0;
+  for (unsigned int f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices != 3) {  // aiProcess_Triangulate leaves only points and lines besides triangles
+      ++dropped;
+      continue;
+    }
+    std::array<std::int32_t, 3> triangle{};
+    for (int corner = 0; corner < 3; ++corner) {
+      const aiVector3D& v = mesh.mVertices[face.mIndices[corner]];
+      triangle[corner] = welder.index_of(placement.apply({double(v.x), double(v.y), double(v.z)}));
+    }
+    if (mirrored) std::swap(triangle[1], triangle[2]);
+    out.triangles.push_back(triangle);
+  }
+  return dropped;
+}
+
+/// Refuses OFF and PLY files whose header declares more vertices or faces than the file has bytes.
+/// assimp 5.2 trusts those counts: assimp-testmodels' invalid/OutOfMemory.off declares 353535235358
+/// vertices in 309 bytes and takes 16 GB and minutes before it fails. Any encoding needs at least
+/// one byte per element, so the bound never refuses a valid file.
+void refuse_impossible_counts(const std::string& path) {
+  const std::string extension = lower_extension(path);
+  if (extension != ".off" && extension != ".ply") return;
+  const auto bytes = std::uintmax_t(std::filesystem::file_size(path));
+  std::ifstream in(path, std::ios::binary);
+  std::string header(4096, '\0');
+  in.read(header.data(), std::streamsize(header.size()));
+  header.resize(std::size_t(in.gcount()));
+  std::istringstream lines(header);
+  std::vector<std::string> counts;  // declared element counts, as written
+  std::string line;
+  bool off_header_seen = false;
+  while (std::getline(lines, line) && line.find("end_header") != 0) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string word;
+    if (extension == ".ply") {
+      if (words >> word && word == "element" && words >> word && words >> word) counts.push_back(word);
+      continue;
+    }
+    // OFF: a keyword ending in "OFF", then the vertex and face counts (on the same line or the next).
+    while (words >> word && counts.size() < 2) {
+      if (!off_header_seen && word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0)
+        off_header_seen = true;
+      else
+        counts.push_back(word);
+    }
+    if (counts.size() >= 2) break;
+  }
+  for (const std::string& count : counts)
+    if (std::strtoull(count.c_str(), nullptr, 10) > bytes)
+      throw MeshError(MeshError::Kind::unreadable, path + ": the header declares " + count + " elements but the file has only " +
+                                                       std::to_string(bytes) + " bytes; the file is damaged, re-export it");
+}
+
+}  // namespace
+
+bool has_importable_extension(const std::string& path) {
+  // One importer for all queries: constructing one instantiates every format reader.
+  static const Assimp::Importer importer;
+  const std::string extension = lower_extension(path);
+  return !extension.empty() && !is_brep_cad(path) && importer.IsExtensionSupported(extension);
+}
+
+TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) {
+  // Options first: a zero or non-finite scale would collapse or poison every vertex.
+  bool options_valid = std::isfinite(options.unit_scale) && options.unit_scale > 0;
+  for (int axis = 0; axis < 3; ++axis)
+    options_valid = options_valid && std::isfinite(options.scale[axis]) && options.scale[axis] != 0 &&
+                    std::isfinite(options.rotate_deg[axis]) && std::isfinite(options.translate[axis]);
+  if (!options_valid)
+    throw MeshError(MeshError::Kind::invalid_options,
+                    path + ": invalid import options: unit_scale must be > 0, scale non-zero, and all values finite");
+
+  // B-rep CAD is refused by extension, before assimp guesses at it (its STEP reader is for IFC only).
+  if (is_brep_cad(path))
+    throw MeshError(MeshError::Kind::cad_format,
+                    path + ": STEP/IGES is a B-rep CAD format that cannot be read as a mesh; " + kExportAdvice +
+                        " and import that file");
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    throw MeshError(MeshError::Kind::missing, path + ": no such file (expected a mesh file: STL, OBJ, PLY, 3MF, glTF, ...)");
+
+  refuse_impossible_counts(path);
+
+  // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
+  Assimp::Importer importer;
+  // Everything but positions and faces is dropped, so JoinIdenticalVertices joins by position only.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
+                                  aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                  aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS | aiComponent_MATERIALS);
+  // Skeleton-only files (MD5, SMD, BVH) would otherwise get invented bone meshes.
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  const aiScene* scene = nullptr;
+  std::string reason;
+  try {
+    scene = importer.ReadFile(path, 0);
+    if (!scene) reason = importer.GetErrorString();
+  } catch (const std::exception& exception) {  // assimp catches its own errors; this is belt and braces
+    reason = exception.what();
+  }
+  if (!scene) {
+    std::string known;
+    importer.GetExtensionList(known);
+    throw MeshError(MeshError::Kind::unreadable, path + ": assimp could not read it (" + reason + "); " +
+                                                     "export STL, OBJ, PLY, 3MF or glTF (assimp reads: " + known + ")");
+  }
+
+  // Surfaces present at all? (assimp's scene preprocessor fills mPrimitiveTypes.)
+  bool has_surface = false;
+  for (unsigned int m = 0; m < scene->mNumMeshes; ++m)
+    has_surface = has_surface || (scene->mMeshes[m] &&
+                                  (scene->mMeshes[m]->mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)));
+  const std::string no_triangles = path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " +
+                                   kExportAdvice;
+  if (!has_surface) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
+
+  // Validate first (so broken files are refused, not crashed on), then triangulate and join.
+  try {
+    scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
+                                         aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    if (!scene) reason = importer.GetErrorString();
+  } catch (const std::exception& exception) {
+    scene = nullptr;
+    reason = exception.what();
+  }
+  if (!scene)
+    throw MeshError(MeshError::Kind::unreadable,
+                    path + ": the file is damaged (" + reason + "); re-export it as STL, OBJ, PLY, 3MF or glTF");
+
+  // Walk the node hierarchy, placing each referenced mesh by its node's global transform.
+  TriangleMesh out;
+  out.source = path;
+  VertexWelder welder(out.vertices);
+  const Affine placement = from_options(options);
+  std::size_t points_and_lines = 0;
+  std::vector<std::pair<const aiNode*, Affine>> stack;
+  if (scene->mRootNode) stack.emplace_back(scene->mRootNode, placement);
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    const Affine global = compose(parent, from_assimp(node->mTransformation));
+    for (unsigned int k = 0; k < node->mNumMeshes; ++k)
+      if (node->mMeshes[k] < scene->mNumMeshes)
+        points_and_lines += append_mesh(*scene->mMeshes[node->mMeshes[k]], global, welder, out);
+    for (unsigned int child = 0; child < node->mNumChildren; ++child)
+      if (node->mChildren[child]) stack.emplace_back(node->mChildren[child], global);
+  }
+  // A scene whose nodes reference no mesh at all: take the meshes as they are.
+  if (out.triangles.empty() && points_and_lines == 0)
+    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) append_mesh(*scene->mMeshes[m], placement, welder, out);
+  if (out.triangles.empty()) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
+  if (out.vertices.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
+    throw MeshError(MeshError::Kind::unreadable, path + ": more than 2^31 vertices; decimate the mesh before import");
+  return out;
+}
+
+}  // namespace dem::geometry
