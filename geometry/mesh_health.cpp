@@ -29,8 +29,8 @@ using Triangle = std::array<std::int32_t, 3>;
 using Soup = std::vector<std::array<std::size_t, 3>>;  // CGAL's polygon soup: indices into points
 
 constexpr std::size_t kMaxExamples = 10;
-constexpr double kCoarseTriangle = 50.0;     // [particle diameters] longest edge above: coarse for wear maps
-constexpr double kFineTriangle = 50.0;      // [1 / particle diameters] longest edge below d / 50: finer than contact needs
+constexpr double kCoarseTriangle = 50.0;     // [-] longest edge above 50 d: coarse for wear maps
+constexpr double kFineTriangle = 50.0;       // [-] longest edge below d / 50: finer than contact needs
 constexpr double kLargestPlausible = 100.0;  // [m] bounding box diagonal above: probably millimetres
 constexpr double kSmallestPlausible = 1e-3;  // [m] bounding box diagonal below: probably scaled twice
 
@@ -40,7 +40,7 @@ struct Work {
   std::vector<Triangle> triangles;
   std::vector<std::int32_t> original;  // (n_triangles) index in the input mesh
 
-  /// Removes the triangles marked in `remove`; returns their input indices.
+  /// Removes the triangles marked in `remove_triangle`; returns their input indices.
   std::vector<std::int32_t> remove(const std::vector<bool>& remove_triangle) {
     std::vector<std::int32_t> removed;
     std::size_t kept = 0;
@@ -60,7 +60,10 @@ struct Work {
 
 /// "1 triangle", "2 triangles": a count with its noun in the right number.
 std::string counted(std::int64_t n, const char* singular, const char* plural = nullptr) {
-  return fmt::format("{} {}", n, n == 1 ? std::string(singular) : plural ? std::string(plural) : std::string(singular) + "s");
+  return fmt::format("{} {}", n,
+                     n == 1   ? std::string(singular)
+                     : plural ? std::string(plural)
+                              : std::string(singular) + "s");
 }
 
 /// Appends an issue whose examples are the lowest kMaxExamples of `triangles` (input indices).
@@ -90,8 +93,9 @@ std::vector<EdgeUse> edge_uses(const std::vector<Triangle>& triangles) {
       const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
       uses.push_back({key, std::int32_t(t), a < b});
     }
-  std::sort(uses.begin(), uses.end(),
-            [](const EdgeUse& x, const EdgeUse& y) { return std::tie(x.key, x.triangle) < std::tie(y.key, y.triangle); });
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return std::tie(x.key, x.triangle) < std::tie(y.key, y.triangle);
+  });
   return uses;
 }
 
@@ -182,7 +186,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     for (std::int32_t v : work.triangles[t]) out_of_range[t] = out_of_range[t] || v < 0 || v >= n_vertices;
   if (const auto removed = work.remove(out_of_range); !removed.empty())
     add_issue(report, Severity::warning,
-              fmt::format("{} referred to vertices that do not exist; removed", counted(std::int64_t(removed.size()), "triangle")),
+              fmt::format("{} referred to vertices that do not exist; removed",
+                          counted(std::int64_t(removed.size()), "triangle")),
               std::int64_t(removed.size()), removed);
 
   // Non-finite coordinates poison every predicate below: fatal, and nothing else is checked.
@@ -200,7 +205,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) non_finite += vertex_bad[v];
   if (!touching_non_finite.empty()) {
     add_issue(report, Severity::fatal,
-              fmt::format("{} with non-finite coordinates (NaN or infinity), used by {}", counted(non_finite, "vertex", "vertices"),
+              fmt::format("{} with non-finite coordinates (NaN or infinity), used by {}",
+                          counted(non_finite, "vertex", "vertices"),
                           counted(std::int64_t(touching_non_finite.size()), "triangle")),
               non_finite, touching_non_finite);
     report.triangles_out = mesh.triangles.size();
@@ -208,7 +214,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     return report;
   }
 
-  // Points at identical positions become one vertex (CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup).
+  // Points at identical positions become one vertex
+  // (CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup).
   work.points.reserve(mesh.vertices.size());
   for (const auto& x : mesh.vertices) work.points.emplace_back(x[0], x[1], x[2]);
   {
@@ -219,7 +226,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     for (std::size_t t = 0; t < soup.size(); ++t)
       for (int k = 0; k < 3; ++k) work.triangles[t][k] = std::int32_t(soup[t][k]);
     if (merged > 0)
-      add_issue(report, Severity::repaired, fmt::format("{} at identical positions joined", counted(std::int64_t(merged), "vertex", "vertices")),
+      add_issue(report, Severity::repaired,
+                fmt::format("{} at identical positions joined", counted(std::int64_t(merged), "vertex", "vertices")),
                 std::int64_t(merged), {});
   }
 
@@ -231,7 +239,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
   }
   if (const auto removed = work.remove(degenerate); !removed.empty())
     add_issue(report, Severity::repaired,
-              fmt::format("{} removed (zero area: repeated or collinear vertices)", counted(std::int64_t(removed.size()), "degenerate triangle")),
+              fmt::format("{} removed (zero area: repeated or collinear vertices)",
+                          counted(std::int64_t(removed.size()), "degenerate triangle")),
               std::int64_t(removed.size()), removed);
 
   // Duplicate triangles: the same three vertices in any order; the first one is kept.
@@ -243,10 +252,12 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     }
     std::sort(sorted.begin(), sorted.end());
     std::vector<bool> duplicate(work.triangles.size(), false);
-    for (std::size_t k = 1; k < sorted.size(); ++k) duplicate[sorted[k].second] = sorted[k].first == sorted[k - 1].first;
+    for (std::size_t k = 1; k < sorted.size(); ++k)
+      duplicate[sorted[k].second] = sorted[k].first == sorted[k - 1].first;
     if (const auto removed = work.remove(duplicate); !removed.empty())
       add_issue(report, Severity::repaired,
-                fmt::format("{} removed (same three vertices as another triangle)", counted(std::int64_t(removed.size()), "duplicate triangle")),
+                fmt::format("{} removed (same three vertices as another triangle)",
+                            counted(std::int64_t(removed.size()), "duplicate triangle")),
                 std::int64_t(removed.size()), removed);
   }
 
@@ -330,7 +341,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     std::vector<std::int32_t> by_patch(n_triangles), roots(n_triangles);
     for (std::size_t t = 0; t < n_triangles; ++t) roots[t] = patches.find(std::int32_t(t));
     std::iota(by_patch.begin(), by_patch.end(), 0);
-    std::stable_sort(by_patch.begin(), by_patch.end(), [&](std::int32_t a, std::int32_t b) { return roots[a] < roots[b]; });
+    std::stable_sort(by_patch.begin(), by_patch.end(),
+                     [&](std::int32_t a, std::int32_t b) { return roots[a] < roots[b]; });
     std::vector<std::int32_t> flipped_triangles;
     for (std::size_t begin = 0, end = 0; begin < n_triangles; begin = end) {
       while (end < n_triangles && roots[by_patch[end]] == roots[by_patch[begin]]) ++end;
@@ -338,7 +350,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
       const bool closed = std::none_of(patch.begin(), patch.end(), [&](std::int32_t t) { return on_open_edge[t]; });
       const auto n_flipped = std::count_if(patch.begin(), patch.end(),
                                            [&](std::int32_t t) { return !same_cycle(oriented[t], work.triangles[t]); });
-      const bool turn = closed ? signed_volume(work.points, oriented, patch) < 0 : 2 * std::size_t(n_flipped) > patch.size();
+      const bool turn =
+          closed ? signed_volume(work.points, oriented, patch) < 0 : 2 * std::size_t(n_flipped) > patch.size();
       // Unflipped triangles keep their exact corner order; flipped ones swap their last two corners.
       for (std::int32_t t : patch) {
         const Triangle& input = work.triangles[t];
@@ -375,7 +388,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
   // then exact tests. Rejected: PMP::self_intersections, which needs a Surface_mesh (no non-manifold
   // edges); CGAL 5.6's triangle_soup_self_intersections is not in Debian bookworm's 5.5.
   {
-    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::int32_t, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::int32_t,
+                                                          CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
     std::vector<Box> boxes;
     boxes.reserve(n_triangles);
     for (std::size_t t = 0; t < n_triangles; ++t) {
@@ -395,7 +409,8 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
         crossing.push_back(work.original[b->info()]);
       }
     };
-    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(box_pointers.begin(), box_pointers.end(), test, std::ptrdiff_t(2000));
+    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(box_pointers.begin(), box_pointers.end(), test,
+                                                        std::ptrdiff_t(2000));
     std::sort(crossing.begin(), crossing.end());
     crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
     if (pairs > 0)
@@ -432,14 +447,16 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
       add_issue(report, Severity::info,
                 fmt::format("{} with an edge longer than {} particle diameters ({:.4g} m): fine for contact, "
                             "coarse for wear maps",
-                            counted(std::int64_t(coarse.size()), "triangle"), kCoarseTriangle, kCoarseTriangle * particle_diameter),
+                            counted(std::int64_t(coarse.size()), "triangle"), kCoarseTriangle,
+                            kCoarseTriangle * particle_diameter),
                 std::int64_t(coarse.size()), coarse);
     if (!fine.empty())
-      add_issue(report, Severity::info,
-                fmt::format("{} smaller than 1/{} particle diameter (longest edge < {:.4g} m): more "
-                            "triangles than contact needs; decimating would speed up the search",
-                            counted(std::int64_t(fine.size()), "triangle"), kFineTriangle, particle_diameter / kFineTriangle),
-                std::int64_t(fine.size()), fine);
+      add_issue(
+          report, Severity::info,
+          fmt::format("{} smaller than 1/{} particle diameter (longest edge < {:.4g} m): more "
+                      "triangles than contact needs; decimating would speed up the search",
+                      counted(std::int64_t(fine.size()), "triangle"), kFineTriangle, particle_diameter / kFineTriangle),
+          std::int64_t(fine.size()), fine);
   }
 
   // Compact: keep only the vertices the triangles use, in their original order.
@@ -476,10 +493,10 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     add_issue(report, Severity::warning,
               fmt::format("the mesh is {:.4g} m across; is it in millimetres? set unit_scale: 0.001", diagonal), 1, {});
   if (diagonal < kSmallestPlausible)
-    add_issue(report, Severity::warning,
-              fmt::format("the mesh is {:.4g} m across; is it in metres already? check unit_scale (1 for metres)",
-                          diagonal),
-              1, {});
+    add_issue(
+        report, Severity::warning,
+        fmt::format("the mesh is {:.4g} m across; is it in metres already? check unit_scale (1 for metres)", diagonal),
+        1, {});
   return report;
 }
 

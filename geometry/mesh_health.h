@@ -5,14 +5,14 @@
 // The checks use CGAL Polygon Mesh Processing (CGAL 5.5), all inside mesh_health.cpp.
 #pragma once
 
-#include "triangle_mesh.h"
-
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
 #include <vector>
+
+#include "triangle_mesh.h"
 
 namespace dem::geometry {
 

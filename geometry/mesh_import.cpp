@@ -1,17 +1,15 @@
 // Mesh import with assimp (https://assimp.org, Debian libassimp 5.2): one triangle soup in metres
 // from any mesh file. assimp is used only here, so no other file of the project sees its headers.
-#include "triangle_mesh.h"
-
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -19,6 +17,8 @@
 #include <sstream>
 #include <unordered_map>
 #include <utility>
+
+#include "triangle_mesh.h"
 
 namespace dem::geometry {
 namespace {
@@ -83,8 +83,9 @@ Affine from_options(const ImportOptions& options) {
   };
   Affine scaling;
   for (int axis = 0; axis < 3; ++axis) scaling.linear[axis][axis] = options.unit_scale * options.scale[axis];
-  Affine placed = compose(rotation(2, options.rotate_deg[2]),
-                          compose(rotation(1, options.rotate_deg[1]), compose(rotation(0, options.rotate_deg[0]), scaling)));
+  Affine placed =
+      compose(rotation(2, options.rotate_deg[2]),
+              compose(rotation(1, options.rotate_deg[1]), compose(rotation(0, options.rotate_deg[0]), scaling)));
   placed.offset = options.translate;
   return placed;
 }
@@ -101,7 +102,8 @@ bool is_brep_cad(const std::string& path) {
   return extension == ".step" || extension == ".stp" || extension == ".iges" || extension == ".igs";
 }
 
-constexpr const char* kExportAdvice = "export the surface from the CAD program as a triangle mesh (STL, OBJ, PLY, 3MF or glTF)";
+constexpr const char* kExportAdvice =
+    "export the surface from the CAD program as a triangle mesh (STL, OBJ, PLY, 3MF or glTF)";
 
 /// Joins vertices at bitwise identical positions (after -0 is made +0), keeping first-seen order.
 class VertexWelder {
@@ -188,8 +190,9 @@ void refuse_impossible_counts(const std::string& path) {
   }
   for (const std::string& count : counts)
     if (std::strtoull(count.c_str(), nullptr, 10) > bytes)
-      throw MeshError(MeshError::Kind::unreadable, path + ": the header declares " + count + " elements but the file has only " +
-                                                       std::to_string(bytes) + " bytes; the file is damaged, re-export it");
+      throw MeshError(MeshError::Kind::unreadable, path + ": the header declares " + count +
+                                                       " elements but the file has only " + std::to_string(bytes) +
+                                                       " bytes; the file is damaged, re-export it");
 }
 
 }  // namespace
@@ -218,17 +221,19 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
                         " and import that file");
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
-    throw MeshError(MeshError::Kind::missing, path + ": no such file (expected a mesh file: STL, OBJ, PLY, 3MF, glTF, ...)");
+    throw MeshError(MeshError::Kind::missing,
+                    path + ": no such file (expected a mesh file: STL, OBJ, PLY, 3MF, glTF, ...)");
 
   refuse_impossible_counts(path);
 
   // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
   Assimp::Importer importer;
   // Everything but positions and faces is dropped, so JoinIdenticalVertices joins by position only.
-  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
-                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
-                                  aiComponent_TEXCOORDS | aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                  aiComponent_TEXTURES | aiComponent_LIGHTS | aiComponent_CAMERAS | aiComponent_MATERIALS);
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                          aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                                          aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                                          aiComponent_TEXTURES | aiComponent_LIGHTS |
+                                                          aiComponent_CAMERAS | aiComponent_MATERIALS);
   // Skeleton-only files (MD5, SMD, BVH) would otherwise get invented bone meshes.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
   const aiScene* scene = nullptr;
@@ -249,10 +254,10 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   // Surfaces present at all? (assimp's scene preprocessor fills mPrimitiveTypes.)
   bool has_surface = false;
   for (unsigned int m = 0; m < scene->mNumMeshes; ++m)
-    has_surface = has_surface || (scene->mMeshes[m] &&
-                                  (scene->mMeshes[m]->mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)));
-  const std::string no_triangles = path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " +
-                                   kExportAdvice;
+    has_surface = has_surface || (scene->mMeshes[m] && (scene->mMeshes[m]->mPrimitiveTypes &
+                                                        (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)));
+  const std::string no_triangles =
+      path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " + kExportAdvice;
   if (!has_surface) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
 
   // Validate first (so broken files are refused, not crashed on), then triangulate and join.

@@ -1,22 +1,26 @@
 // Mesh reports as text, and the `demdesign check-mesh FILE...` command built on them.
 // No CGAL or assimp here: this file compiles in a second.
-#include "mesh_health.h"
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
 #include <ostream>
 
+#include "mesh_health.h"
+
 namespace dem::geometry {
 namespace {
 
 const char* severity_name(MeshIssue::Severity severity) {
   switch (severity) {
-    case MeshIssue::Severity::info: return "info";
-    case MeshIssue::Severity::repaired: return "repaired";
-    case MeshIssue::Severity::warning: return "warning";
-    case MeshIssue::Severity::fatal: return "FATAL";
+    case MeshIssue::Severity::info:
+      return "info";
+    case MeshIssue::Severity::repaired:
+      return "repaired";
+    case MeshIssue::Severity::warning:
+      return "warning";
+    case MeshIssue::Severity::fatal:
+      return "FATAL";
   }
   return "?";
 }
@@ -34,8 +38,8 @@ std::string MeshReport::text() const {
                                 simulable() ? "simulable" : "NOT SIMULABLE", triangles_out, triangles_in, vertices_out,
                                 closed ? "closed" : "open");
   if (triangles_out > 0) {
-    out += fmt::format("  box [m]: ({:.4g}, {:.4g}, {:.4g}) to ({:.4g}, {:.4g}, {:.4g}); area {:.4g} m^2\n", bbox_min[0],
-                       bbox_min[1], bbox_min[2], bbox_max[0], bbox_max[1], bbox_max[2], area);
+    out += fmt::format("  box [m]: ({:.4g}, {:.4g}, {:.4g}) to ({:.4g}, {:.4g}, {:.4g}); area {:.4g} m^2\n",
+                       bbox_min[0], bbox_min[1], bbox_min[2], bbox_max[0], bbox_max[1], bbox_max[2], area);
     out += fmt::format("  edges [m]: min {:.4g}, median {:.4g}, max {:.4g}\n", edge_min, edge_median, edge_max);
   }
   // One line per issue, with example triangles (indices in the file's triangle order).

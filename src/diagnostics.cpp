@@ -84,6 +84,13 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
     const auto& n = model.planes[w].normal;
     out.wall_normal_force.push_back(-(s.walls.fx[w] * n[0] + s.walls.fy[w] * n[1] + s.walls.fz[w] * n[2]));
   }
+  const MeshLoads& loads = s.mesh_loads;
+  for (size_t m = 0; m < model.meshes.size() && m < loads.fx.size(); ++m) {
+    out.mesh_force.push_back(std::sqrt(loads.fx[m] * loads.fx[m] + loads.fy[m] * loads.fy[m] + loads.fz[m] * loads.fz[m]));
+    const Eigen::Vector3d w = model.meshes[m].motion.velocity(s.time).angular, torque(loads.tx[m], loads.ty[m], loads.tz[m]);
+    out.mesh_torque.push_back(w.norm() > 0 ? torque.dot(w.normalized()) : torque.norm());
+    out.mesh_power.push_back(loads.power[m]);
+  }
   return out;
 }
 

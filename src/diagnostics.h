@@ -28,6 +28,9 @@ struct Scalars {
   double removed_mass = 0;         // [kg] by all outlets so far
   std::vector<double> outlet_mass;       // [kg] per outlet, cumulative
   std::vector<double> wall_normal_force; // [N] per wall, pushing the wall along -normal
+  std::vector<double> mesh_force;        // [N] per mesh, magnitude of the particles' force on it
+  std::vector<double> mesh_torque;       // [N m] per mesh, about its rotation axis (|T| if it does not rotate)
+  std::vector<double> mesh_power;        // [W] per mesh, rate of work it does on the particles
 };
 
 Scalars measure(const Model& model, const State& state, const Workspace& work);

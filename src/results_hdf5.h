@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -46,6 +47,18 @@ struct StoredFrame {
   std::vector<std::int32_t> material;
   std::size_t size() const { return radius.size(); }
 };
+
+/// One triangulated wall with fields per triangle, for ParaView.
+struct MeshFieldSet {
+  std::string name;
+  std::vector<std::array<double, 3>> vertices;         // [m] where the mesh is now
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::vector<std::pair<std::string, std::vector<double>>> fields;  ///< per triangle, name with unit
+};
+
+/// Writes DIR/walls.h5 (one group per mesh: vertices, triangles, a dataset per field) and
+/// DIR/walls.xdmf (a spatial collection of triangle grids with cell attributes), both atomically.
+void write_mesh_fields(const std::string& directory, const std::vector<MeshFieldSet>& meshes, double time);
 
 /// Reads a frame file written by FrameWriter; throws std::runtime_error naming the path.
 StoredFrame read_frame(const std::string& path);

@@ -39,6 +39,8 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
       "dt_s,lost,inserted_mass_kg,removed_mass_kg";
   for (const OutletSpec& o : model.outlets) out += fmt::format(",outlet_{}_kg", o.name);
   for (const PlaneWall& w : model.planes) out += fmt::format(",wall_{}_normal_force_N", w.name);
+  for (const MeshWall& m : model.meshes)
+    out += fmt::format(",mesh_{0}_force_N,mesh_{0}_torque_Nm,mesh_{0}_power_W", m.name);
   out += "\n";
   for (const Scalars& r : rows) {
     out += fmt::format("{:.9g},{},{},{:.9g},{:.9g},{},{:.6g},{:.6g},{:.6g},{},{:.9g},{:.9g}", r.time, r.step, r.particles,
@@ -46,6 +48,8 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
                        r.dt, r.lost, r.inserted_mass, r.removed_mass);
     for (double m : r.outlet_mass) out += fmt::format(",{:.9g}", m);
     for (double f : r.wall_normal_force) out += fmt::format(",{:.9g}", f);
+    for (size_t m = 0; m < r.mesh_force.size(); ++m)
+      out += fmt::format(",{:.9g},{:.9g},{:.9g}", r.mesh_force[m], r.mesh_torque[m], r.mesh_power[m]);
     out += "\n";
   }
   return out;
@@ -119,6 +123,40 @@ void write_frame(FrameWriter& writer, const State& s) {
   frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
   frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
   writer.write_frame(frame);
+}
+
+/// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
+void write_mesh_records(const Model& model, const State& s, const std::string& out) {
+  std::vector<MeshFieldSet> sets;
+  const double duration = std::max(s.time, 1e-30);
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const MeshWall& mesh = model.meshes[m];
+    MeshFieldSet set;
+    set.name = mesh.name;
+    set.triangles = mesh.surface->triangles;
+    const Pose pose = mesh.motion.pose(s.time);
+    for (const auto& v : mesh.surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      set.vertices.push_back({w.x(), w.y(), w.z()});
+    }
+    const TriangleRecords& r = s.records[m];
+    const auto& area = mesh.surface->areas;
+    auto per_area_rate = [&](const std::vector<double>& total) {
+      std::vector<double> rate(total.size());
+      for (size_t t = 0; t < total.size(); ++t) rate[t] = area[t] > 0 ? total[t] / (area[t] * duration) : 0.0;
+      return rate;
+    };
+    set.fields = {{"mean_pressure_Pa", per_area_rate(r.normal_impulse)},
+                  {"mean_shear_stress_Pa", per_area_rate(r.shear_impulse)},
+                  {"shear_work_rate_W_per_m2", per_area_rate(r.shear_work)},
+                  {"impact_energy_rate_W_per_m2", per_area_rate(r.impact_energy)},
+                  {"impacts_per_s_m2", per_area_rate(r.impacts)},
+                  {"shear_work_J", r.shear_work},
+                  {"impact_energy_J", r.impact_energy},
+                  {"impacts", r.impacts}};
+    sets.push_back(std::move(set));
+  }
+  write_mesh_fields(out, sets, s.time);
 }
 
 }  // namespace
@@ -255,10 +293,11 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   for (size_t k = 0; k < model.outlets.size(); ++k)
     fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, state.outlets[k].removed,
                state.outlets[k].removed_mass);
+  if (options.write_files && !model.meshes.empty()) write_mesh_records(model, state, out);
   if (options.write_files) {
     write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
-    fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml\n", out,
-               frames ? frames->frames().size() : 0);
+    fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", out,
+               frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
   }
   return summary;
 }

@@ -268,3 +268,44 @@ TEST(MeshWalls, BedInTriangulatedCylinderCarriesTheWallForceOfTheAnalyticCylinde
 
 }  // namespace
 }  // namespace dem::test
+
+namespace dem::test {
+namespace {
+
+TEST(MeshWalls, RecordedFrictionWorkEqualsCoulombWorkAndImpactsAreCounted) {
+  // A bead dropped onto a triangulated floor: one impact, on one triangle, with the energy
+  // 1/2 m vn^2 of the impact. Then it is pushed along the floor at constant speed (imposed), so
+  // friction works at mu m g v: the recorded shear work over the slide equals mu m g times the
+  // distance (1 %).
+  CaseSpec spec = floor_case(true, 10);
+  for (auto& m : spec.materials) m.youngs_modulus = 1e8, m.params["restitution"] = 0.2, m.params["friction"] = 0.3;
+  spec.particles[0].positions[0] = Vec3(0.0012, 0.0013, 0.0025);
+  spec.particles[0].velocity = Vec3(0, 0, -0.5);
+  Sim sim(spec);
+  while (sim.state.time < 0.05) sim.advance();  // lands and settles
+  const TriangleRecords& r = sim.state.records[0];
+  double impacts = 0, energy = 0;
+  for (size_t t = 0; t < r.impacts.size(); ++t) impacts += r.impacts[t], energy += r.impact_energy[t];
+  EXPECT_GE(impacts, 1.0);
+  EXPECT_LE(impacts, 4.0) << "one impact and a few small rebounds (e = 0.2)";
+  const double mass = 1.0 / sim.state.inv_mass[0];
+  // The first impact, at about 0.5 m/s, carries nearly all the impact energy; rebounds add e^2.
+  EXPECT_GT(energy, 0.9 * 0.5 * mass * 0.5 * 0.5);
+  EXPECT_LT(energy, 1.2 * 0.5 * mass * 0.52 * 0.52);
+  // Slide at 0.1 m/s for 0.2 s: 20 mm across many triangles.
+  double before = 0;
+  for (double w : r.shear_work) before += w;
+  const double x0 = sim.state.x[0];
+  while (sim.state.time < 0.25) {
+    sim.state.vx[0] = 0.1, sim.state.vy[0] = 0;
+    sim.state.wx[0] = sim.state.wy[0] = sim.state.wz[0] = 0;
+    sim.advance();
+  }
+  double after = 0;
+  for (double w : r.shear_work) after += w;
+  const double distance = sim.state.x[0] - x0;
+  EXPECT_NEAR(after - before, 0.3 * mass * 9.81 * distance, 0.01 * 0.3 * mass * 9.81 * distance);
+}
+
+}  // namespace
+}  // namespace dem::test
