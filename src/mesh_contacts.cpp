@@ -339,13 +339,16 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
       if (!f.active[slot]) continue;
       const std::int32_t m = mc.mesh[slot], t = mc.triangle[slot];
       TriangleRecords& r = s.records[m];
+      const bool record = work.mesh_time >= model.output.records_from;
       const double fn = slot_results.fn[slot];
       const double ftx = f.fx[slot], fty = f.fy[slot], ftz = f.fz[slot];
       const double total = std::sqrt(ftx * ftx + fty * fty + ftz * ftz);
-      r.normal_impulse[t] += std::max(fn, 0.0) * dt;
-      r.shear_impulse[t] += std::sqrt(std::max(total * total - fn * fn, 0.0)) * dt;
-      r.shear_work[t] += slot_results.shear_power[slot] * dt;
-      if (slot_results.impact_energy[slot] >= 0) r.impacts[t] += 1.0, r.impact_energy[t] += slot_results.impact_energy[slot];
+      if (record) {
+        r.normal_impulse[t] += std::max(fn, 0.0) * dt;
+        r.shear_impulse[t] += std::sqrt(std::max(total * total - fn * fn, 0.0)) * dt;
+        r.shear_work[t] += slot_results.shear_power[slot] * dt;
+        if (slot_results.impact_energy[slot] >= 0) r.impacts[t] += 1.0, r.impact_energy[t] += slot_results.impact_energy[slot];
+      }
       // The particle pushes the mesh with -F; torque about the motion origin; power F . v_wall.
       loads.fx[m] -= ftx, loads.fy[m] -= fty, loads.fz[m] -= ftz;
       const double arm[3] = {slot_results.cx[slot] - work.mesh_origin[m][0], slot_results.cy[slot] - work.mesh_origin[m][1],

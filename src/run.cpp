@@ -56,7 +56,7 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
 }
 
 /// Rows of an earlier scalars.csv up to `time` (a resumed run keeps what it had computed).
-std::vector<Scalars> read_scalars(const std::string& path, double time) {
+std::vector<Scalars> read_scalars(const Model& model, const std::string& path, double time) {
   std::vector<Scalars> rows;
   std::ifstream in(path);
   std::string line;
@@ -72,6 +72,17 @@ std::vector<Scalars> read_scalars(const std::string& path, double time) {
     r.kinetic_translation = v[3], r.kinetic_rotation = v[4], r.contacts = static_cast<size_t>(v[5]);
     r.max_overlap_ratio = v[6], r.mean_overlap_ratio = v[7], r.dt = v[8], r.lost = static_cast<std::int64_t>(v[9]);
     r.inserted_mass = v[10], r.removed_mass = v[11];
+    // Then one column per outlet, per wall, and three per mesh, in the header's order.
+    const size_t outlets = model.outlets.size(), walls = model.planes.size(), meshes = model.meshes.size();
+    if (v.size() != 12 + outlets + walls + 3 * meshes) break;
+    size_t c = 12;
+    for (size_t k = 0; k < outlets; ++k) r.outlet_mass.push_back(v[c++]);
+    for (size_t k = 0; k < walls; ++k) r.wall_normal_force.push_back(v[c++]);
+    for (size_t k = 0; k < meshes; ++k) {
+      r.mesh_force.push_back(v[c++]);
+      r.mesh_torque.push_back(v[c++]);
+      r.mesh_power.push_back(v[c++]);
+    }
     rows.push_back(r);
   }
   return rows;
@@ -128,7 +139,7 @@ void write_frame(FrameWriter& writer, const State& s) {
 /// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
 void write_mesh_records(const Model& model, const State& s, const std::string& out) {
   std::vector<MeshFieldSet> sets;
-  const double duration = std::max(s.time, 1e-30);
+  const double duration = std::max(s.time - model.output.records_from, 1e-30);  // [s] the records' interval
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     const MeshWall& mesh = model.meshes[m];
     MeshFieldSet set;
@@ -208,7 +219,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
 
   if (options.resume) {
     state = load_checkpoint(checkpoint_path, model);
-    summary.scalars = read_scalars(out + "/scalars.csv", state.time);
+    summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
     fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
   }
   print_setup(model, state, log);

@@ -419,6 +419,7 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
   o.frames_every = map.number("frames_every", 0.0, 0.0, 1e9, "s");
   o.checkpoint_every = map.number("checkpoint_every", 0.0, 0.0, 1e9, "s");
+  o.records_from = map.number("records_from", 0.0, 0.0, 1e9, "s");
   if (const YAML::Node render = map.node("render")) {
     MapReader r(render, file, "output.render");
     o.render_every = static_cast<int>(r.integer("every", 0, 0, 1000000));

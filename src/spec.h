@@ -183,6 +183,7 @@ struct OutputSpec {
   double progress_seconds = 2.0;  ///< wall-clock seconds between progress lines
   double frames_every = 0;        ///< [s] simulated time between HDF5 particle frames; 0: 20 frames
   double checkpoint_every = 0;    ///< [s] simulated time between checkpoints; 0: none
+  double records_from = 0;        ///< [s] wall records (pressure, wear inputs) accumulate from here on
   /// Images of the flow: every render_every-th particle frame (0: the last frame only).
   int render_every = 0;
   std::string render_camera = "iso";     ///< side, front, top, iso

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "run.h"
+#include "triangle_mesh.h"
 #include "sim.h"
 
 namespace dem::test {
@@ -22,7 +23,14 @@ class ShippedCase : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ShippedCase, RunsShortened) {
   const CaseSpec spec = load_case(GetParam());
-  const Model model = compile(spec);
+  // Mesh files through the geometry library, as the demdesign program reads them.
+  const Model model = compile(spec, [](const MeshWallSpec& m) {
+    geometry::ImportOptions options;
+    options.unit_scale = m.unit_scale;
+    for (int a = 0; a < 3; ++a) options.scale[a] = m.scale[a], options.rotate_deg[a] = m.rotate_deg[a], options.translate[a] = m.translate[a];
+    geometry::TriangleMesh mesh = geometry::import_mesh(m.file, options);
+    return TriangleSoup{std::move(mesh.vertices), std::move(mesh.triangles)};
+  });
   State state = initial_state(model);
   Workspace work;
   RunOptions options;

@@ -1,6 +1,7 @@
 // Inlets, outlets, mass scaling, restart from a checkpoint, results files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -140,7 +141,9 @@ TEST(Run, ResumedRunEndsInTheSameStateAndKeepsEarlierResults) {
   std::string line;
   double first_time = -1, last_time = -1;
   std::getline(csv, line);
+  const auto columns = std::count(line.begin(), line.end(), ',');
   while (std::getline(csv, line)) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), columns) << "every row has every column: " << line;
     const double t = std::stod(line.substr(0, line.find(',')));
     if (first_time < 0) first_time = t;
     last_time = t;

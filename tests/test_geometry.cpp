@@ -242,6 +242,33 @@ TEST_F(MeshFiles, RotationsApplyAboutXThenYThenZAndMirrorsKeepOutwardFaces) {
   EXPECT_THROW(import_mesh(path("cube.stl"), zero), MeshError);
 }
 
+TEST_F(MeshFiles, NodeTransformsComposeDownTheHierarchyAndMirrorsKeepOutwardFaces) {
+  // glTF: parent node translated by (10, 0, 0), child scaled by (-2, 1, 1) holding the unit cube
+  // (positions and 16-bit indices in an embedded buffer, in cube()'s order).
+  std::ofstream(path("cube.gltf")) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"translation": [10, 0, 0], "children": [1]}, {"scale": [-2, 1, 1], "mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+  "buffers": [{"byteLength": 168, "uri": "data:application/octet-stream;base64,)"
+                                      "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwAAgD8AAAAAAAAAAAAAAAAAAIA/"
+                                      "AACAPwAAAAAAAIA/AAAAAAAAgD8AAIA/AACAPwAAgD8AAIA/AAACAAMAAAADAAEABAAFAAcABAAHAAYA"
+                                      "AAABAAUAAAAFAAQAAgAGAAcAAgAHAAMAAAAEAAYAAAAGAAIAAQADAAcAAQAHAAUA"
+                                      R"("}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}]})";
+  TriangleMesh mesh = import_mesh(path("cube.gltf"), {});
+  const MeshReport report = check_and_repair(mesh, 0);
+  EXPECT_TRUE(report.issues.empty()) << report.text();  // the mirror reversed the winding: no repair needed
+  EXPECT_EQ(report.bbox_min, (std::array<double, 3>{8, 0, 0}));
+  EXPECT_EQ(report.bbox_max, (std::array<double, 3>{10, 1, 1}));
+  EXPECT_NEAR(signed_volume(mesh), 2.0, 1e-12);
+  // The user's placement comes after the file's own: lifted 1 m in z.
+  ImportOptions lifted;
+  lifted.translate = {0, 0, 1};
+  EXPECT_EQ(check_and_repair(mesh = import_mesh(path("cube.gltf"), lifted), 0).bbox_min,
+            (std::array<double, 3>{8, 0, 1}));
+}
+
 TEST(MeshRepair, DegenerateAndDuplicateTrianglesAreRemovedAndCounted) {
   TriangleMesh mesh = cube();
   mesh.vertices.push_back({0.5, 0, 0});  // vertex 8, on the edge 0-1
