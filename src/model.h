@@ -65,16 +65,6 @@ struct PlaneWall {
   }
 };
 
-struct PlaneWallUnused {
-  std::array<double, 3> normal;
-  std::array<double, 3> velocity;  // [m/s] set velocity (a servo adds its normal speed)
-  int material;
-  bool servo = false;
-  double target_stress = 0;  // [Pa]
-  double servo_area = 0;     // [m^2]
-  double servo_max_speed = 0;  // [m/s]
-};
-
 /// A triangulated wall: its surface in the mesh's own frame, the BVH over it, how it moves.
 struct MeshWall {
   std::string name;

@@ -148,12 +148,9 @@ void wrap_into_period(const Model& model, State& s) {
     const double lo = model.domain_min[a];
     auto wrap = [&](double& v) { v -= period * std::floor((v - lo) / period); };
     std::vector<double>& column = a == 0 ? s.x : a == 1 ? s.y : s.z;
-    std::vector<double>& built = a == 0 ? s.x_built : a == 1 ? s.y_built : s.z_built;
     for (size_t p = 0; p < s.size(); ++p) {
       if (s.body[p] >= 0) continue;
-      const double before = column[p];
       wrap(column[p]);
-      if (p < built.size()) built[p] += column[p] - before;
     }
     std::vector<double>& centre = a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z;
     std::vector<double> shift(s.bodies.size());
@@ -165,7 +162,6 @@ void wrap_into_period(const Model& model, State& s) {
     for (size_t p = 0; p < s.size(); ++p) {
       if (s.body[p] < 0 || shift[s.body[p]] == 0.0) continue;
       column[p] += shift[s.body[p]];
-      if (p < built.size()) built[p] += shift[s.body[p]];
     }
   }
 }

@@ -210,8 +210,7 @@ InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t ind
   InletSpec in;
   in.location = map.location();
   in.name = map.string("name", fmt::format("inlet{}", index));
-  in.material = map.string("material", "");
-  if (in.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  in.material = map.required_string("material", "name one of the case's materials");
   in.clump = map.string("clump", "");
   in.diameter = read_diameter(map, file);
   const bool tph = map.has("mass_rate_tph"), kgs = map.has("mass_rate_kgs");
@@ -241,8 +240,7 @@ MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t i
   MeshWallSpec m;
   m.location = map.location();
   m.name = map.string("name", fmt::format("mesh{}", index));
-  m.material = map.string("material", "");
-  if (m.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  m.material = map.required_string("material", "name one of the case's materials");
   const std::string base_dir = std::filesystem::path(file).parent_path().string();
   m.file = map.string("file", "");
   if (!m.file.empty() && std::filesystem::path(m.file).is_relative() && !base_dir.empty())
@@ -304,8 +302,7 @@ ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, 
   MapReader map(node, file, fmt::format("particles[{}]", index));
   ParticleSetSpec p;
   p.location = map.location();
-  p.material = map.string("material", "");
-  if (p.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  p.material = map.required_string("material", "name one of the case's materials");
   p.clump = map.string("clump", "");
   p.diameter = read_diameter(map, file);
   p.velocity = map.vec3("velocity", p.velocity);
@@ -334,8 +331,7 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
   PlaneWallSpec w;
   w.location = map.location();
   w.name = map.string("name", fmt::format("wall{}", index));
-  w.material = map.string("material", "");
-  if (w.material.empty()) map.fail("material", "missing: name one of the case's materials");
+  w.material = map.required_string("material", "name one of the case's materials");
   const YAML::Node plane = map.node("plane"), cylinder = map.node("cylinder");
   if (!plane == !cylinder)
     map.fail("plane", "give one of plane: {point, normal} or cylinder: {point, axis, radius} (particles inside); "

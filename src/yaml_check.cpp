@@ -149,6 +149,12 @@ std::string MapReader::string(const std::string& key, const std::string& fallbac
   return value;
 }
 
+std::string MapReader::required_string(const std::string& key, const std::string& what) {
+  const std::string value = string(key, "");
+  if (value.empty()) fail(key, "missing: " + what);
+  return value;
+}
+
 Vec3 MapReader::vec3(const std::string& key, const Vec3& fallback) {
   used_.insert(key);
   const YAML::Node n = node_[key];
