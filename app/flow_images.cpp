@@ -10,6 +10,25 @@
 
 namespace dem::app {
 
+std::string default_camera(const Model& model);
+
+namespace {
+
+/// The case's explicit camera when it gives one (and the command line names no preset), else the
+/// preset fitted to the box.
+render::Camera camera_for(const Model& model, const ImageOptions& options, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                          double aspect) {
+  const OutputSpec& o = model.output;
+  if (o.has_camera_pose && options.camera.empty()) {
+    render::Camera c;
+    c.eye = o.camera_eye, c.target = o.camera_target, c.up = o.camera_up, c.fov_deg = o.camera_fov_deg;
+    return c;
+  }
+  return render::fit_camera(lo, hi, options.camera.empty() ? default_camera(model) : options.camera, aspect);
+}
+
+}  // namespace
+
 void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
   render::Frame frame;
   frame.width = options.width, frame.height = options.height;
@@ -80,8 +99,61 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
     layer.opacity = 0.35f;
     frame.meshes.push_back(layer);
   }
-  frame.camera = render::fit_camera(lo, hi, options.camera, double(frame.width) / frame.height);
+  frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
   frame.caption = fmt::format("{}   t = {:.3f} s   {} particles", model.title.empty() ? model.source : model.title, s.time, s.size());
+  render::render_png(frame, path);
+}
+
+}  // namespace dem::app
+
+namespace dem::app {
+
+std::string default_camera(const Model& model) {
+  if (!model.output.render_camera.empty()) return model.output.render_camera;
+  return model.equipment_camera.empty() ? "iso" : model.equipment_camera;
+}
+
+void render_wall_field(const Model& model, const State& s, const std::vector<std::vector<double>>& field,
+                       const std::string& label, const ImageOptions& options, const std::string& path) {
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
+  std::vector<std::vector<float>> values(model.meshes.size());
+  std::vector<double> all;
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const Pose pose = model.meshes[m].motion.pose(s.time);
+    for (const auto& v : model.meshes[m].surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      placed[m].push_back({w.x(), w.y(), w.z()});
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+    for (double v : field[m]) {
+      values[m].push_back(static_cast<float>(v));
+      if (std::isfinite(v)) all.push_back(v);
+    }
+  }
+  if (!std::isfinite(lo.x())) return;
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    render::MeshLayer layer;
+    layer.vertices = placed[m];
+    layer.triangles = model.meshes[m].surface->triangles;
+    layer.triangle_value = values[m];
+    frame.meshes.push_back(layer);
+  }
+  // Particles faint, for orientation.
+  render::ParticleLayer particles;
+  particles.x = s.x, particles.y = s.y, particles.z = s.z, particles.radius = s.radius;
+  particles.colour = {0.55f, 0.55f, 0.55f};
+  frame.particles.push_back(particles);
+  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
+  if (!all.empty()) {
+    std::sort(all.begin(), all.end());
+    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
+  }
+  frame.mesh_colours = colours;
+  frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
+  frame.caption = fmt::format("{}   {}", model.title.empty() ? model.source : model.title, label);
   render::render_png(frame, path);
 }
 

@@ -11,12 +11,21 @@
 namespace dem::app {
 
 struct ImageOptions {
-  std::string camera = "iso";    // side, front, top, iso
+  std::string camera;            // side, front, top, iso; "": default_camera(model)
   std::string colour = "speed";  // speed, radius, material
   int width = 1280, height = 720;
 };
 
 /// Renders the state to a PNG at `path` (headless, OSMesa).
 void render_state(const Model& model, const State& state, const ImageOptions& options, const std::string& path);
+
+/// Renders the meshes coloured by a per-triangle field (one vector per mesh, NaN: not coloured)
+/// with a colour bar titled `label`, particles faint; the colour scale ends at the field's 99th
+/// percentile so one hot triangle does not wash out the rest.
+void render_wall_field(const Model& model, const State& state, const std::vector<std::vector<double>>& field,
+                       const std::string& label, const ImageOptions& options, const std::string& path);
+
+/// The camera for a model when the case names none: the equipment's, else iso.
+std::string default_camera(const Model& model);
 
 }  // namespace dem::app

@@ -12,16 +12,21 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "diagnostics.h"
+#include "equipment.h"
 #include "flow_images.h"
 #include "mesh_health.h"
 #include "model.h"
 #include "particles.h"
+#include "report.h"
 #include "results_hdf5.h"
 #include "run.h"
 #include "spec.h"
+#include "sweep.h"
 #include "triangle_mesh.h"
+#include "video.h"
 
 namespace {
 
@@ -33,7 +38,30 @@ struct RunArgs {
   std::string out;
   bool quiet = false;
   bool resume = false;
+  long variant = -1;  ///< run this variant of the case's sweep (the sweep runner's children)
+  bool report = true;
 };
+
+/// The case file as YAML, with file:line errors.
+YAML::Node load_case_yaml(const std::string& path, std::string* text_out = nullptr) {
+  std::ifstream in(path);
+  if (!in) throw dem::CaseError(fmt::format("{}: cannot open the case file", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  if (text_out) *text_out = text.str();
+  try {
+    return YAML::Load(text.str());
+  } catch (const YAML::ParserException& e) {
+    throw dem::CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", path, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+}
+
+/// Reads a case with its equipment expanded: what every command compiles.
+dem::CaseSpec read_case(const std::string& path) {
+  dem::CaseSpec spec = dem::parse_case_file(path);
+  dem::equipment::expand_equipment(spec);
+  return spec;
+}
 
 /// Mesh files go through the geometry library: import, health check, safe repair. A mesh that
 /// cannot be simulated stops the run with its report.
@@ -63,8 +91,80 @@ dem::app::ImageOptions image_options(const dem::Model& model) {
   return {model.output.render_camera, model.output.render_colour, model.output.render_width, model.output.render_height};
 }
 
+/// Per-triangle rate per area [W/m^2] of a wall record over the recording interval; NaN where a
+/// mesh has no records.
+std::vector<std::vector<double>> wall_rate(const dem::Model& model, const dem::State& state, bool impact, double seconds) {
+  std::vector<std::vector<double>> out(model.meshes.size());
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const dem::TriangleSurface& surface = *model.meshes[m].surface;
+    out[m].assign(surface.size(), std::numeric_limits<double>::quiet_NaN());
+    if (m >= state.records.size()) continue;
+    const std::vector<double>& work = impact ? state.records[m].impact_energy : state.records[m].shear_work;
+    for (size_t t = 0; t < surface.size() && t < work.size(); ++t) out[m][t] = work[t] / (seconds * surface.areas[t]);
+  }
+  return out;
+}
+
+/// The run's report folder: renders of the flow and of the wear fields on the walls, then the
+/// report itself (throughput, power, wear, belt loading at steady state).
+void write_run_report(const dem::Model& model, const dem::State& state, const dem::CaseSpec& spec, const dem::RunSummary& summary,
+                      const std::string& case_path, const std::string& case_text) {
+  const std::string out = summary.output_directory, report_dir = out + "/report";
+  std::filesystem::create_directories(report_dir);
+  dem::report::RunReportInput input;
+  input.model = &model, input.state = &state, input.scalars = summary.scalars;
+  input.case_path = case_path, input.case_text = case_text, input.version = DEMDESIGN_VERSION;
+  input.wall_seconds = summary.wall_seconds;
+  input.records_from = model.output.records_from;
+  input.sensors = model.sensors, input.design = model.design;
+  for (const auto& mesh : spec.meshes) {
+    auto k = spec.wear_coefficients.find(mesh.name);
+    if (k == spec.wear_coefficients.end()) k = spec.wear_coefficients.find("default");
+    if (k != spec.wear_coefficients.end()) input.wear_coefficient[mesh.name] = k->second;
+  }
+  for (const auto& outlet : spec.outlets)
+    if (!outlet.spillage) input.outlet_intended.push_back(outlet.name);
+  const std::string flow = fmt::format("{}/renders/frame_{:06d}.png", out, state.step);
+  if (std::filesystem::exists(flow))
+    input.images.push_back({"Flow at the end of the run", flow,
+                            fmt::format("Particles coloured by {} at t = {:.2f} s; walls cut away where they face the camera.",
+                                        model.output.render_colour, state.time)});
+  const double seconds = state.time - model.output.records_from;
+  if (!model.meshes.empty() && seconds > 0) {
+    dem::app::ImageOptions wear_view = image_options(model);
+    wear_view.camera = "iso";
+    const std::string shear = report_dir + "/wear_shear_work.png", impact = report_dir + "/wear_impact_energy.png";
+    dem::app::render_wall_field(model, state, wall_rate(model, state, false, seconds), "shear work rate [W/m²]", wear_view, shear);
+    dem::app::render_wall_field(model, state, wall_rate(model, state, true, seconds), "impact energy rate [W/m²]", wear_view, impact);
+    input.images.push_back({"Abrasive wear: shear work rate", shear,
+                            fmt::format("Friction work per area and time on the walls (Archard wear input), averaged over t = {:.2f} to {:.2f} s.",
+                                        model.output.records_from, state.time)});
+    input.images.push_back({"Impact wear: impact energy rate", impact,
+                            fmt::format("Normal impact energy per area and time on the walls, t = {:.2f} to {:.2f} s.", model.output.records_from, state.time)});
+  }
+  const dem::report::RunMetrics metrics = dem::report::write_run_report(input, report_dir);
+  std::cout << fmt::format("  report: {}/report.html ({})\n", report_dir, metrics.steady_text);
+}
+
 int run_case(const RunArgs& args) {
-  const dem::CaseSpec spec = dem::parse_case_file(args.case_path);
+  std::string case_text;
+  YAML::Node root = load_case_yaml(args.case_path, &case_text);
+  const dem::app::SweepPlan plan = dem::app::read_sweep(root, args.case_path);
+  if (!plan.variants.empty() && args.variant < 0) {
+    dem::app::SweepOptions sweep;
+    sweep.case_path = args.case_path;
+    sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
+    sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
+    return dem::app::run_sweep(plan, sweep, std::cout);
+  }
+  if (args.variant >= 0) {
+    if (args.variant >= static_cast<long>(plan.variants.size()))
+      throw dem::CaseError(fmt::format("--variant {}: the case has {} sweep variants", args.variant, plan.variants.size()));
+    root = dem::app::variant_case(root, plan, static_cast<size_t>(args.variant));
+    case_text = fmt::format("# {} of {}: {}\n", plan.name(args.variant), args.case_path, plan.label(args.variant)) + YAML::Dump(root) + "\n";
+  }
+  dem::CaseSpec spec = dem::parse_case_node(root, args.case_path);
+  dem::equipment::expand_equipment(spec);
   const dem::Model model = compile_case(spec);
   const int threads = args.threads > 0 ? args.threads : model.threads;
   if (threads > 0) omp_set_num_threads(threads);
@@ -87,18 +187,34 @@ int run_case(const RunArgs& args) {
     dem::app::render_state(m, s, image_options(m), path);
     if (last) std::cout << fmt::format("  rendered {}\n", path);
   };
-  dem::run(model, state, work, options, std::cout);
+  const dem::RunSummary summary = dem::run(model, state, work, options, std::cout);
+  const std::string out = summary.output_directory;
+  dem::write_file_atomically(out + "/case.yaml", case_text);
+  if (spec.equipment) {
+    const auto files = dem::equipment::write_equipment_meshes(spec, out + "/meshes");
+    std::cout << fmt::format("  wrote {} equipment meshes (STL) to {}/meshes\n", files.size(), out);
+  }
+  if (args.report) write_run_report(model, state, spec, summary, args.case_path, case_text);
   return 0;
 }
 
 /// Renders saved frames of a finished (or running) run: the case comes from run_info.yaml.
-int render_results(const std::string& out, const std::string& which, const dem::app::ImageOptions& given) {
+int render_results(const std::string& out, const std::string& which, const dem::app::ImageOptions& given, bool video) {
   std::ifstream info(out + "/run_info.yaml");
   if (!info) throw std::runtime_error(fmt::format("{}/run_info.yaml: not a demdesign output folder", out));
   std::string line, case_path;
   while (std::getline(info, line))
     if (line.rfind("case: ", 0) == 0) case_path = line.substr(6);
-  const dem::Model model = compile_case(dem::parse_case_file(case_path));
+  // The case as it ran (a sweep variant has its values set in OUT/case.yaml); relative paths in it
+  // resolve against the original case file.
+  dem::CaseSpec spec;
+  if (std::filesystem::exists(out + "/case.yaml")) {
+    spec = dem::parse_case_node(load_case_yaml(out + "/case.yaml"), case_path);
+    dem::equipment::expand_equipment(spec);
+  } else {
+    spec = read_case(case_path);
+  }
+  const dem::Model model = compile_case(spec);
   dem::FrameWriter frames(out, {}, {});
   frames.adopt_existing();
   if (frames.frames().empty()) throw std::runtime_error(fmt::format("{}: no frames listed in particles.xdmf", out));
@@ -127,6 +243,12 @@ int render_results(const std::string& out, const std::string& which, const dem::
     dem::app::render_state(model, s, given, path);
     std::cout << fmt::format("rendered {}\n", path);
   }
+  if (video) {
+    std::string message;
+    const std::string movie = out + "/renders/flow.mp4";
+    if (dem::app::make_video(out + "/renders", "frame_", movie, 10.0, &message)) std::cout << fmt::format("video {}\n", movie);
+    else std::cout << message << "\n";
+  }
   return 0;
 }
 
@@ -142,6 +264,8 @@ int main(int argc, char** argv) {
     cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)");
     cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
     cmd->add_flag("--quiet", args.quiet, "no progress lines");
+    cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
+    cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
     cmd->add_flag("--resume", args.resume, "continue from OUT/checkpoint.bin (written every output.checkpoint_every, and on SIGINT/SIGTERM)");
   };
   app.add_option("case", args.case_path, "case file (YAML) to run");
@@ -168,6 +292,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"speed", "radius", "material"}));
   render_cmd->add_option("--camera", render_options.camera, "side, front, top or iso")
       ->check(CLI::IsMember({"side", "front", "top", "iso"}));
+  bool render_video = false;
+  render_cmd->add_flag("--video", render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
   render_cmd->add_option("--width", render_options.width, "[px]");
   render_cmd->add_option("--height", render_options.height, "[px]");
   CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
@@ -179,13 +305,13 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (check_cmd->parsed()) {
-      const dem::Model model = compile_case(dem::parse_case_file(check_path));
+      const dem::Model model = compile_case(read_case(check_path));
       const dem::State state = dem::initial_state(model);
       dem::print_setup(model, state, std::cout);
       return 0;
     }
     if (mesh_cmd->parsed()) return dem::geometry::check_mesh_command(mesh_files, mesh_options, mesh_particle_diameter, std::cout);
-    if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options);
+    if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options, render_video);
     if (args.case_path.empty()) {
       std::cout << app.help();
       return 2;

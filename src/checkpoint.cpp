@@ -13,12 +13,12 @@ namespace dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '3'};
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '4'};
 
 /// Every field of the State, in one order, for both directions.
 template <typename Io, typename S>
 void visit(Io& io, S& s) {
-  io(s.time), io(s.step), io(s.next_id), io(s.lost);
+  io(s.time), io(s.step), io(s.next_id), io(s.lost), io(s.lost_mass);
   for (auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
                   &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
                   &s.z_built})

@@ -309,6 +309,24 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     model.inlets.push_back(std::move(inlet));
   }
   model.outlets = spec.outlets;
+  for (size_t k = 0; k < spec.inlets.size(); ++k)
+    if (!spec.inlets[k].port.empty() && !(spec.inlets[k].region_max.array() > spec.inlets[k].region_min.array()).all())
+      throw CaseError(fmt::format("{}: inlets[{}].port: '{}' names an equipment port that was not resolved: the "
+                                  "case needs `equipment:` with that port (or give `region` instead)",
+                                  spec.inlets[k].location.str(), k, spec.inlets[k].port));
+  // Sensors: unit directions, a slab a couple of particles thick, unique names.
+  for (size_t k = 0; k < spec.sensors.size(); ++k) {
+    SensorSpec sensor = spec.sensors[k];
+    for (size_t j = 0; j < k; ++j)
+      if (spec.sensors[j].name == sensor.name)
+        throw CaseError(fmt::format("{}: sensors[{}].name: '{}' is used twice; sensor names must differ", sensor.location.str(), k, sensor.name));
+    sensor.normal.normalize();
+    sensor.across.normalize();
+    if (sensor.kind == SensorSpec::Kind::plane && sensor.thickness <= 0) sensor.thickness = 4.0 * model.radius_max;
+    model.sensors.push_back(sensor);
+  }
+  model.design = spec.design;
+  model.equipment_camera = spec.equipment_camera;
 
   // Options.
   const SimulationSpec& s = spec.simulation;

@@ -13,6 +13,14 @@
 
 namespace dem {
 
+/// What a sensor (SensorSpec) saw at one instant. Plane sensors fill `flow`; box sensors the rest.
+struct SensorReading {
+  double flow = 0;        // [kg/s] plane: mass flow through it along its normal
+  double mass = 0;        // [kg] box: mass of the particles inside
+  double vx = 0, vy = 0, vz = 0;  // [m/s] box: mass-weighted mean velocity
+  double offset = 0;      // [m] box: centroid offset along `across` from the box centre
+};
+
 struct Scalars {
   double time = 0;                 // [s]
   std::int64_t step = 0;
@@ -31,6 +39,8 @@ struct Scalars {
   std::vector<double> mesh_force;        // [N] per mesh, magnitude of the particles' force on it
   std::vector<double> mesh_torque;       // [N m] per mesh, about its rotation axis (|T| if it does not rotate)
   std::vector<double> mesh_power;        // [W] per mesh, rate of work it does on the particles
+  double lost_mass = 0;                  // [kg] left the domain (outside every outlet): spillage
+  std::vector<SensorReading> sensors;    ///< per sensor, in the model's order
 };
 
 Scalars measure(const Model& model, const State& state, const Workspace& work);

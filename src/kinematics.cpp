@@ -67,6 +67,48 @@ void table_pose(const MotionPart& part, double s, bool moving, PartPose& out) {
   if (moving && inside) out.translation_rate = v[i] + slope * u;
 }
 
+/// Belt-loop part at `travelled` [m] of arc length since start: the carried frame and its rate
+/// (`moving`: the belt runs). Path and frame as documented in kinematics.h.
+void belt_loop_pose(const MotionPart& part, double travelled, bool moving, PartPose& out) {
+  const Vector3d axis = part.axis.normalized();
+  const Vector3d span = part.upper - part.lower;
+  const Vector3d along = (span - span.dot(axis) * axis);
+  const double straight = along.norm();  // [m]
+  const Vector3d e = along / straight;    // up the loop
+  const Vector3d s = e.cross(axis);       // outward on the up-going straight
+  const double r = part.radius;
+  const double arc = std::numbers::pi * r;  // [m] one half turn
+  const double loop = 2 * straight + 2 * arc;
+  double u = std::fmod(part.offset + travelled, loop);
+  if (u < 0) u += loop;
+  // Four pieces: up straight, upper arc, down straight, lower arc; theta is the frame's turn.
+  double theta = 0;         // [rad] about axis
+  double turn_rate = 0;     // [rad/m] dtheta/du
+  Vector3d point, tangent;  // path point [m] and unit tangent
+  if (u < straight) {
+    point = part.lower + r * s + u * e, tangent = e, theta = 0;
+  } else if (u < straight + arc) {
+    theta = (u - straight) / r, turn_rate = 1 / r;
+    point = part.lower + along + r * (std::cos(theta) * s + std::sin(theta) * e);
+    tangent = -std::sin(theta) * s + std::cos(theta) * e;
+  } else if (u < 2 * straight + arc) {
+    point = part.lower + along - r * s - (u - straight - arc) * e, tangent = -e, theta = std::numbers::pi;
+  } else {
+    theta = std::numbers::pi + (u - 2 * straight - arc) / r, turn_rate = 1 / r;
+    point = part.lower + r * (std::cos(theta) * s + std::sin(theta) * e);
+    tangent = -std::sin(theta) * s + std::cos(theta) * e;
+  }
+  // Local frame at arc length 0: x -> s, y -> e, z -> axis; then turned by theta about axis.
+  Eigen::Matrix3d start_frame;
+  start_frame.col(0) = s, start_frame.col(1) = e, start_frame.col(2) = axis;
+  out.rotation = Quaterniond(Eigen::AngleAxisd(theta, axis)) * Quaterniond(start_frame);
+  out.translation = point;
+  if (moving) {
+    out.translation_rate = part.speed * tangent;
+    out.angular = part.speed * turn_rate * axis;
+  }
+}
+
 /// The pose of one part at time t [s] and its rate.
 PartPose part_pose(const MotionPart& part, double t) {
   // Time is clamped into [start, stop]: at rest before, frozen after. The rate is that of the
@@ -101,6 +143,9 @@ PartPose part_pose(const MotionPart& part, double t) {
     case MotionPart::Kind::table:
       table_pose(part, elapsed, moving, out);
       break;
+    case MotionPart::Kind::belt_loop:
+      belt_loop_pose(part, part.speed * elapsed, moving, out);
+      break;
   }
   return out;
 }
@@ -131,9 +176,18 @@ bool Motion::is_static() const {
         for (const Vector3d& value : part.values)
           if (part.speeds ? !value.isZero(0.0) : value != part.values.front()) return false;
         break;
+      case MotionPart::Kind::belt_loop:
+        if (part.speed != 0.0) return false;
+        break;
     }
   }
   return true;
+}
+
+double belt_loop_length(const MotionPart& part) {
+  const Vector3d axis = part.axis.normalized();
+  const Vector3d span = part.upper - part.lower;
+  return 2 * (span - span.dot(axis) * axis).norm() + 2 * std::numbers::pi * part.radius;
 }
 
 Pose Motion::pose(double t) const {
@@ -194,7 +248,7 @@ double Motion::max_displacement(double t0, double t1, double radius) const {
 
 namespace {
 
-const std::vector<std::string> kKinds = {"translation", "rotation", "oscillation", "table"};
+const std::vector<std::string> kKinds = {"translation", "rotation", "oscillation", "table", "belt_loop"};
 
 std::string trim(const std::string& text) {
   const auto first = text.find_first_not_of(" \t\r");
@@ -296,7 +350,7 @@ MotionPart read_part(const YAML::Node& node, const std::string& file, const std:
   for (const std::string& kind : kKinds)
     if (reader.has(kind)) given.push_back(kind);
   if (given.empty()) {
-    throw CaseError(fmt::format("{}: {}: a motion part needs one of translation, rotation, oscillation, table",
+    throw CaseError(fmt::format("{}: {}: a motion part needs one of translation, rotation, oscillation, table, belt_loop",
                                 reader.location().str(), path));
   }
   if (given.size() > 1) {
@@ -334,6 +388,25 @@ MotionPart read_part(const YAML::Node& node, const std::string& file, const std:
     part.phase = inner.number("phase", 0.0, -1e3, 1e3, "rad");
     inner.finish();
     if (part.frequency == 0.0) inner.fail("frequency", "must be above 0 Hz");
+  } else if (kind == "belt_loop") {
+    part.kind = MotionPart::Kind::belt_loop;
+    const Vector3d axis = required_vec3("axis", "[0, 1, 0]");
+    part.lower = required_vec3("lower", "[0, 0, 0] (m)");
+    part.upper = required_vec3("upper", "[0, 0, 3] (m)");
+    part.radius = inner.required_number("radius", 0.0, 1e3, "m");
+    part.speed = inner.required_number("speed", -1e3, 1e3, "m/s");
+    part.offset = inner.number("offset", 0.0, -1e6, 1e6, "m");
+    inner.finish();
+    if (axis.norm() == 0.0) inner.fail("axis", "must not be zero; give the pulley axis direction, e.g. [0, 1, 0]");
+    part.axis = axis.normalized();
+    if (part.radius == 0.0) inner.fail("radius", "must be above 0 m (the path radius around the pulleys)");
+    const Vector3d span = part.upper - part.lower;
+    const double along_axis = std::abs(span.dot(part.axis));
+    if (along_axis > 1e-9 * std::max(1.0, span.norm()) || span.norm() == 0.0) {
+      inner.fail("upper", fmt::format("upper - lower must be a non-zero distance perpendicular to the axis (it has "
+                                      "{:g} m along the axis and {:g} m across)", along_axis,
+                                      std::sqrt(std::max(0.0, span.squaredNorm() - along_axis * along_axis))));
+    }
   } else {
     part.kind = MotionPart::Kind::table;
     if (!inner.has("file")) inner.fail("file", "missing; give a CSV file with the header t,x,y,z or t,vx,vy,vz");

@@ -15,6 +15,8 @@
 //     - {oscillation: {amplitude: [0, 0, 0.005], frequency: 10}}  # [m], [Hz], optional phase [rad]
 //     - {table: {file: lift.csv, columns: position}}              # header t,x,y,z (speed: t,vx,vy,vz)
 //
+//   motion: {belt_loop: {axis: [0, 1, 0], lower: [0, 0, 0], upper: [0, 0, 3], radius: 0.3, speed: 1.5, offset: 0}}
+//
 // Every part takes `start` (default 0) and `stop` (default .inf) [s]: before start the part rests
 // in its start pose, after stop it stays frozen where it stopped. Rotation takes `axis` (any
 // non-zero length), `point` on the axis [m] (default origin) and exactly one of `rpm` or
@@ -29,6 +31,20 @@
 // before the first time it holds the first position (a speed table: zero), after the last time it
 // holds the last position. Rejected: continuing with the last speed after the table ends; a wall
 // that keeps going after its profile is over runs through the rest of the plant.
+//
+// Belt loop (a bucket on an elevator belt): the local frame is carried around the stadium-shaped
+// path of a belt over two pulleys with parallel axes along `axis`, centres `lower` and `upper`
+// [m] (upper - lower perpendicular to axis), path radius `radius` [m] (where the carried point
+// runs on the arcs, e.g. the belt's outer surface), at `speed` [m/s] along the path, starting
+// `offset` [m] of arc length after the reference point. With e = unit(upper - lower) and
+// s = e x axis, the loop runs anticlockwise about `axis` (right-hand rule): up (+e) on the +s
+// straight, over the upper pulley, down on the -s straight, round the lower pulley. The reference
+// point (arc length 0) is lower + radius s, where the +s straight leaves the lower pulley. The
+// local frame: origin on the path, local +x outward from the loop (away from the pulleys' side of
+// the belt), local +y along the direction of travel, local +z along `axis`; on the arcs it turns
+// with the belt about `axis` by the arc angle (at arc length 0: x -> s, y -> e, z -> axis). A
+// negative speed runs the loop backwards. The loop closes after (2 |upper - lower| + 2 pi
+// radius) / |speed| seconds.
 #pragma once
 
 #include <Eigen/Core>
@@ -63,7 +79,7 @@ struct RigidVelocity {
 /// One part of a motion, active between start and stop [s] (before start: at rest in its start
 /// pose; after stop: frozen where it stopped). Only the fields of its kind are used.
 struct MotionPart {
-  enum class Kind { translation, rotation, oscillation, table } kind = Kind::translation;
+  enum class Kind { translation, rotation, oscillation, table, belt_loop } kind = Kind::translation;
   double start = 0.0;                                      // [s]
   double stop = std::numeric_limits<double>::infinity();  // [s]
 
@@ -86,7 +102,17 @@ struct MotionPart {
   std::vector<double> times;            // [s] from `start`, strictly increasing
   std::vector<Eigen::Vector3d> values;  // [m] or [m/s], one per time
   bool speeds = false;
+
+  // belt_loop (uses `axis` too): see the header comment for the path and the carried frame.
+  Eigen::Vector3d lower{0, 0, 0};  // [m] centre of the lower pulley (arc length 0 starts here)
+  Eigen::Vector3d upper{0, 0, 1};  // [m] centre of the upper pulley
+  double radius = 0.0;             // [m] path radius on the pulley arcs
+  double speed = 0.0;              // [m/s] along the path
+  double offset = 0.0;             // [m] arc length at `start`
 };
+
+/// Length [m] of a belt_loop part's closed path: 2 |upper - lower| + 2 pi radius.
+double belt_loop_length(const MotionPart& part);
 
 /// A rigid motion composed of parts.
 struct Motion {

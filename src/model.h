@@ -129,6 +129,10 @@ struct Model {
   std::vector<ParticleSource> sources;
   std::vector<Inlet> inlets;
   std::vector<OutletSpec> outlets;
+  std::vector<SensorSpec> sensors;  ///< normals and `across` unit, plane thickness > 0
+  /// Design values of the equipment (name with unit -> value) and the camera that suits it.
+  std::vector<std::pair<std::string, double>> design;
+  std::string equipment_camera;
 
   double dt = 0;                  // [s]
   double duration = 0;            // [s]

@@ -71,6 +71,7 @@ void remove_lost(const Model& model, State& state) {
         ++state.outlets[verdict].removed;
       } else {
         ++state.lost;
+        state.lost_mass += 1.0 / state.inv_mass[p];
       }
     }
   }
@@ -82,6 +83,7 @@ void remove_lost(const Model& model, State& state) {
       ++state.outlets[body_outlet[b]].removed;
     } else {
       ++state.lost;
+      state.lost_mass += state.bodies.mass[b];
     }
   }
   for (size_t p = 0; p < n; ++p)

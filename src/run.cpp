@@ -41,6 +41,10 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
   for (const PlaneWall& w : model.planes) out += fmt::format(",wall_{}_normal_force_N", w.name);
   for (const MeshWall& m : model.meshes)
     out += fmt::format(",mesh_{0}_force_N,mesh_{0}_torque_Nm,mesh_{0}_power_W", m.name);
+  out += ",lost_mass_kg";
+  for (const SensorSpec& s : model.sensors)
+    out += s.kind == SensorSpec::Kind::plane ? fmt::format(",sensor_{}_flow_kg_s", s.name)
+                                             : fmt::format(",sensor_{0}_mass_kg,sensor_{0}_vx_m_s,sensor_{0}_vy_m_s,sensor_{0}_vz_m_s,sensor_{0}_offset_m", s.name);
   out += "\n";
   for (const Scalars& r : rows) {
     out += fmt::format("{:.9g},{},{},{:.9g},{:.9g},{},{:.6g},{:.6g},{:.6g},{},{:.9g},{:.9g}", r.time, r.step, r.particles,
@@ -50,6 +54,13 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
     for (double f : r.wall_normal_force) out += fmt::format(",{:.9g}", f);
     for (size_t m = 0; m < r.mesh_force.size(); ++m)
       out += fmt::format(",{:.9g},{:.9g},{:.9g}", r.mesh_force[m], r.mesh_torque[m], r.mesh_power[m]);
+    out += fmt::format(",{:.9g}", r.lost_mass);
+    for (size_t k = 0; k < model.sensors.size() && k < r.sensors.size(); ++k) {
+      const SensorReading& s = r.sensors[k];
+      out += model.sensors[k].kind == SensorSpec::Kind::plane
+                 ? fmt::format(",{:.9g}", s.flow)
+                 : fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", s.mass, s.vx, s.vy, s.vz, s.offset);
+    }
     out += "\n";
   }
   return out;
@@ -72,9 +83,11 @@ std::vector<Scalars> read_scalars(const Model& model, const std::string& path, d
     r.kinetic_translation = v[3], r.kinetic_rotation = v[4], r.contacts = static_cast<size_t>(v[5]);
     r.max_overlap_ratio = v[6], r.mean_overlap_ratio = v[7], r.dt = v[8], r.lost = static_cast<std::int64_t>(v[9]);
     r.inserted_mass = v[10], r.removed_mass = v[11];
-    // Then one column per outlet, per wall, and three per mesh, in the header's order.
+    // Then one column per outlet, per wall, three per mesh, lost mass, the sensors' columns.
     const size_t outlets = model.outlets.size(), walls = model.planes.size(), meshes = model.meshes.size();
-    if (v.size() != 12 + outlets + walls + 3 * meshes) break;
+    size_t sensor_columns = 0;
+    for (const SensorSpec& s : model.sensors) sensor_columns += s.kind == SensorSpec::Kind::plane ? 1 : 5;
+    if (v.size() != 13 + outlets + walls + 3 * meshes + sensor_columns) break;
     size_t c = 12;
     for (size_t k = 0; k < outlets; ++k) r.outlet_mass.push_back(v[c++]);
     for (size_t k = 0; k < walls; ++k) r.wall_normal_force.push_back(v[c++]);
@@ -82,6 +95,13 @@ std::vector<Scalars> read_scalars(const Model& model, const std::string& path, d
       r.mesh_force.push_back(v[c++]);
       r.mesh_torque.push_back(v[c++]);
       r.mesh_power.push_back(v[c++]);
+    }
+    r.lost_mass = v[c++];
+    for (const SensorSpec& s : model.sensors) {
+      SensorReading reading;
+      if (s.kind == SensorSpec::Kind::plane) reading.flow = v[c++];
+      else reading.mass = v[c], reading.vx = v[c + 1], reading.vy = v[c + 2], reading.vz = v[c + 3], reading.offset = v[c + 4], c += 5;
+      r.sensors.push_back(reading);
     }
     rows.push_back(r);
   }

@@ -4,7 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,6 +63,95 @@ MaterialSpec read_material(const std::string& name, const YAML::Node& node, cons
   m.poisson_ratio = map.number("poisson_ratio", 0.25, -0.99, 0.499, "-");
   read_effect_params(map, {"density", "youngs_modulus", "poisson_ratio"}, m.params, m.where);
   return m;
+}
+
+/// Where `materials: {NAME: {library: gravel}}` looks for gravel.yaml, first match wins: the case's
+/// folder, its `materials/` and `../materials/` folders, $DEMDESIGN_MATERIALS, and the library
+/// shipped with the source tree.
+std::vector<std::filesystem::path> library_folders(const std::string& case_file) {
+  const std::filesystem::path dir = std::filesystem::path(case_file).parent_path();
+  std::vector<std::filesystem::path> out = {dir, dir / "materials", dir / ".." / "materials"};
+  if (const char* env = std::getenv("DEMDESIGN_MATERIALS")) out.emplace_back(env);
+#ifdef DEMDESIGN_MATERIALS_DIR
+  out.emplace_back(DEMDESIGN_MATERIALS_DIR);
+#endif
+  return out;
+}
+
+/// A library material: materials/NAME.yaml with `properties` (as a case material), `sources`
+/// (provenance of each value), `description`, `walls` (pair parameters against wall materials),
+/// `contact` (the contact model it was calibrated with), `tunable` ranges and a typical `size`.
+struct LibraryMaterial {
+  MaterialSpec material;
+  YAML::Node contact;  ///< null when the file has none
+  std::string file;
+  std::vector<std::pair<std::string, YAML::Node>> walls;
+};
+
+LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file) {
+  const std::string wanted = entry.string("library", "");
+  std::filesystem::path found;
+  std::string searched;
+  for (const auto& dir : library_folders(case_file)) {
+    const std::filesystem::path candidate = dir / (wanted + ".yaml");
+    searched += "\n  " + candidate.lexically_normal().string();
+    if (std::filesystem::is_regular_file(candidate)) {
+      found = candidate;
+      break;
+    }
+  }
+  if (found.empty()) entry.fail("library", fmt::format("no material file '{}.yaml' found; looked in:{}", wanted, searched));
+  std::ifstream in(found);
+  std::stringstream text;
+  text << in.rdbuf();
+  LibraryMaterial lib;
+  lib.file = found.lexically_normal().string();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", lib.file, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+  MapReader file_map(root, lib.file, "");
+  if (!file_map.has("properties")) file_map.fail("properties", "missing: the material's {density, youngs_modulus, ...}");
+  lib.material = read_material(name, file_map.node("properties"), lib.file);
+  lib.material.library_file = lib.file;
+  lib.material.description = file_map.string("name", wanted);
+  lib.material.description = file_map.string("description", lib.material.description);
+  if (const YAML::Node sources = file_map.node("sources")) {
+    MapReader s(sources, lib.file, "sources");
+    for (const std::string& key : s.keys()) lib.material.sources[key] = s.string(key, "");
+  }
+  if (const YAML::Node tunable = file_map.node("tunable")) {
+    MapReader t(tunable, lib.file, "tunable");
+    for (const std::string& key : t.keys()) {
+      const YAML::Node range = t.node(key);
+      if (!range.IsSequence() || range.size() != 2) t.fail(key, "must be a range [min, max]");
+      const double lo = MapReader::scalar_number(range[0], t, key), hi = MapReader::scalar_number(range[1], t, key);
+      if (!(lo < hi)) t.fail(key, "needs min < max");
+      lib.material.tunable[key] = {lo, hi};
+    }
+  }
+  if (const YAML::Node walls = file_map.node("walls")) {
+    if (!walls.IsMap()) file_map.fail("walls", "must map wall material names to pair parameters {friction: ..., ...}");
+    for (const auto& kv : walls) lib.walls.emplace_back(kv.first.as<std::string>(), kv.second);
+  }
+  lib.contact = file_map.node("contact");
+  file_map.node("size");  // a typical size, for the calibration tests
+  file_map.finish();
+  // Overrides in the case entry, beside `library:`.
+  MaterialSpec& m = lib.material;
+  m.location = entry.location();
+  m.density = entry.number("density", m.density, 1.0, 1e5, "kg/m^3");
+  m.youngs_modulus = entry.number("youngs_modulus", m.youngs_modulus, 1e3, kInf, "Pa");
+  m.poisson_ratio = entry.number("poisson_ratio", m.poisson_ratio, -0.99, 0.499, "-");
+  for (const char* key : {"density", "youngs_modulus", "poisson_ratio"})
+    if (entry.has(key)) m.where[key] = entry.where(key), m.sources[key] = "set in the case";
+  std::map<std::string, double> overrides;
+  std::map<std::string, SourceLocation> where;
+  read_effect_params(entry, {"library", "density", "youngs_modulus", "poisson_ratio"}, overrides, where);
+  for (const auto& [key, value] : overrides) m.params[key] = value, m.where[key] = where[key], m.sources[key] = "set in the case";
+  return lib;
 }
 
 ContactSpec::Choice read_choice(const YAML::Node& node, const std::string& file, const std::string& path,
@@ -213,10 +304,12 @@ InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t ind
   in.material = map.required_string("material", "name one of the case's materials");
   in.clump = map.string("clump", "");
   in.diameter = read_diameter(map, file);
+  in.port = map.string("port", "");
   const bool tph = map.has("mass_rate_tph"), kgs = map.has("mass_rate_kgs");
   if (tph == kgs) map.fail("mass_rate_tph", "give exactly one of mass_rate_tph [t/h] or mass_rate_kgs [kg/s]");
   in.mass_rate = tph ? map.number("mass_rate_tph", 0, 1e-9, 1e6, "t/h") / 3.6 : map.number("mass_rate_kgs", 0, 1e-12, 1e6, "kg/s");
-  read_box(map, "region", file, in.region_min, in.region_max);
+  if (in.port.empty()) read_box(map, "region", file, in.region_min, in.region_max);
+  else if (map.has("region")) map.fail("region", fmt::format("give either `port: {}` (the equipment's feed point) or `region`, not both", in.port));
   in.velocity = map.vec3("velocity", in.velocity);
   in.start = map.number("start", 0.0, 0.0, 1e9, "s");
   in.stop = map.number("stop", 1e300, in.start, 1e300, "s");
@@ -231,8 +324,61 @@ OutletSpec read_outlet(const YAML::Node& node, const std::string& file, size_t i
   out.location = map.location();
   out.name = map.string("name", fmt::format("outlet{}", index));
   read_box(map, "region", file, out.region_min, out.region_max);
+  out.spillage = map.boolean("spillage", false);
   map.finish();
   return out;
+}
+
+SensorSpec read_sensor(const YAML::Node& node, const std::string& file, size_t index) {
+  MapReader map(node, file, fmt::format("sensors[{}]", index));
+  SensorSpec s;
+  s.location = map.location();
+  s.name = map.string("name", fmt::format("sensor{}", index));
+  if (map.has("plane") == map.has("box"))
+    map.fail("plane", "give exactly one of `plane: {point, normal, thickness}` (a flow plane) or `box: {min, max, across}`");
+  if (const YAML::Node plane = map.node("plane")) {
+    s.kind = SensorSpec::Kind::plane;
+    MapReader p(plane, file, map.key_path("plane"));
+    s.point = p.vec3("point", Vec3::Zero());
+    s.normal = p.vec3("normal", Vec3(1, 0, 0));
+    if (s.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
+    s.thickness = p.number("thickness", 0.0, 0.0, 100.0, "m");
+    p.finish();
+    read_box(map, "region", file, s.region_min, s.region_max);
+  } else {
+    s.kind = SensorSpec::Kind::box;
+    MapReader b(map.node("box"), file, map.key_path("box"));
+    s.region_min = b.vec3("min", Vec3::Zero());
+    s.region_max = b.vec3("max", Vec3::Zero());
+    if (!(s.region_max.array() > s.region_min.array()).all()) b.fail("max", "each component must exceed min");
+    s.across = b.vec3("across", s.across);
+    if (s.across.norm() < 1e-12) b.fail("across", "must not be zero");
+    b.finish();
+  }
+  map.finish();
+  return s;
+}
+
+EquipmentSpec read_equipment(const YAML::Node& node, const std::string& file) {
+  MapReader map(node, file, "equipment");
+  const std::vector<std::string> keys = map.keys();
+  const std::vector<std::string> types = {"transfer_chute", "screw_conveyor", "bucket_elevator", "belt_conveyor", "silo"};
+  if (keys.size() != 1)
+    map.fail(keys.empty() ? "equipment" : keys[1], "must name exactly one generator: transfer_chute, screw_conveyor, bucket_elevator, belt_conveyor or silo");
+  EquipmentSpec e;
+  e.type = keys[0];
+  if (std::find(types.begin(), types.end(), e.type) == types.end()) {
+    const std::string near = nearest_word(e.type, types);
+    map.fail(e.type, fmt::format("'{}' is not an equipment generator{}; valid: transfer_chute, screw_conveyor, bucket_elevator, belt_conveyor, silo",
+                                 e.type, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+  }
+  e.location = map.where(e.type);
+  YAML::Node params = map.node(e.type);
+  if (!params || params.IsNull()) params = YAML::Node(YAML::NodeType::Map);
+  e.params = std::make_shared<const YAML::Node>(params);
+  e.file = file;
+  map.finish();
+  return e;
 }
 
 MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t index) {
@@ -419,7 +565,24 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   if (const YAML::Node render = map.node("render")) {
     MapReader r(render, file, "output.render");
     o.render_every = static_cast<int>(r.integer("every", 0, 0, 1000000));
-    o.render_camera = r.string("camera", o.render_camera, {"side", "front", "top", "iso"});
+    const YAML::Node camera = r.node("camera");
+    if (camera && camera.IsMap()) {
+      MapReader c(camera, file, "output.render.camera");
+      o.has_camera_pose = true;
+      o.camera_eye = c.vec3("eye", o.camera_eye);
+      o.camera_target = c.vec3("target", o.camera_target);
+      o.camera_up = c.vec3("up", o.camera_up);
+      o.camera_fov_deg = c.number("fov_deg", o.camera_fov_deg, 1.0, 170.0, "deg");
+      if ((o.camera_eye - o.camera_target).norm() < 1e-12) c.fail("eye", "must differ from target");
+      if ((o.camera_eye - o.camera_target).cross(o.camera_up).norm() < 1e-12) c.fail("up", "must not be parallel to the view direction");
+      c.finish();
+    } else if (camera) {
+      const std::vector<std::string> presets = {"side", "front", "top", "iso"};
+      o.render_camera = camera.IsScalar() ? camera.Scalar() : "";
+      if (std::find(presets.begin(), presets.end(), o.render_camera) == presets.end())
+        r.fail("camera", fmt::format("'{}' is not a camera; valid: side, front, top, iso, or {{eye: [x,y,z], target: [x,y,z], up: [x,y,z], fov_deg: 35}}",
+                                     o.render_camera));
+    }
     o.render_colour = r.string("colour_by", o.render_colour, {"speed", "radius", "material"});
     o.render_width = static_cast<int>(r.integer("width", o.render_width, 16, 8192));
     o.render_height = static_cast<int>(r.integer("height", o.render_height, 16, 8192));
@@ -440,7 +603,21 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   const YAML::Node materials = top.node("materials");
   if (!materials || !materials.IsMap() || materials.size() == 0)
     top.fail("materials", "missing: a map of material names to {density, youngs_modulus, ...}");
-  for (const auto& kv : materials) spec.materials.push_back(read_material(kv.first.as<std::string>(), kv.second, file));
+  YAML::Node library_contact;  // valid only when library_contact_file is set
+  std::string library_contact_file;
+  std::vector<std::pair<std::string, std::pair<std::string, YAML::Node>>> library_walls;  // material, (wall, params)
+  for (const auto& kv : materials) {
+    const std::string name = kv.first.as<std::string>();
+    if (kv.second.IsMap() && kv.second["library"]) {
+      MapReader entry(kv.second, file, "materials." + name);
+      LibraryMaterial lib = read_library_material(name, entry, file);
+      if (lib.contact && library_contact_file.empty()) library_contact = lib.contact, library_contact_file = lib.file;
+      for (auto& wall : lib.walls) library_walls.push_back({name, {wall.first, wall.second}});
+      spec.materials.push_back(std::move(lib.material));
+    } else {
+      spec.materials.push_back(read_material(name, kv.second, file));
+    }
+  }
 
   if (const YAML::Node list = top.node("interactions")) {
     if (!list.IsSequence()) top.fail("interactions", "must be a list of {materials: [A, B], KEY: VALUE}");
@@ -456,7 +633,26 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
       spec.interactions.push_back(std::move(in));
     }
   }
-  spec.contact = read_contact(top.node("contact"), file);
+  // The contact model: the case's, else the one the first library material was calibrated with.
+  if (top.has("contact") || library_contact_file.empty()) spec.contact = read_contact(top.node("contact"), file);
+  else spec.contact = read_contact(library_contact, library_contact_file);
+  // Pair parameters a library material gives against wall materials the case has, unless the
+  // case gives that pair itself.
+  for (const auto& [material, wall] : library_walls) {
+    const auto has = [&](const std::string& n) { return std::any_of(spec.materials.begin(), spec.materials.end(), [&](const MaterialSpec& m) { return m.name == n; }); };
+    if (!has(wall.first)) continue;
+    const bool given = std::any_of(spec.interactions.begin(), spec.interactions.end(), [&](const InteractionSpec& in) {
+      return (in.material_a == material && in.material_b == wall.first) || (in.material_b == material && in.material_a == wall.first);
+    });
+    if (given) continue;
+    const MaterialSpec& m = *std::find_if(spec.materials.begin(), spec.materials.end(), [&](const MaterialSpec& x) { return x.name == material; });
+    MapReader map(wall.second, m.library_file, "walls." + wall.first);
+    InteractionSpec in;
+    in.location = map.location();
+    in.material_a = material, in.material_b = wall.first;
+    read_effect_params(map, {}, in.params, in.where);
+    spec.interactions.push_back(std::move(in));
+  }
   if (const YAML::Node walls = top.node("walls")) {
     if (!walls.IsSequence()) top.fail("walls", "must be a list of walls");
     for (size_t k = 0; k < walls.size(); ++k) spec.planes.push_back(read_wall(walls[k], file, k));
@@ -483,6 +679,16 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     top.fail("particles", "missing: a list of particle sets {material, diameter, count + region | positions}, or inlets");
   if (particles)
     for (size_t k = 0; k < particles.size(); ++k) spec.particles.push_back(read_particles(particles[k], file, k));
+  if (const YAML::Node sensors = top.node("sensors")) {
+    if (!sensors.IsSequence()) top.fail("sensors", "must be a list of sensors ({name, plane: {...}, region} or {name, box: {...}})");
+    for (size_t k = 0; k < sensors.size(); ++k) spec.sensors.push_back(read_sensor(sensors[k], file, k));
+  }
+  if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
+  if (const YAML::Node wear = top.node("wear_coefficients")) {
+    MapReader w(wear, file, "wear_coefficients");
+    for (const std::string& key : w.keys()) spec.wear_coefficients[key] = w.number(key, 0.0, 0.0, 1e-6, "m^3/J");
+  }
+  top.node("sweep");  // read by the sweep runner (app/sweep.cpp) before the variants are parsed
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;
@@ -516,6 +722,16 @@ double SizeDistributionSpec::smallest() const {
     case Kind::discrete: return *std::min_element(values.begin(), values.end());
   }
   return value;
+}
+
+SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file) { return read_diameter(parent, file); }
+
+CaseSpec parse_case_node(const YAML::Node& root, const std::string& file) {
+  try {
+    return read_case(root, file);
+  } catch (const YAML::Exception& e) {
+    throw CaseError(fmt::format("{}:{}:{}: {}", file, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
 }
 
 CaseSpec parse_case_text(const std::string& text, const std::string& name) {

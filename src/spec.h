@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,11 @@
 
 #include "kinematics.h"
 #include "vec3.h"
+
+// Forward declaration: the equipment and sweep sections keep their YAML for the generators.
+namespace YAML {
+class Node;
+}
 
 namespace dem {
 
@@ -39,6 +45,11 @@ struct MaterialSpec {
   std::map<std::string, double> params;  ///< effect parameters given in the file, by key
   std::map<std::string, SourceLocation> where;  ///< location of each given key
   SourceLocation location;
+  // Provenance when the material comes from the library (materials/NAME.yaml):
+  std::string library_file;                     ///< "" when defined in the case
+  std::string description;
+  std::map<std::string, std::string> sources;   ///< key -> where its value comes from
+  std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max] for calibration
 };
 
 /// Parameters for one unlike pair that replace the mixing rule.
@@ -138,6 +149,9 @@ struct InletSpec {
   Vec3 velocity{0, 0, 0};         // [m/s]
   double start = 0, stop = 1e300; // [s]
   double interval = 0;            // [s] between insertions; 0: automatic
+  /// Name of an equipment port (e.g. "feed_belt") that supplies region and velocity; "" when the
+  /// inlet gives its own region.
+  std::string port;
   SourceLocation location;
 };
 
@@ -145,6 +159,32 @@ struct InletSpec {
 struct OutletSpec {
   std::string name;
   Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m]
+  bool spillage = false;  ///< collects spilled material (the report counts it as spillage, not product)
+  SourceLocation location;
+};
+
+/// Measures the flow without touching it. A plane sensor gives the mass flow through a plane
+/// (within a box), estimated from the particles in a thin slab: Q = sum(m v.n) / thickness. A box
+/// sensor gives the mass inside, its mean velocity and the offset of its centroid along `across`
+/// from the box centre (the centring of the load on a belt).
+struct SensorSpec {
+  enum class Kind { plane, box } kind = Kind::box;
+  std::string name;
+  Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m] box; for a plane, the part of it counted
+  Vec3 point{0, 0, 0};    // [m] plane: a point on it
+  Vec3 normal{1, 0, 0};   // plane: unit normal, flow along it counts positive
+  double thickness = 0;   // [m] plane: slab thickness; 0: twice the largest particle diameter
+  Vec3 across{0, 1, 0};   // box: unit lateral axis for the centring offset
+  SourceLocation location;
+};
+
+/// A parametric equipment generator named in the case (`equipment: {transfer_chute: {...}}`). The
+/// spec keeps its YAML; the equipment library (equipment/) expands it into meshes with their
+/// motions, ports for inlets, outlets and sensors before the case is compiled.
+struct EquipmentSpec {
+  std::string type;                          ///< transfer_chute, screw_conveyor, bucket_elevator, belt_conveyor
+  std::shared_ptr<const YAML::Node> params;  ///< the map under the type key
+  std::string file;                          ///< case file, for errors and relative paths
   SourceLocation location;
 };
 
@@ -186,7 +226,11 @@ struct OutputSpec {
   double records_from = 0;        ///< [s] wall records (pressure, wear inputs) accumulate from here on
   /// Images of the flow: every render_every-th particle frame (0: the last frame only).
   int render_every = 0;
-  std::string render_camera = "iso";     ///< side, front, top, iso
+  std::string render_camera;             ///< side, front, top, iso; "": the equipment's preset, else iso
+  /// An explicit camera (`camera: {eye, target, up, fov_deg}`) instead of a preset.
+  bool has_camera_pose = false;
+  Vec3 camera_eye{0, -1, 0}, camera_target{0, 0, 0}, camera_up{0, 0, 1};  // [m]
+  double camera_fov_deg = 35;                                               // [deg] vertical
   std::string render_colour = "speed";   ///< speed, radius, material
   int render_width = 1280, render_height = 720;  // [px]
 };
@@ -204,11 +248,28 @@ struct CaseSpec {
   std::vector<ParticleSetSpec> particles;
   std::vector<InletSpec> inlets;
   std::vector<OutletSpec> outlets;
+  std::vector<SensorSpec> sensors;
+  std::optional<EquipmentSpec> equipment;
+  /// Design values the report shows (written by the equipment generator): name -> value with
+  /// unit in the name, e.g. "receiving_belt_speed_m_s".
+  std::vector<std::pair<std::string, double>> design;
+  /// Render camera preset suggested by the equipment ("" when none).
+  std::string equipment_camera;
+  /// Archard specific wear rate k/H [m^3/J] of the liner of each named mesh (`wear_coefficients:
+  /// {hood: 2.0e-13, default: 1.0e-13}`; "default" applies to meshes not named).
+  std::map<std::string, double> wear_coefficients;
   OutputSpec output;
 };
 
 /// Reads and checks a case file. Throws CaseError naming file, line and key.
 CaseSpec parse_case_file(const std::string& path);
+/// Same for an already loaded YAML tree (sweep variants: the case with a parameter replaced);
+/// `file` names it in errors and resolves relative paths.
+CaseSpec parse_case_node(const YAML::Node& root, const std::string& file);
+
+/// Reads a size distribution from the map that holds `diameter:` (inlets, particle sets, feeds).
+class MapReader;
+SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file);
 /// Same for YAML text (tests keep their model inline); `name` stands in for the file name.
 CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>");
 

@@ -89,6 +89,7 @@ struct State {
   std::int64_t step = 0;
   std::int64_t next_id = 0;
   std::int64_t lost = 0;  ///< particles removed because they left the domain
+  double lost_mass = 0;   // [kg] of those particles (spillage)
 
   // Particles (n): hot columns. 18 doubles + 12 bytes = 156 bytes a particle.
   std::vector<double> x, y, z;     // [m] centre

@@ -1,9 +1,11 @@
-// Every shipped case reads, compiles and runs (shortened to a few hundred steps).
+// Every shipped case reads, expands its equipment, compiles and runs (shortened to a few hundred
+// steps; a sweep case runs its base values).
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <sstream>
 
+#include "equipment.h"
 #include "run.h"
 #include "triangle_mesh.h"
 #include "sim.h"
@@ -22,7 +24,8 @@ std::vector<std::string> shipped_cases() {
 class ShippedCase : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ShippedCase, RunsShortened) {
-  const CaseSpec spec = load_case(GetParam());
+  CaseSpec spec = load_case(GetParam());
+  equipment::expand_equipment(spec);
   // Mesh files through the geometry library, as the demdesign program reads them.
   const Model model = compile(spec, [](const MeshWallSpec& m) {
     geometry::ImportOptions options;

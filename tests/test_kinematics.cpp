@@ -220,6 +220,87 @@ TEST(Kinematics, MaxDisplacementBoundsSampledPointsTightlyForRotation) {
   EXPECT_LT(Motion{}.max_displacement(0, 1, radius), 1e-14);
 }
 
+MotionPart belt_loop(double offset, double speed = 1.5) {
+  MotionPart p;
+  p.kind = MotionPart::Kind::belt_loop, p.axis = Vector3d::UnitY(), p.lower = Vector3d(0.1, 0.2, -0.3);
+  p.upper = p.lower + Vector3d(0, 0, 3), p.radius = 0.3, p.speed = speed, p.offset = offset;
+  return p;
+}
+
+/// Arc length on the loop of belt_loop(): 3 m straights, 0.3 pi m arcs.
+constexpr double kStraight = 3.0, kArc = 0.3 * kPi, kLoop = 2 * kStraight + 2 * kArc;
+
+TEST(Kinematics, BeltLoopClosesAfterOnePeriodAndStartsWhereDocumented) {
+  const Motion m{{belt_loop(0.0)}};
+  EXPECT_NEAR(belt_loop_length(m.parts[0]), kLoop, 1e-12);
+  // Arc length 0: on the up straight (+s = e x axis = z x y = -x), local x outward, y up, z along axis.
+  const Pose start = m.pose(0);
+  EXPECT_LT((start.translation - Vector3d(0.1 - 0.3, 0.2, -0.3)).norm(), 1e-12);
+  EXPECT_LT((start.rotation * Vector3d::UnitX() - Vector3d(-1, 0, 0)).norm(), 1e-12);
+  EXPECT_LT((start.rotation * Vector3d::UnitY() - Vector3d(0, 0, 1)).norm(), 1e-12);
+  EXPECT_LT((start.rotation * Vector3d::UnitZ() - Vector3d(0, 1, 0)).norm(), 1e-12);
+  // Over the top (arc length 3 + 0.15 pi): at the upper pulley's top, moving +x, x outward = +z.
+  const Pose top = m.pose((kStraight + kArc / 2) / 1.5);
+  EXPECT_LT((top.translation - Vector3d(0.1, 0.2, 2.7 + 0.3)).norm(), 1e-12);
+  EXPECT_LT((top.rotation * Vector3d::UnitX() - Vector3d(0, 0, 1)).norm(), 1e-12);
+  EXPECT_LT((m.velocity((kStraight + kArc / 2) / 1.5).linear - Vector3d(1.5, 0, 0)).norm(), 1e-12);
+  // Closed: one loop length later every body point is back, for any offset and direction.
+  for (const double speed : {1.5, -0.7}) {
+    const Motion shifted{{belt_loop(0.37, speed)}};
+    const double period = kLoop / std::abs(speed);
+    for (double t : {0.0, 0.8, 2.3, 5.1}) {
+      const Pose a = shifted.pose(t), b = shifted.pose(t + period);
+      for (const Vector3d& local : {Vector3d(0, 0, 0), Vector3d(0.14, 0.1, -0.1)})
+        EXPECT_LT((apply(a, local) - apply(b, local)).norm(), 1e-9) << "t = " << t;
+    }
+  }
+}
+
+TEST(Kinematics, BeltLoopVelocityIsTheDerivativeOnStraightsAndArcs) {
+  const double speed = 1.5;  // [m/s]
+  const Motion m{{belt_loop(0.0, speed)}};
+  const double h = 1e-6;  // [s]
+  // Arc lengths inside each piece: up straight, upper arc, down straight, lower arc.
+  const struct { double arc_length; bool on_arc; } samples[] = {
+      {0.4, false}, {2.9, false}, {kStraight + 0.1, true}, {kStraight + 0.8, true},
+      {kStraight + kArc + 1.7, false}, {2 * kStraight + kArc + 0.2, true}, {kLoop - 0.05, true}};
+  for (const auto& sample : samples) {
+    const double t = sample.arc_length / speed;
+    SCOPED_TRACE(testing::Message() << "arc length " << sample.arc_length);
+    const Pose before = m.pose(t - h), now = m.pose(t), after = m.pose(t + h);
+    const RigidVelocity v = m.velocity(t);
+    EXPECT_LT((v.origin - now.translation).norm(), 1e-12);  // the reference point is on the path
+    EXPECT_NEAR(v.linear.norm(), speed, 1e-12);
+    EXPECT_NEAR(v.angular.norm(), sample.on_arc ? speed / 0.3 : 0.0, 1e-12);
+    if (sample.on_arc) {
+      EXPECT_NEAR(v.angular.dot(Vector3d::UnitY()), speed / 0.3, 1e-12);
+    }
+    for (const Vector3d& local : {Vector3d(0, 0, 0), Vector3d(0.14, 0.1, -0.1), Vector3d(-0.05, 0.2, 0.3)}) {
+      const Vector3d fd = (apply(after, local) - apply(before, local)) / (2 * h);
+      const Vector3d exact = v.at(apply(now, local));
+      EXPECT_LE((fd - exact).norm(), 1e-6 * std::max(1.0, exact.norm()));
+    }
+  }
+  // Composed with a later translation it stays exact (the generic twist composition).
+  expect_velocity_matches_pose(Motion{{belt_loop(0.2, 1.1), translation(Vector3d(0.1, 0, 0))}}, 4);
+}
+
+TEST(Kinematics, BeltLoopDisplacementBoundHoldsAndStaticWhenStopped) {
+  const Motion m{{belt_loop(0.0)}};
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> time(0.0, 6.0), span(0.0, 0.5), unit(-0.2, 0.2);
+  for (int trial = 0; trial < 40; ++trial) {
+    const double t0 = time(random), t1 = t0 + span(random);
+    const double bound = m.max_displacement(t0, t1, 0.35);
+    for (int k = 0; k < 200; ++k) {
+      const Vector3d x(unit(random), unit(random), unit(random));
+      EXPECT_GE(bound, (apply(m.pose(t1), x) - apply(m.pose(t0), x)).norm());
+    }
+  }
+  EXPECT_FALSE(m.is_static());
+  EXPECT_TRUE((Motion{{belt_loop(0.3, 0.0)}}.is_static()));
+}
+
 // ---------------------------------------------------------------------------------------------
 // YAML
 // ---------------------------------------------------------------------------------------------
@@ -285,6 +366,23 @@ meshes:
   EXPECT_TRUE(list.parts[3].speeds);
   EXPECT_EQ(list.parts[4].angular_speed, -2.0);
   EXPECT_TRUE(read("meshes:\n  drum:\n    motion:\n").is_static());
+}
+
+TEST_F(KinematicsYaml, ReadsABeltLoopAndChecksItsPulleys) {
+  const Motion m = read("meshes:\n  drum:\n    motion: {belt_loop: {axis: [0, 1, 0], lower: [0, 0, 0], upper: [0, 0, 3], "
+                        "radius: 0.3, speed: 1.5, offset: 0.0}}\n");
+  ASSERT_EQ(m.parts.size(), 1u);
+  EXPECT_EQ(m.parts[0].kind, MotionPart::Kind::belt_loop);
+  EXPECT_EQ(m.parts[0].upper, Vector3d(0, 0, 3));
+  EXPECT_EQ(m.parts[0].radius, 0.3);
+  EXPECT_EQ(m.parts[0].speed, 1.5);
+  const std::string skew = error("meshes:\n  drum:\n    motion:\n      belt_loop: {axis: [0, 1, 0], lower: [0, 0, 0], "
+                                 "upper: [0, 1, 3], radius: 0.3, speed: 1}\n");
+  EXPECT_NE(skew.find("meshes.drum.motion.belt_loop.upper"), std::string::npos) << skew;
+  EXPECT_NE(skew.find("perpendicular"), std::string::npos) << skew;
+  const std::string radius = error("meshes:\n  drum:\n    motion:\n      belt_loop: {axis: [0, 1, 0], lower: [0, 0, 0], "
+                                   "upper: [0, 0, 3], speed: 1}\n");
+  EXPECT_NE(radius.find("belt_loop.radius: missing"), std::string::npos) << radius;
 }
 
 TEST_F(KinematicsYaml, UnknownKeysNameLineAndSuggestion) {

@@ -1,0 +1,995 @@
+// Run and sweep reports: numbers at a detected steady state, plots by gnuplot, one
+// self-contained HTML file each.
+#include "report.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "plot.h"
+#include "run.h"
+#include "steady_state.h"
+
+namespace dem::report {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kSecondsPerYear = 8760.0 * 3600.0;  // 8760 h
+constexpr double kTonnesPerHourPerKgPerSecond = 3.6;
+
+// ---- text ---------------------------------------------------------------------------------
+
+/// HTML-escaped text. "://" is written with an entity so that no URL appears literally (the
+/// report must not reference anything outside itself, even in quoted case text).
+std::string esc(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else if (c == '\'') out += "&#39;";
+    else if (c == '/' && i > 0 && text[i - 1] == ':') out += "&#47;";
+    else out += c;
+  }
+  return out;
+}
+
+/// A number with `sig` significant figures, fixed notation between 1e-3 and 1e7.
+std::string num(double v, int sig = 4) {
+  if (std::isnan(v)) return "&ndash;";
+  if (std::isinf(v)) return v > 0 ? "&infin;" : "&minus;&infin;";
+  if (v == 0) return "0";
+  const double magnitude = std::abs(v);
+  if (magnitude < 1e-3 || magnitude >= 1e7) return fmt::format("{:.{}e}", v, sig - 1);
+  const int decimals = std::max(0, sig - 1 - static_cast<int>(std::floor(std::log10(magnitude))));
+  return fmt::format("{:.{}f}", v, decimals);
+}
+
+/// "mean ± std" with the same number of decimals.
+std::string pm(double mean, double spread, int sig = 4) { return num(mean, sig) + " &plusmn; " + num(spread, 2); }
+
+/// A metric name from free text: letters, digits and '_' only.
+std::string key(const std::string& text) {
+  std::string out;
+  for (char c : text) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8 | (unsigned char)bytes[i + 2];
+    out += table[v >> 18 & 63], out += table[v >> 12 & 63], out += table[v >> 6 & 63], out += table[v & 63];
+  }
+  if (i + 1 == bytes.size()) {
+    const unsigned v = (unsigned char)bytes[i] << 16;
+    out += table[v >> 18 & 63], out += table[v >> 12 & 63], out += "==";
+  } else if (i + 2 == bytes.size()) {
+    const unsigned v = (unsigned char)bytes[i] << 16 | (unsigned char)bytes[i + 1] << 8;
+    out += table[v >> 18 & 63], out += table[v >> 12 & 63], out += table[v >> 6 & 63], out += '=';
+  }
+  return out;
+}
+
+/// An <img> with the file embedded as a data URI, or a note saying why there is none.
+std::string embed_image(const std::string& path, const std::string& alt) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fmt::format("<p class=\"missing\">image not available: {}</p>", esc(path));
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const char* mime = ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : ext == ".svg" ? "image/svg+xml" : "image/png";
+  return fmt::format("<img alt=\"{}\" src=\"data:{};base64,{}\">", esc(alt), mime, base64(bytes.str()));
+}
+
+const char* kStyle = R"(
+body{font-family:"DejaVu Sans",Helvetica,Arial,sans-serif;font-size:14px;color:#222;max-width:1100px;margin:24px auto;padding:0 16px;line-height:1.45}
+h1{font-size:24px;margin-bottom:4px}h2{font-size:19px;border-bottom:2px solid #ccd;padding-bottom:3px;margin-top:32px}
+h3{font-size:15px;margin-bottom:6px}
+table{border-collapse:collapse;margin:8px 0 14px}th,td{border:1px solid #ccd;padding:3px 8px;text-align:left;vertical-align:top}
+th{background:#eef0f6}td.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+.meta{color:#555}.note{color:#555;font-size:13px}
+.banner{padding:10px 14px;margin:12px 0;border-radius:4px;font-weight:bold}
+.bad{background:#fbe3e1;border:1px solid #d9534f}.warn{background:#fff4d6;border:1px solid #e0a800}.good{background:#e3f4e1;border:1px solid #4c9a47}
+.missing{background:#f4f4f4;border:1px dashed #999;padding:10px;color:#555}
+img{max-width:100%;border:1px solid #ddd}figure{margin:10px 0 18px}figcaption{font-size:13px;color:#555}
+pre{background:#f6f7f9;border:1px solid #dde;padding:8px;overflow-x:auto;font-size:12px}
+.grid{display:flex;flex-wrap:wrap;gap:12px}.grid figure{flex:1 1 320px;max-width:48%}
+)";
+
+std::string html_head(const std::string& title) {
+  return fmt::format("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>{}</title>\n<style>{}</style>\n"
+                     "</head><body>\n",
+                     esc(title), kStyle);
+}
+
+std::string now_text() {
+  const std::time_t t = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&t, &local);
+  char buffer[64];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M %Z", &local);
+  return buffer;
+}
+
+// ---- series -------------------------------------------------------------------------------
+
+/// A time series of the run with its own steady-state detection and its average over the
+/// run's steady interval.
+struct Quantity {
+  std::string name;  ///< "outlet bin"
+  std::string unit;  ///< "t/h"
+  std::vector<double> y;
+  SteadyState own;
+  IntervalStats at_run;
+};
+
+template <typename F>
+std::vector<double> column(const std::vector<Scalars>& rows, F f) {
+  std::vector<double> out;
+  out.reserve(rows.size());
+  for (const Scalars& r : rows) out.push_back(f(r));
+  return out;
+}
+
+double at(const std::vector<double>& v, std::size_t k) { return k < v.size() ? v[k] : 0.0; }
+
+/// Design value whose name contains all of `parts`; NaN when none.
+std::pair<std::string, double> design_value(const std::vector<std::pair<std::string, double>>& design,
+                                            std::initializer_list<const char*> parts) {
+  for (const auto& [name, value] : design) {
+    bool all = true;
+    for (const char* p : parts) all = all && name.find(p) != std::string::npos;
+    if (all) return {name, value};
+  }
+  return {"", kNaN};
+}
+
+/// Belt speed [m/s] for a box sensor: the design value "<prefix>belt_speed_m_s" whose prefix
+/// appears in the sensor's name, else the only one, else the receiving belt's.
+std::pair<std::string, double> belt_speed_for(const std::vector<std::pair<std::string, double>>& design,
+                                              const std::string& sensor) {
+  std::vector<std::pair<std::string, double>> belts;
+  const std::string suffix = "belt_speed_m_s";
+  for (const auto& d : design)
+    if (d.first.size() >= suffix.size() && d.first.compare(d.first.size() - suffix.size(), suffix.size(), suffix) == 0)
+      belts.push_back(d);
+  for (const auto& b : belts) {
+    std::string prefix = b.first.substr(0, b.first.size() - suffix.size());
+    while (!prefix.empty() && prefix.back() == '_') prefix.pop_back();
+    if (!prefix.empty() && sensor.find(prefix) != std::string::npos) return b;
+  }
+  if (belts.size() == 1) return belts[0];
+  for (const auto& b : belts)
+    if (b.first.find("receiving") != std::string::npos) return b;
+  return {"", kNaN};
+}
+
+struct Hotspot {
+  std::size_t mesh = 0, triangle = 0;
+  Eigen::Vector3d centroid{0, 0, 0};
+  double area = 0, shear_rate = 0, impact_rate = 0, impacts_rate = 0, wear_mm_per_year = kNaN;
+};
+
+/// Cells that start with a number (or a dash for "none") are right-aligned.
+bool looks_numeric(const std::string& cell) {
+  if (cell.empty()) return false;
+  if (std::isdigit(static_cast<unsigned char>(cell[0])) || ((cell[0] == '-' || cell[0] == '+') && cell.size() > 1 && std::isdigit(static_cast<unsigned char>(cell[1]))))
+    return true;
+  return cell.rfind("&ndash;", 0) == 0 || cell.rfind("&minus;", 0) == 0 || cell.rfind("&infin;", 0) == 0;
+}
+
+std::string table_row(std::initializer_list<std::string> cells, bool header = false) {
+  std::string out = "<tr>";
+  bool first = true;
+  for (const std::string& c : cells) {
+    if (header) out += "<th>" + c + "</th>";
+    else out += (!first && looks_numeric(c) ? "<td class=\"n\">" : "<td>") + c + "</td>";
+    first = false;
+  }
+  return out + "</tr>\n";
+}
+
+/// Draws a plot into dir/plots and returns the HTML figure (or the reason there is none).
+std::string figure(const plot::Plot& p, const std::string& dir, const std::string& name, const std::string& caption) {
+  const std::string png = (fs::path(dir) / "plots" / (name + ".png")).string();
+  std::string message;
+  const bool ok = plot::draw_plot(p, png, &message);
+  std::string body = ok ? embed_image(png, p.title)
+                        : fmt::format("<p class=\"missing\">Plot &ldquo;{}&rdquo; not drawn: {}. Its data are in plots/{}.tsv.</p>",
+                                      esc(p.title), esc(message), esc(name));
+  return fmt::format("<figure>{}<figcaption>{}</figcaption></figure>\n", body, caption);
+}
+
+}  // namespace
+
+double RunMetrics::get(const std::string& name) const {
+  for (const auto& [n, v] : values)
+    if (n == name) return v;
+  return kNaN;
+}
+
+void write_metrics(const RunMetrics& metrics, const std::string& path) {
+  std::string text = "name,value\n";
+  text += fmt::format("steady,{}\n", metrics.steady ? 1 : 0);
+  std::string steady_text = metrics.steady_text;
+  std::replace(steady_text.begin(), steady_text.end(), '\n', ' ');
+  text += "# steady_text: " + steady_text + "\n";
+  for (const auto& [name, value] : metrics.values) text += fmt::format("{},{:.17g}\n", key(name), value);
+  write_file_atomically(path, text);
+}
+
+RunMetrics read_metrics(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the metrics file", path));
+  RunMetrics m;
+  std::string line;
+  const std::string text_tag = "# steady_text: ";
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.rfind(text_tag, 0) == 0) {
+      m.steady_text = line.substr(text_tag.size());
+      continue;
+    }
+    if (line.empty() || line[0] == '#' || line == "name,value") continue;
+    const std::size_t comma = line.find(',');
+    if (comma == std::string::npos) throw std::runtime_error(fmt::format("{}:{}: expected name,value", path, number));
+    const std::string name = line.substr(0, comma);
+    double value = kNaN;
+    try {
+      value = std::stod(line.substr(comma + 1));
+    } catch (const std::exception&) {
+      throw std::runtime_error(fmt::format("{}:{}: '{}' is not a number", path, number, line.substr(comma + 1)));
+    }
+    if (name == "steady")
+      m.steady = value != 0;
+    else
+      m.values.emplace_back(name, value);
+  }
+  return m;
+}
+
+RunMetrics write_run_report(const RunReportInput& in, const std::string& report_dir) {
+  if (!in.model || !in.state) throw std::invalid_argument("write_run_report: model and state are required");
+  const Model& model = *in.model;
+  const State& state = *in.state;
+  const std::vector<Scalars>& rows = in.scalars;
+  fs::create_directories(fs::path(report_dir) / "plots");
+  RunMetrics metrics;
+  auto metric = [&](const std::string& name, double value) { metrics.values.emplace_back(key(name), value); };
+
+  const std::vector<double> t = column(rows, [](const Scalars& r) { return r.time; });
+  const double t_end = t.empty() ? state.time : t.back();
+  const Scalars last = rows.empty() ? Scalars{} : rows.back();
+
+  // ---- outlets, intended or not ----------------------------------------------------------
+  std::vector<bool> intended(model.outlets.size(), true);
+  if (!in.outlet_intended.empty())
+    for (std::size_t k = 0; k < model.outlets.size(); ++k)
+      intended[k] = std::find(in.outlet_intended.begin(), in.outlet_intended.end(), model.outlets[k].name) !=
+                    in.outlet_intended.end();
+  std::vector<Quantity> outlets;
+  std::vector<double> intended_cumulative(rows.size(), 0.0);
+  for (std::size_t k = 0; k < model.outlets.size(); ++k) {
+    const std::vector<double> cumulative = column(rows, [k](const Scalars& r) { return at(r.outlet_mass, k); });
+    if (intended[k])
+      for (std::size_t i = 0; i < rows.size(); ++i) intended_cumulative[i] += cumulative[i];
+    Quantity q{"outlet " + model.outlets[k].name, "t/h", rate_of(t, cumulative), {}, {}};
+    for (double& v : q.y) v *= kTonnesPerHourPerKgPerSecond;
+    outlets.push_back(std::move(q));
+  }
+  std::vector<Quantity> plane_sensors, box_offsets;
+  std::vector<std::size_t> plane_index, box_index;
+  for (std::size_t k = 0; k < in.sensors.size(); ++k) {
+    if (in.sensors[k].kind == SensorSpec::Kind::plane) {
+      Quantity q{"sensor " + in.sensors[k].name, "t/h",
+                 column(rows, [k](const Scalars& r) { return k < r.sensors.size() ? r.sensors[k].flow * 3.6 : 0.0; }), {}, {}};
+      plane_sensors.push_back(std::move(q));
+      plane_index.push_back(k);
+    } else {
+      box_index.push_back(k);
+    }
+  }
+
+  // ---- the series that defines the run's steady state -------------------------------------
+  Quantity primary;
+  if (!model.outlets.empty()) {
+    primary = {"throughput (intended outlets)", "t/h", rate_of(t, intended_cumulative), {}, {}};
+    for (double& v : primary.y) v *= kTonnesPerHourPerKgPerSecond;
+  } else if (!plane_sensors.empty()) {
+    primary = {"flow through the plane sensors", "t/h", std::vector<double>(rows.size(), 0.0), {}, {}};
+    for (const Quantity& q : plane_sensors)
+      for (std::size_t i = 0; i < rows.size(); ++i) primary.y[i] += q.y[i];
+  } else {
+    primary = {"kinetic energy", "J", column(rows, [](const Scalars& r) { return r.kinetic_translation + r.kinetic_rotation; }), {}, {}};
+  }
+  primary.own = find_steady_state(t, primary.y);
+  const bool steady = primary.own.found;
+  // Not steady: averages over the last third are given for information, marked as such.
+  const double run_t0 = steady ? primary.own.t_start : (t.empty() ? 0.0 : t_end - (t_end - t.front()) / 3.0);
+  const double run_t1 = t_end;
+  const std::pair<double, double> band{run_t0, run_t1};
+  const std::string interval_text = fmt::format("{} s to {} s", num(run_t0, 3), num(run_t1, 3));
+  auto set_band = [&](plot::Plot& p) {
+    p.band = band;
+    p.band_label = steady ? "steady state" : "last third (not steady)";
+  };
+  metrics.steady = steady;
+  metrics.steady_text = steady ? fmt::format("steady from {} s to {} s ({})", num(run_t0, 3), num(run_t1, 3), primary.name)
+                               : fmt::format("no steady state ({}): {}", primary.name, primary.own.why);
+  auto finish = [&](Quantity& q) {
+    q.own = find_steady_state(t, q.y);
+    q.at_run = average_over(t, q.y, run_t0, run_t1);
+  };
+  finish(primary);
+  for (Quantity& q : outlets) finish(q);
+  for (Quantity& q : plane_sensors) finish(q);
+
+  // ---- mass balance, spillage, blockage ---------------------------------------------------
+  const std::vector<double> inserted = column(rows, [](const Scalars& r) { return r.inserted_mass; });
+  const std::vector<double> removed = column(rows, [](const Scalars& r) { return r.removed_mass; });
+  const std::vector<double> lost = column(rows, [](const Scalars& r) { return r.lost_mass; });
+  std::vector<double> holdup(rows.size()), out_cumulative(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    holdup[i] = inserted[i] - removed[i] - lost[i], out_cumulative[i] = removed[i] + lost[i];
+  const std::vector<double> outflow = rate_of(t, out_cumulative);
+  const Blockage blockage = detect_blockage(t, outflow, holdup);
+  double spill_outlets = 0;
+  for (std::size_t k = 0; k < model.outlets.size(); ++k)
+    if (!intended[k]) spill_outlets += at(last.outlet_mass, k);
+  const double spillage = last.lost_mass + spill_outlets;
+  const double spillage_pct = last.inserted_mass > 0 ? 100.0 * spillage / last.inserted_mass : 0.0;
+
+  // ---- design capacity ------------------------------------------------------------------
+  double capacity = kNaN;  // [t/h]
+  std::string capacity_label, capacity_source;
+  {
+    const auto th = design_value(in.design, {"capacity", "_t_h"});
+    const auto kgs = design_value(in.design, {"capacity", "_kg_s"});
+    if (!std::isnan(th.second)) capacity = th.second, capacity_label = "design capacity", capacity_source = th.first;
+    else if (!std::isnan(kgs.second)) capacity = kgs.second * 3.6, capacity_label = "design capacity", capacity_source = kgs.first;
+    else if (!model.inlets.empty()) {
+      capacity = 0;
+      for (const Inlet& inlet : model.inlets) capacity += inlet.spec.mass_rate * 3.6;
+      capacity_label = "feed rate of the inlets", capacity_source = "sum of the inlets' mass rates";
+    }
+  }
+
+  // ---- power and torque per mesh --------------------------------------------------------
+  std::vector<Quantity> power, torque;
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+    power.push_back({"power " + model.meshes[m].name, "W", column(rows, [m](const Scalars& r) { return at(r.mesh_power, m); }), {}, {}});
+    torque.push_back({"torque " + model.meshes[m].name, "N m", column(rows, [m](const Scalars& r) { return at(r.mesh_torque, m); }), {}, {}});
+    finish(power.back());
+    finish(torque.back());
+  }
+
+  // ---- wear per triangle ----------------------------------------------------------------
+  const double record_time = state.time - in.records_from;  // [s]
+  std::vector<Hotspot> spots;
+  struct MeshWear {
+    double shear_power = 0, impact_power = 0, area = 0, max_shear = 0, max_impact = 0, max_wear = kNaN, k = kNaN;
+  };
+  std::vector<MeshWear> mesh_wear(model.meshes.size());
+  if (record_time > 0) {
+    for (std::size_t m = 0; m < model.meshes.size() && m < state.records.size(); ++m) {
+      const MeshWall& mesh = model.meshes[m];
+      const TriangleSurface& surface = *mesh.surface;
+      const TriangleRecords& rec = state.records[m];
+      const Pose pose = mesh.motion.pose(0.0);
+      const auto k_it = in.wear_coefficient.find(mesh.name);
+      MeshWear& w = mesh_wear[m];
+      if (k_it != in.wear_coefficient.end()) w.k = k_it->second;
+      for (std::size_t tri = 0; tri < surface.size() && tri < rec.shear_work.size(); ++tri) {
+        const double area = surface.areas[tri];
+        if (area <= 0) continue;
+        Hotspot h;
+        h.mesh = m, h.triangle = tri, h.area = area;
+        Eigen::Vector3d c(0, 0, 0);
+        for (int v = 0; v < 3; ++v) {
+          const auto& p = surface.vertices[surface.triangles[tri][v]];
+          c += Eigen::Vector3d(p[0], p[1], p[2]) / 3.0;
+        }
+        h.centroid = pose.rotation * c + pose.translation;
+        h.shear_rate = rec.shear_work[tri] / (area * record_time);
+        h.impact_rate = at(rec.impact_energy, tri) / (area * record_time);
+        h.impacts_rate = at(rec.impacts, tri) / (area * record_time);
+        // Archard: wear depth rate = k_A q, k_A [m^3/J] = [m/Pa m], q [W/m^2] -> [m/s].
+        if (!std::isnan(w.k)) h.wear_mm_per_year = w.k * h.shear_rate * 1000.0 * kSecondsPerYear;
+        w.shear_power += rec.shear_work[tri] / record_time;
+        w.impact_power += at(rec.impact_energy, tri) / record_time;
+        w.area += area;
+        w.max_shear = std::max(w.max_shear, h.shear_rate);
+        w.max_impact = std::max(w.max_impact, h.impact_rate);
+        if (!std::isnan(h.wear_mm_per_year)) w.max_wear = std::isnan(w.max_wear) ? h.wear_mm_per_year : std::max(w.max_wear, h.wear_mm_per_year);
+        spots.push_back(h);
+      }
+    }
+  }
+  std::sort(spots.begin(), spots.end(), [](const Hotspot& a, const Hotspot& b) { return a.shear_rate > b.shear_rate; });
+  if (spots.size() > 10) spots.resize(10);
+
+  // ---- belt loading (box sensors) -------------------------------------------------------
+  Eigen::Vector3d up(-model.gravity[0], -model.gravity[1], -model.gravity[2]);
+  up = up.norm() > 0 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d(0, 0, 1);
+  struct BoxResult {
+    std::string name;
+    Quantity offset, mass;
+    double width = 0;               // [m] extent of the box along `across`
+    Eigen::Vector3d velocity{0, 0, 0};  // [m/s] mean over the run interval
+    double along = 0, lateral = 0, vertical = 0;  // [m/s]
+    std::string belt_name;
+    double belt_speed = kNaN;
+  };
+  std::vector<BoxResult> boxes;
+  for (std::size_t k : box_index) {
+    const SensorSpec& s = in.sensors[k];
+    BoxResult b;
+    b.name = s.name;
+    b.offset = {"offset " + s.name, "mm", column(rows, [k](const Scalars& r) { return k < r.sensors.size() ? 1000 * r.sensors[k].offset : 0.0; }), {}, {}};
+    b.mass = {"mass in " + s.name, "kg", column(rows, [k](const Scalars& r) { return k < r.sensors.size() ? r.sensors[k].mass : 0.0; }), {}, {}};
+    finish(b.offset);
+    finish(b.mass);
+    const Eigen::Vector3d across = s.across.norm() > 0 ? Eigen::Vector3d(s.across.normalized()) : Eigen::Vector3d(0, 1, 0);
+    const Eigen::Vector3d extent = s.region_max - s.region_min;
+    b.width = std::abs(extent.x() * across.x()) + std::abs(extent.y() * across.y()) + std::abs(extent.z() * across.z());
+    // Mean velocity of the material in the box, weighted by the rows where it held material.
+    double weight = 0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (t[i] < run_t0 || k >= rows[i].sensors.size()) continue;
+      const SensorReading& r = rows[i].sensors[k];
+      if (r.mass <= 0) continue;
+      b.velocity += r.mass * Eigen::Vector3d(r.vx, r.vy, r.vz);
+      weight += r.mass;
+    }
+    if (weight > 0) b.velocity /= weight;
+    b.vertical = b.velocity.dot(up);
+    b.lateral = b.velocity.dot(across);
+    b.along = (b.velocity - b.vertical * up - b.lateral * across).norm();
+    std::tie(b.belt_name, b.belt_speed) = belt_speed_for(in.design, s.name);
+    boxes.push_back(std::move(b));
+  }
+
+  // ---- other series ---------------------------------------------------------------------
+  Quantity kinetic{"kinetic energy", "J", column(rows, [](const Scalars& r) { return r.kinetic_translation + r.kinetic_rotation; }), {}, {}};
+  Quantity particles{"particles", "-", column(rows, [](const Scalars& r) { return double(r.particles); }), {}, {}};
+  Quantity holdup_q{"hold-up (inserted - removed - lost)", "kg", holdup, {}, {}};
+  Quantity contacts{"contacts", "-", column(rows, [](const Scalars& r) { return double(r.contacts); }), {}, {}};
+  finish(kinetic);
+  finish(particles);
+  finish(holdup_q);
+  finish(contacts);
+
+  // ---- metrics --------------------------------------------------------------------------
+  metric("steady_from_s", steady ? run_t0 : kNaN);
+  if (!model.outlets.empty()) {
+    metric("throughput_t_h", primary.at_run.mean);
+    metric("throughput_std_t_h", primary.at_run.std_dev);
+    for (const Quantity& q : outlets) metric(key(q.name) + "_t_h", q.at_run.mean);
+  }
+  for (const Quantity& q : plane_sensors) metric(key(q.name) + "_t_h", q.at_run.mean);
+  if (!std::isnan(capacity) && capacity > 0 && !model.outlets.empty()) metric("throughput_of_capacity_pct", 100 * primary.at_run.mean / capacity);
+  metric("spillage_kg", spillage);
+  metric("spillage_pct", spillage_pct);
+  metric("holdup_kg", holdup.empty() ? 0.0 : holdup.back());
+  metric("blockage", blockage.blocked ? 1.0 : 0.0);
+  double total_power = 0;
+  for (std::size_t m = 0; m < power.size(); ++m) {
+    metric("power_" + model.meshes[m].name + "_W", power[m].at_run.mean);
+    metric("torque_" + model.meshes[m].name + "_N_m", torque[m].at_run.mean);
+    total_power += power[m].at_run.mean;
+  }
+  if (!power.empty()) metric("power_total_W", total_power);
+  if (!model.meshes.empty() && record_time > 0) {
+    double max_shear = 0, max_impact = 0, max_wear = kNaN;
+    for (const MeshWear& w : mesh_wear) {
+      max_shear = std::max(max_shear, w.max_shear), max_impact = std::max(max_impact, w.max_impact);
+      if (!std::isnan(w.max_wear)) max_wear = std::isnan(max_wear) ? w.max_wear : std::max(max_wear, w.max_wear);
+    }
+    metric("shear_power_max_W_m2", max_shear);
+    metric("impact_power_max_W_m2", max_impact);
+    if (!std::isnan(max_wear)) metric("wear_rate_max_mm_yr", max_wear);
+  }
+  for (const BoxResult& b : boxes) {
+    metric("centring_offset_" + b.name + "_pct", b.width > 0 ? 100 * b.offset.at_run.mean / (1000 * b.width) : kNaN);
+    metric("vertical_speed_" + b.name + "_m_s", b.vertical);
+    if (!std::isnan(b.belt_speed) && b.belt_speed != 0) {
+      metric("speed_ratio_" + b.name, b.along / b.belt_speed);
+      // For ranking: how far the load's speed along the belt is from the belt's (0 is best).
+      metric("speed_mismatch_" + b.name + "_pct", 100 * std::abs(1 - b.along / b.belt_speed));
+    }
+  }
+  metric("kinetic_energy_J", kinetic.at_run.mean);
+
+  // ---- files: steady_state.csv, wear_hotspots.csv, metrics.csv --------------------------
+  std::vector<const Quantity*> all{&primary};
+  for (const auto* group : {&outlets, &plane_sensors, &power, &torque})
+    for (const Quantity& q : *group) all.push_back(&q);
+  for (const BoxResult& b : boxes) all.push_back(&b.offset), all.push_back(&b.mass);
+  for (const Quantity* q : {&holdup_q, &kinetic, &particles, &contacts}) all.push_back(q);
+  {
+    std::string csv = "series,unit,found,t_start_s,t_end_s,mean,std_dev,std_error,trend_per_s,why\n";
+    for (const Quantity* q : all) {
+      std::string why = q->own.why;
+      std::replace(why.begin(), why.end(), '"', '\'');
+      csv += fmt::format("\"{}\",{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},\"{}\"\n", q->name, q->unit, q->own.found ? 1 : 0,
+                         q->own.t_start, q->own.t_end, q->own.mean, q->own.std_dev, q->own.std_error, q->own.trend_per_s, why);
+    }
+    write_file_atomically((fs::path(report_dir) / "steady_state.csv").string(), csv);
+    std::string hot = "rank,mesh,triangle,x_m,y_m,z_m,area_m2,shear_power_W_m2,impact_power_W_m2,impacts_per_s_m2,wear_rate_mm_yr\n";
+    for (std::size_t r = 0; r < spots.size(); ++r) {
+      const Hotspot& h = spots[r];
+      hot += fmt::format("{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", r + 1, model.meshes[h.mesh].name, h.triangle,
+                         h.centroid.x(), h.centroid.y(), h.centroid.z(), h.area, h.shear_rate, h.impact_rate, h.impacts_rate, h.wear_mm_per_year);
+    }
+    write_file_atomically((fs::path(report_dir) / "wear_hotspots.csv").string(), hot);
+    write_metrics(metrics, (fs::path(report_dir) / "metrics.csv").string());
+  }
+
+  // ---- HTML -----------------------------------------------------------------------------
+  const std::string title = model.title.empty() ? fs::path(in.case_path).stem().string() : model.title;
+  std::string h = html_head(title + " - demdesign run report");
+  h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">Run report &middot; {} &middot; demdesign {} &middot; case <code>{}</code> &middot; "
+                   "simulated {} s in {} s wall time</p>\n",
+                   esc(title), esc(now_text()), esc(in.version), esc(in.case_path), num(t_end, 4), num(in.wall_seconds, 3));
+
+  // Banners.
+  if (!steady)
+    h += fmt::format("<div class=\"banner bad\">No steady state reached ({}): {}. The values below are averages over the last third "
+                     "of the run ({}) and are for information only.</div>\n",
+                     esc(primary.name), esc(primary.own.why), interval_text);
+  if (blockage.blocked) h += fmt::format("<div class=\"banner bad\">Blockage: {}.</div>\n", esc(blockage.text));
+  if (spillage > 0)
+    h += fmt::format("<div class=\"banner warn\">Spillage: {} kg ({} % of the inserted mass) left the domain or went to outlets that "
+                     "are not intended.</div>\n",
+                     num(spillage, 3), num(spillage_pct, 3));
+  if (model.mass_scaling != 1 || model.stiffness_scaling != 1)
+    h += fmt::format("<div class=\"banner warn\">Scaled model: particle density &times; {}, Young&#39;s modulus &times; {}. Forces, "
+                     "power and wear scale with these factors.</div>\n",
+                     num(model.mass_scaling, 3), num(model.stiffness_scaling, 3));
+  if (steady && !blockage.blocked && spillage <= 0)
+    h += fmt::format("<div class=\"banner good\">Steady state from {} ({} samples); no blockage, no spillage.</div>\n", interval_text,
+                     primary.own.samples);
+
+  // Summary.
+  h += "<h2>Summary</h2>\n";
+  h += fmt::format("<p><b>{}</b>.{} Values are means &plusmn; standard deviation of the signal over the {} interval <b>{}</b>; "
+                   "the standard error of the mean (batch means) is given where it matters.</p>\n<table>\n",
+                   esc(metrics.steady_text),
+                   model.outlets.empty() ? std::string()
+                                         : fmt::format(" Throughput {} t/h.", num(primary.at_run.mean, 4)),
+                   steady ? "steady-state" : "last-third", interval_text);
+  h += table_row({"quantity", "value", "unit", "note"}, true);
+  if (!model.outlets.empty()) {
+    h += table_row({"throughput (intended outlets)", pm(primary.at_run.mean, primary.at_run.std_dev), "t/h",
+                    fmt::format("std error of the mean {} t/h", num(primary.own.std_error, 2))});
+    if (!std::isnan(capacity))
+      h += table_row({esc(capacity_label), num(capacity), "t/h",
+                      esc(capacity_source) + (capacity > 0 ? fmt::format("; throughput = {} % of it", num(100 * primary.at_run.mean / capacity, 3)) : "")});
+  }
+  for (const Quantity& q : plane_sensors) h += table_row({esc(q.name) + " flow", pm(q.at_run.mean, q.at_run.std_dev), "t/h", ""});
+  h += table_row({"spillage", num(spillage, 3), "kg", fmt::format("{} % of the inserted {} kg", num(spillage_pct, 3), num(last.inserted_mass, 4))});
+  h += table_row({"hold-up at the end", num(holdup.empty() ? 0.0 : holdup.back()), "kg", "inserted &minus; removed &minus; lost"});
+  h += table_row({"blockage", blockage.blocked ? "<b>yes</b>" : "no", "", esc(blockage.text)});
+  for (std::size_t m = 0; m < power.size(); ++m)
+    h += table_row({"power of " + esc(model.meshes[m].name), pm(power[m].at_run.mean, power[m].at_run.std_dev), "W", ""});
+  for (const BoxResult& b : boxes)
+    h += table_row({"centring offset on " + esc(b.name), pm(b.offset.at_run.mean, b.offset.at_run.std_dev, 3), "mm",
+                    b.width > 0 ? fmt::format("{} % of the {} mm box width", num(100 * b.offset.at_run.mean / (1000 * b.width), 3), num(1000 * b.width, 4)) : ""});
+  if (!spots.empty())
+    h += table_row({"highest shear power per area (wear)", num(spots.front().shear_rate, 3), "W/m&sup2;",
+                    fmt::format("{} triangle {}", esc(model.meshes[spots.front().mesh].name), spots.front().triangle)});
+  h += "</table>\n";
+
+  // Throughput.
+  h += "<h2>Throughput</h2>\n";
+  if (model.outlets.empty() && plane_sensors.empty()) h += "<p>The case has no outlets and no plane sensors.</p>\n";
+  if (!model.outlets.empty()) {
+    h += "<p>Mass flow at each outlet: the rate of its cumulative mass, by differences over a window of ten rows (centred). The green "
+         "band marks the interval the averages are taken over.</p>\n<table>\n";
+    h += table_row({"outlet", "intended", "mean &plusmn; std dev [t/h]", "std error [t/h]", "own steady state", "total [kg]"}, true);
+    for (std::size_t k = 0; k < outlets.size(); ++k)
+      h += table_row({esc(model.outlets[k].name), intended[k] ? "yes" : "<b>no (spillage)</b>", pm(outlets[k].at_run.mean, outlets[k].at_run.std_dev),
+                      num(outlets[k].own.std_error, 2),
+                      outlets[k].own.found ? fmt::format("from {} s", num(outlets[k].own.t_start, 3)) : esc(outlets[k].own.why),
+                      num(at(last.outlet_mass, k))});
+    h += "</table>\n";
+    plot::Plot p;
+    p.title = "Mass flow at the outlets";
+    p.x_label = "time [s]";
+    p.y_label = "mass flow [t/h]";
+    if (outlets.size() > 1) p.series.push_back({"throughput (intended outlets)", t, primary.y});
+    for (const Quantity& q : outlets) p.series.push_back({q.name, t, q.y});
+    set_band(p);
+    p.lines.push_back({primary.at_run.mean, fmt::format("mean {:.4g} t/h", primary.at_run.mean)});
+    if (!std::isnan(capacity)) p.lines.push_back({capacity, fmt::format("{} {:.4g} t/h", capacity_label, capacity)});
+    h += figure(p, report_dir, "outlet_flow", fmt::format("Mass flow at the outlets; mean over {}: {} t/h.", interval_text,
+                                                           pm(primary.at_run.mean, primary.at_run.std_dev)));
+  }
+  if (!plane_sensors.empty()) {
+    h += "<h3>Plane sensors</h3>\n<table>\n";
+    h += table_row({"sensor", "mean &plusmn; std dev [t/h]", "std error [t/h]", "own steady state"}, true);
+    for (const Quantity& q : plane_sensors)
+      h += table_row({esc(q.name), pm(q.at_run.mean, q.at_run.std_dev), num(q.own.std_error, 2),
+                      q.own.found ? fmt::format("from {} s", num(q.own.t_start, 3)) : esc(q.own.why)});
+    h += "</table>\n";
+    plot::Plot p;
+    p.title = "Mass flow through the plane sensors";
+    p.x_label = "time [s]";
+    p.y_label = "mass flow [t/h]";
+    for (const Quantity& q : plane_sensors) p.series.push_back({q.name, t, q.y});
+    set_band(p);
+    if (!std::isnan(capacity)) p.lines.push_back({capacity, fmt::format("{} {:.4g} t/h", capacity_label, capacity)});
+    h += figure(p, report_dir, "sensor_flow", "Mass flow through the plane sensors (along each sensor's normal).");
+  }
+
+  // Spillage and blockage.
+  std::string intended_names;
+  for (std::size_t k = 0; k < model.outlets.size(); ++k)
+    if (intended[k]) intended_names += (intended_names.empty() ? "" : ", ") + esc(model.outlets[k].name);
+  if (intended_names.empty()) intended_names = "none";
+  h += "<h2>Mass balance, spillage and blockage</h2>\n";
+  h += fmt::format("<p>Spillage = mass that left the domain ({} kg) + mass into outlets that are not intended ({} kg) = <b>{} kg</b>, {} % "
+                   "of the {} kg inserted. Intended outlets: {}.</p>\n",
+                   num(last.lost_mass, 3), num(spill_outlets, 3), num(spillage, 3), num(spillage_pct, 3), num(last.inserted_mass, 4),
+                   intended_names);
+  h += fmt::format("<p>Blockage rule: {}. Result: {}.</p>\n", esc(kBlockageRule), esc(blockage.text));
+  {
+    plot::Plot p;
+    p.title = "Mass balance";
+    p.x_label = "time [s]";
+    p.y_label = "mass [kg]";
+    p.series = {{"inserted", t, inserted}, {"removed by outlets", t, removed}, {"lost (left the domain)", t, lost}, {"hold-up", t, holdup}};
+    h += figure(p, report_dir, "mass_balance", "Cumulative masses and the hold-up (inserted &minus; removed &minus; lost).");
+  }
+
+  // Power.
+  h += "<h2>Power and torque</h2>\n";
+  if (power.empty()) {
+    h += "<p>The case has no mesh walls.</p>\n";
+  } else {
+    h += "<p>Sign convention: power is the rate of work a mesh does on the material; <b>positive = the mesh drives the material</b> "
+         "(a rotating drum, a belt through its surface velocity), negative = the material does work on the mesh. Torque is about "
+         "the mesh&#39;s rotation axis (its magnitude |T| about the motion origin when the mesh does not rotate). A static mesh "
+         "without surface velocity does no work.</p>\n<table>\n";
+    h += table_row({"mesh", "power [W]", "torque [N m]", "own steady state (power)"}, true);
+    for (std::size_t m = 0; m < power.size(); ++m)
+      h += table_row({esc(model.meshes[m].name), pm(power[m].at_run.mean, power[m].at_run.std_dev), pm(torque[m].at_run.mean, torque[m].at_run.std_dev),
+                      power[m].own.found ? fmt::format("from {} s", num(power[m].own.t_start, 3)) : esc(power[m].own.why)});
+    h += "</table>\n";
+    plot::Plot p;
+    p.title = "Power of the meshes on the material";
+    p.x_label = "time [s]";
+    p.y_label = "power [W]";
+    for (std::size_t m = 0; m < power.size(); ++m) p.series.push_back({model.meshes[m].name, t, power[m].y});
+    set_band(p);
+    h += figure(p, report_dir, "mesh_power", "Power per mesh (positive: the mesh does work on the material).");
+    p.title = "Torque on the meshes";
+    p.y_label = "torque [N m]";
+    p.series.clear();
+    for (std::size_t m = 0; m < torque.size(); ++m) p.series.push_back({model.meshes[m].name, t, torque[m].y});
+    h += figure(p, report_dir, "mesh_torque", "Torque per mesh about its rotation axis.");
+  }
+
+  // Wear.
+  h += "<h2>Wear</h2>\n";
+  if (model.meshes.empty()) {
+    h += "<p>The case has no mesh walls.</p>\n";
+  } else if (record_time <= 0) {
+    h += fmt::format("<p>No wall records: recording starts at {} s, the run ended at {} s.</p>\n", num(in.records_from, 3), num(state.time, 4));
+  } else {
+    h += fmt::format(
+        "<p>From the per-triangle records over the recording interval {} s to {} s ({} s): shear power per area q = friction work / "
+        "(area &times; interval) [W/m&sup2;], the Archard wear input, and impact power per area = sum of &frac12; m* v<sub>n</sub>&sup2; "
+        "at contact starts / (area &times; interval) [W/m&sup2;]. Where a specific wear rate k<sub>A</sub> = k/H [m&sup3;/J] is given "
+        "for a mesh, the wear depth rate is h&#775; = k<sub>A</sub> q [m/s], shown in mm/year (8760 h of operation a year).</p>\n<table>\n",
+        num(in.records_from, 3), num(state.time, 4), num(record_time, 3));
+    h += table_row({"mesh", "area [m&sup2;]", "shear power [W]", "impact power [W]", "max shear power [W/m&sup2;]", "max impact power [W/m&sup2;]",
+                    "k<sub>A</sub> [m&sup3;/J]", "max wear rate [mm/yr]"},
+                   true);
+    for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+      const MeshWear& w = mesh_wear[m];
+      h += table_row({esc(model.meshes[m].name), num(w.area), num(w.shear_power, 3), num(w.impact_power, 3), num(w.max_shear, 3), num(w.max_impact, 3),
+                      num(w.k, 3), num(w.max_wear, 3)});
+    }
+    h += "</table>\n<h3>Hot spots: the 10 triangles with the highest shear power per area</h3>\n<table>\n";
+    h += table_row({"#", "mesh", "triangle", "centroid x, y, z [m] (pose at t = 0)", "shear power [W/m&sup2;]", "impact power [W/m&sup2;]",
+                    "impacts [1/(s m&sup2;)]", "wear rate [mm/yr]"},
+                   true);
+    for (std::size_t r = 0; r < spots.size(); ++r) {
+      const Hotspot& s = spots[r];
+      h += table_row({std::to_string(r + 1), esc(model.meshes[s.mesh].name), std::to_string(s.triangle),
+                      fmt::format("{}, {}, {}", num(s.centroid.x(), 4), num(s.centroid.y(), 4), num(s.centroid.z(), 4)), num(s.shear_rate, 3),
+                      num(s.impact_rate, 3), num(s.impacts_rate, 3), num(s.wear_mm_per_year, 3)});
+    }
+    h += "</table>\n<p class=\"note\">Also in wear_hotspots.csv.</p>\n";
+  }
+
+  // Belt loading.
+  if (!boxes.empty()) {
+    h += "<h2>Belt loading (box sensors)</h2>\n";
+    h += "<p>Centring offset: the centroid of the material in the box along the sensor&#39;s <code>across</code> axis, from the box centre "
+         "(0 = centred). Velocities are mass-weighted means over the interval; &ldquo;along&rdquo; is the speed perpendicular to "
+         "<code>across</code> and to the vertical, &ldquo;vertical&rdquo; is positive upwards (negative: the material moves down onto "
+         "the belt, the impact speed).</p>\n<table>\n";
+    h += table_row({"sensor", "offset [mm]", "offset [% of width]", "mass in box [kg]", "along [m/s]", "lateral [m/s]", "vertical [m/s]",
+                    "belt speed [m/s]", "along / belt"},
+                   true);
+    for (const BoxResult& b : boxes)
+      h += table_row({esc(b.name), pm(b.offset.at_run.mean, b.offset.at_run.std_dev, 3),
+                      b.width > 0 ? num(100 * b.offset.at_run.mean / (1000 * b.width), 3) : "&ndash;", pm(b.mass.at_run.mean, b.mass.at_run.std_dev, 3),
+                      num(b.along, 3), num(b.lateral, 3), num(b.vertical, 3),
+                      std::isnan(b.belt_speed) ? "&ndash;" : num(b.belt_speed, 3) + " (" + esc(b.belt_name) + ")",
+                      std::isnan(b.belt_speed) || b.belt_speed == 0 ? "&ndash;" : num(b.along / b.belt_speed, 3)});
+    h += "</table>\n";
+    plot::Plot p;
+    p.title = "Centring offset of the load";
+    p.x_label = "time [s]";
+    p.y_label = "offset along across [mm]";
+    for (const BoxResult& b : boxes) p.series.push_back({b.name, t, b.offset.y});
+    set_band(p);
+    p.lines.push_back({0.0, "centred"});
+    h += figure(p, report_dir, "centring_offset", "Offset of the load's centroid from the box centre along <code>across</code>.");
+  }
+
+  // Images.
+  if (!in.images.empty()) {
+    h += "<h2>Images</h2>\n";
+    for (const ImageRef& img : in.images)
+      h += fmt::format("<figure><h3>{}</h3>{}<figcaption>{}</figcaption></figure>\n", esc(img.title), embed_image(img.path, img.title), esc(img.caption));
+  }
+
+  // Time series.
+  h += "<h2>Time series</h2>\n";
+  {
+    plot::Plot p;
+    p.x_label = "time [s]";
+    p.title = "Particles in the domain";
+    p.y_label = "particles [-]";
+    p.series = {{"particles", t, particles.y}};
+    h += figure(p, report_dir, "particles", "Number of particles.");
+    p.title = "Kinetic energy";
+    p.y_label = "kinetic energy [J]";
+    p.series = {{"translation", t, column(rows, [](const Scalars& r) { return r.kinetic_translation; })},
+                {"rotation", t, column(rows, [](const Scalars& r) { return r.kinetic_rotation; })}};
+    set_band(p);
+    h += figure(p, report_dir, "kinetic_energy", "Kinetic energy of the particles.");
+    p.band.reset();
+    p.title = "Contacts";
+    p.y_label = "contacts [-]";
+    p.series = {{"contacts", t, contacts.y}};
+    h += figure(p, report_dir, "contacts", "Touching particle pairs and particle-wall contacts.");
+    p.title = "Overlap";
+    p.y_label = "overlap / smaller radius [-]";
+    p.series = {{"max", t, column(rows, [](const Scalars& r) { return r.max_overlap_ratio; })},
+                {"mean", t, column(rows, [](const Scalars& r) { return r.mean_overlap_ratio; })}};
+    h += figure(p, report_dir, "overlap", "Largest and mean overlap relative to the smaller radius (a check of the stiffness and time step).");
+  }
+
+  // Steady-state detection.
+  h += "<h2>Steady-state detection</h2>\n";
+  h += "<p>Each series&#39; steady part is found from the data: MSER-5 (White 1997; batch means of 5 samples) chooses the warm-up "
+       "truncation d minimising S&sup2;(d)/(n&minus;d)&sup2; over d &le; n/2; the rest must hold &ge; 10 samples and show no trend "
+       "that is both significant (|t| &gt; 3 for the least-squares slope on 10&ndash;30 batch means) and relevant (change over the "
+       "interval &gt; 2 % of max(|mean|, std dev)); if MSER&#39;s choice fails, the last half is tried. Standard error of the mean "
+       "from the same batch means. The run&#39;s interval comes from the " +
+       esc(primary.name) + ". Also in steady_state.csv.</p>\n<table>\n";
+  h += table_row({"series", "unit", "steady", "from [s]", "to [s]", "mean", "std dev", "std error", "trend [unit/s]"}, true);
+  for (const Quantity* q : all)
+    h += table_row({esc(q->name), esc(q->unit), q->own.found ? "yes" : esc(q->own.why), q->own.found ? num(q->own.t_start, 4) : "&ndash;",
+                    q->own.found ? num(q->own.t_end, 4) : "&ndash;", num(q->own.mean), num(q->own.std_dev, 3), num(q->own.std_error, 2),
+                    num(q->own.trend_per_s, 3)});
+  h += "</table>\n";
+
+  // Reproducibility.
+  h += "<h2>Reproducibility</h2>\n<table>\n";
+  h += table_row({"item", "value"}, true);
+  h += table_row({"software", "demdesign " + esc(in.version)});
+  h += table_row({"case file", "<code>" + esc(in.case_path) + "</code>"});
+  h += table_row({"model hash", fmt::format("<code>{:016x}</code>", model.hash)});
+  h += table_row({"mass scaling (particle density factor)", num(model.mass_scaling)});
+  h += table_row({"stiffness scaling (particle Young's modulus factor)", num(model.stiffness_scaling)});
+  h += table_row({"time step [s]", num(model.dt, 4)});
+  h += table_row({"Rayleigh time [s]", num(model.advice.rayleigh_time, 4)});
+  h += table_row({"time step / Rayleigh time (Rayleigh fraction)",
+                  model.advice.rayleigh_time > 0 ? num(model.dt / model.advice.rayleigh_time, 3) : "&ndash;"});
+  h += table_row({"contact time [s]", num(model.advice.contact_time, 4)});
+  h += table_row({"duration [s]", num(model.duration, 4)});
+  h += table_row({"seed", std::to_string(model.seed)});
+  h += table_row({"wall records from [s]", num(in.records_from, 4)});
+  h += table_row({"run wall time [s]", num(in.wall_seconds, 4)});
+  h += "</table>\n";
+  if (!model.advice.report.empty()) h += "<h3>Time-step advice</h3>\n<pre>" + esc(model.advice.report) + "</pre>\n";
+  h += "<h3>Materials</h3>\n<table>\n";
+  h += table_row({"material", "density [kg/m&sup3;]", "Young's modulus [Pa]", "Poisson ratio [-]"}, true);
+  for (const Material& m : model.materials)
+    h += table_row({esc(m.name), num(m.density), num(m.youngs_modulus), num(m.poisson_ratio, 3)});
+  h += "</table>\n<h3>Contact law and pair parameters</h3>\n<ul>\n";
+  for (const ActiveEffect& e : model.effects)
+    h += fmt::format("<li>{}: <b>{}</b> &ndash; {} ({})</li>\n", esc(std::string(kStageKeys[static_cast<int>(e.spec->stage)])),
+                     esc(std::string(e.spec->name)), esc(std::string(e.spec->summary)), esc(std::string(e.spec->citation)));
+  h += "</ul>\n<table>\n<tr><th>pair</th><th>E* [Pa]</th><th>G* [Pa]</th>";
+  for (const ActiveEffect& e : model.effects)
+    for (const ParamSpec& p : e.spec->params) h += fmt::format("<th>{} [{}]</th>", esc(std::string(p.key)), esc(std::string(p.unit)));
+  h += "</tr>\n";
+  for (int a = 0; a < model.n_materials(); ++a)
+    for (int b = a; b < model.n_materials(); ++b) {
+      const double* row = model.pair_row(model.pair_type(a, b));
+      h += fmt::format("<tr><td>{} &ndash; {}</td><td class=\"n\">{}</td><td class=\"n\">{}</td>", esc(model.materials[a].name),
+                       esc(model.materials[b].name), num(row[0]), num(row[1]));
+      for (const ActiveEffect& e : model.effects)
+        for (std::size_t k = 0; k < e.spec->params.size(); ++k) h += fmt::format("<td class=\"n\">{}</td>", num(row[e.param_offset + k]));
+      h += "</tr>\n";
+    }
+  h += "</table>\n";
+  if (!in.design.empty()) {
+    h += "<h3>Design values</h3>\n<table>\n" + table_row({"name (with unit)", "value"}, true);
+    for (const auto& [name, value] : in.design) h += table_row({esc(name), num(value, 5)});
+    h += "</table>\n";
+  }
+  if (!model.notes.empty()) {
+    h += "<h3>Model notes</h3>\n<ul>\n";
+    for (const std::string& note : model.notes) h += "<li>" + esc(note) + "</li>\n";
+    h += "</ul>\n";
+  }
+  h += "<h3>Case file as run</h3>\n<pre>" + esc(in.case_text) + "</pre>\n";
+  h += "<p class=\"note\">Files beside this report: metrics.csv, steady_state.csv, wear_hotspots.csv, plots/*.png with their data "
+       "(*.tsv) and gnuplot scripts (*.gp).</p>\n</body></html>\n";
+  write_file_atomically((fs::path(report_dir) / "report.html").string(), h);
+  return metrics;
+}
+
+// ---- sweep --------------------------------------------------------------------------------
+
+std::vector<Ranked> rank_variants(const SweepReportInput& input) {
+  const std::size_t n = input.variants.size(), nc = input.criteria.size();
+  std::vector<Ranked> ranked(n);
+  double weight_sum = 0;
+  for (const Criterion& c : input.criteria) weight_sum += std::max(c.weight, 0.0);
+  for (std::size_t v = 0; v < n; ++v) ranked[v].variant = v, ranked[v].criterion_scores.assign(nc, 0.0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Criterion& crit = input.criteria[c];
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const SweepVariant& var : input.variants) {
+      const double v = var.metrics.get(crit.metric);
+      if (var.ok && std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    for (std::size_t v = 0; v < n; ++v) {
+      const double x = input.variants[v].metrics.get(crit.metric);
+      if (!input.variants[v].ok || !std::isfinite(x)) continue;
+      double s = hi > lo ? (x - lo) / (hi - lo) : 1.0;
+      if (!crit.maximise) s = hi > lo ? 1.0 - s : 1.0;
+      ranked[v].criterion_scores[c] = s;
+    }
+  }
+  for (Ranked& r : ranked) {
+    if (!input.variants[r.variant].ok) {
+      r.score = kNaN;
+      continue;
+    }
+    double s = 0;
+    for (std::size_t c = 0; c < nc; ++c) s += std::max(input.criteria[c].weight, 0.0) * r.criterion_scores[c];
+    r.score = weight_sum > 0 ? s / weight_sum : 0.0;
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
+    const bool fa = std::isnan(a.score), fb = std::isnan(b.score);
+    if (fa != fb) return fb;
+    return !fa && a.score > b.score;
+  });
+  return ranked;
+}
+
+void write_sweep_report(const SweepReportInput& input, const std::string& dir) {
+  fs::create_directories(dir);
+  const std::vector<Ranked> ranked = rank_variants(input);
+
+  // Every metric any variant has, in first-seen order.
+  std::vector<std::string> names;
+  for (const SweepVariant& v : input.variants)
+    for (const auto& [name, value] : v.metrics.values)
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  std::vector<std::string> parameters;
+  for (const SweepVariant& v : input.variants)
+    for (const auto& [name, value] : v.parameters)
+      if (std::find(parameters.begin(), parameters.end(), name) == parameters.end()) parameters.push_back(name);
+  auto parameter = [](const SweepVariant& v, const std::string& name) {
+    for (const auto& [n, value] : v.parameters)
+      if (n == name) return value;
+    return std::string();
+  };
+
+  std::string csv = "rank,variant,status,steady,score";
+  for (const std::string& p : parameters) csv += "," + key(p);
+  for (const std::string& m : names) csv += "," + m;
+  csv += "\n";
+  for (std::size_t r = 0; r < ranked.size(); ++r) {
+    const SweepVariant& v = input.variants[ranked[r].variant];
+    csv += fmt::format("{},\"{}\",{},{},{:.6g}", r + 1, v.name, v.ok ? "ok" : "failed", v.metrics.steady ? 1 : 0, ranked[r].score);
+    for (const std::string& p : parameters) csv += ",\"" + parameter(v, p) + "\"";
+    for (const std::string& m : names) csv += fmt::format(",{:.9g}", v.metrics.get(m));
+    csv += "\n";
+  }
+  write_file_atomically((fs::path(dir) / "ranking.csv").string(), csv);
+
+  const std::string title = input.title.empty() ? "Design sweep" : input.title;
+  std::string h = html_head(title + " - demdesign sweep report");
+  h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">Sweep report &middot; {} &middot; demdesign {} &middot; case <code>{}</code> &middot; {} "
+                   "variants</p>\n",
+                   esc(title), esc(now_text()), esc(input.version), esc(input.case_path), input.variants.size());
+  std::size_t failed = 0, unsteady = 0;
+  for (const SweepVariant& v : input.variants) failed += !v.ok, unsteady += v.ok && !v.metrics.steady;
+  if (failed) h += fmt::format("<div class=\"banner bad\">{} variant(s) failed; they are ranked last.</div>\n", failed);
+  if (unsteady)
+    h += fmt::format("<div class=\"banner warn\">{} variant(s) reached no steady state; their values are last-third averages.</div>\n", unsteady);
+
+  h += "<h2>Ranking</h2>\n";
+  if (input.criteria.empty()) {
+    h += "<p>No criteria given: variants are listed in sweep order.</p>\n";
+  } else {
+    h += "<p>Rule: normalised weighted score. For each criterion, s = (value &minus; worst) / (best &minus; worst) over the variants that "
+         "ran (1 when all are equal, 0 when a variant lacks the value); score = &Sigma; w&middot;s / &Sigma; w, highest first. "
+         "Criteria:</p>\n<table>\n" +
+         table_row({"metric", "goal", "weight"}, true);
+    for (const Criterion& c : input.criteria) h += table_row({esc(c.metric), c.maximise ? "maximise" : "minimise", num(c.weight, 3)});
+    h += "</table>\n";
+  }
+  h += "<table>\n<tr><th>rank</th><th>variant</th><th>status</th><th>score</th>";
+  for (const std::string& p : parameters) h += "<th>" + esc(p) + "</th>";
+  for (const Criterion& c : input.criteria) h += "<th>" + esc(c.metric) + "</th>";
+  h += "</tr>\n";
+  for (std::size_t r = 0; r < ranked.size(); ++r) {
+    const SweepVariant& v = input.variants[ranked[r].variant];
+    std::string status = v.ok ? (v.metrics.steady ? "ok" : "ok, not steady") : "failed: " + esc(v.message);
+    h += fmt::format("<tr><td class=\"n\">{}</td><td>{}</td><td>{}</td><td class=\"n\">{}</td>", r + 1, esc(v.name), status,
+                     num(ranked[r].score, 3));
+    for (const std::string& p : parameters) h += "<td>" + esc(parameter(v, p)) + "</td>";
+    for (const Criterion& c : input.criteria) h += "<td class=\"n\">" + num(v.metrics.get(c.metric)) + "</td>";
+    h += "</tr>\n";
+  }
+  h += "</table>\n";
+
+  h += "<h2>All metrics</h2>\n<table>\n<tr><th>metric</th>";
+  for (const Ranked& r : ranked) h += "<th>" + esc(input.variants[r.variant].name) + "</th>";
+  h += "</tr>\n";
+  for (const std::string& m : names) {
+    h += "<tr><td>" + esc(m) + "</td>";
+    for (const Ranked& r : ranked) h += "<td class=\"n\">" + num(input.variants[r.variant].metrics.get(m)) + "</td>";
+    h += "</tr>\n";
+  }
+  h += "<tr><td>steady state</td>";
+  for (const Ranked& r : ranked) h += "<td>" + esc(input.variants[r.variant].metrics.steady_text) + "</td>";
+  h += "</tr>\n</table>\n";
+
+  h += "<h2>Images (same camera for every variant)</h2>\n<div class=\"grid\">\n";
+  for (std::size_t r = 0; r < ranked.size(); ++r) {
+    const SweepVariant& v = input.variants[ranked[r].variant];
+    const std::string image = v.image_path.empty() ? "<p class=\"missing\">no image</p>" : embed_image(v.image_path, v.name);
+    h += fmt::format("<figure>{}<figcaption>#{} {}{}</figcaption></figure>\n", image, r + 1, esc(v.name),
+                     v.report_path.empty() ? "" : " &middot; report: <code>" + esc(v.report_path) + "</code>");
+  }
+  h += "</div>\n<p class=\"note\">Also in ranking.csv.</p>\n</body></html>\n";
+  write_file_atomically((fs::path(dir) / "sweep.html").string(), h);
+}
+
+}  // namespace dem::report

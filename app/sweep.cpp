@@ -1,0 +1,297 @@
+#include "sweep.h"
+
+#include <fmt/format.h>
+#include <omp.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <regex>
+
+#include "report.h"
+#include "spec.h"
+#include "yaml_check.h"
+
+extern char** environ;
+
+namespace dem::app {
+
+namespace {
+
+/// One step of a key path: a map key, or a list index.
+struct PathStep {
+  std::string key;
+  long index = -1;
+};
+
+std::vector<PathStep> split_path(const std::string& path) {
+  std::vector<PathStep> steps;
+  static const std::regex part(R"(([A-Za-z_][A-Za-z0-9_]*)((\[[0-9]+\])*))");
+  size_t start = 0;
+  while (start <= path.size()) {
+    const size_t dot = path.find('.', start);
+    const std::string piece = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    std::smatch m;
+    if (!std::regex_match(piece, m, part)) return {};
+    steps.push_back({m[1].str(), -1});
+    std::string rest = m[2].str();
+    while (!rest.empty()) {
+      const size_t close = rest.find(']');
+      steps.push_back({"", std::stol(rest.substr(1, close - 1))});
+      rest = rest.substr(close + 1);
+    }
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  return steps;
+}
+
+std::string short_path(const std::string& path) {
+  // The last two parts are what a reader recognises: "spoon.radius".
+  const size_t last = path.rfind('.');
+  if (last == std::string::npos) return path;
+  const size_t before = path.rfind('.', last - 1);
+  return before == std::string::npos ? path : path.substr(before + 1);
+}
+
+std::string format_seconds(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  if (s >= 3600) return fmt::format("{}h{:02}m", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{}m{:02}s", s / 60, s % 60);
+  return fmt::format("{}s", s);
+}
+
+}  // namespace
+
+std::string SweepPlan::name(size_t k) const { return fmt::format("v{:02}", k + 1); }
+
+std::string SweepPlan::label(size_t k) const {
+  std::string out;
+  for (size_t p = 0; p < paths.size(); ++p) {
+    if (p) out += ", ";
+    out += fmt::format("{}={}", short_path(paths[p]), YAML::Dump(variants[k][p]));
+  }
+  return out;
+}
+
+SweepPlan read_sweep(const YAML::Node& root, const std::string& file) {
+  SweepPlan plan;
+  plan.file = file;
+  if (!root.IsMap() || !root["sweep"]) return plan;
+  MapReader map(root["sweep"], file, "sweep");
+  const YAML::Node parameters = map.node("parameters");
+  if (!parameters || !parameters.IsMap() || parameters.size() == 0)
+    map.fail("parameters", "missing: a map of key paths to value lists, e.g. {equipment.transfer_chute.spoon.radius: [0.6, 0.8]}");
+  MapReader params(parameters, file, "sweep.parameters");
+  std::vector<std::vector<YAML::Node>> values;
+  for (const std::string& path : params.keys()) {
+    if (split_path(path).empty()) params.fail(path, "is not a key path (names separated by dots, list items as [k])");
+    if (path.rfind("sweep", 0) == 0) params.fail(path, "a sweep cannot vary itself");
+    const YAML::Node list = params.node(path);
+    if (!list.IsSequence() || list.size() == 0) params.fail(path, "must be a non-empty list of values");
+    plan.paths.push_back(path);
+    values.emplace_back(list.begin(), list.end());
+  }
+  const std::string combine = map.string("combine", "grid", {"grid", "zip"});
+  if (combine == "zip") {
+    for (size_t p = 1; p < values.size(); ++p)
+      if (values[p].size() != values[0].size())
+        params.fail(plan.paths[p], fmt::format("has {} values but {} has {}; `combine: zip` needs lists of equal length",
+                                               values[p].size(), plan.paths[0], values[0].size()));
+    for (size_t k = 0; k < values[0].size(); ++k) {
+      std::vector<YAML::Node> row;
+      for (const auto& v : values) row.push_back(v[k]);
+      plan.variants.push_back(row);
+    }
+  } else {
+    plan.variants = {{}};
+    for (const auto& v : values) {
+      std::vector<std::vector<YAML::Node>> next;
+      for (const auto& row : plan.variants)
+        for (const auto& value : v) {
+          next.push_back(row);
+          next.back().push_back(value);
+        }
+      plan.variants = std::move(next);
+    }
+  }
+  if (plan.variants.size() > 1000) map.fail("parameters", fmt::format("makes {} variants; at most 1000", plan.variants.size()));
+  if (const YAML::Node rank = map.node("rank_by")) {
+    if (!rank.IsSequence()) map.fail("rank_by", "must be a list of {metric, goal: minimize|maximize, weight}");
+    for (size_t k = 0; k < rank.size(); ++k) {
+      MapReader c(rank[k], file, fmt::format("sweep.rank_by[{}]", k));
+      SweepCriterion criterion;
+      criterion.metric = c.required_string("metric", "a metric of the run report's metrics.csv");
+      criterion.minimize = c.string("goal", "minimize", {"minimize", "maximize"}) == "minimize";
+      criterion.weight = c.number("weight", 1.0, 0.0, 1e6);
+      c.finish();
+      plan.criteria.push_back(criterion);
+    }
+  }
+  plan.parallel = static_cast<int>(map.integer("parallel", 0, 0, 256));
+  map.finish();
+  return plan;
+}
+
+YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k) {
+  YAML::Node copy = YAML::Clone(root);
+  copy.remove("sweep");
+  for (size_t p = 0; p < plan.paths.size(); ++p) {
+    const std::vector<PathStep> steps = split_path(plan.paths[p]);
+    // yaml-cpp nodes are handles: walking with operator[] on a non-const node creates missing
+    // map entries, which is what lets a sweep set a parameter the case leaves at its default.
+    std::vector<YAML::Node> chain = {copy};
+    for (size_t s = 0; s < steps.size(); ++s) {
+      YAML::Node here = chain.back();
+      const bool last = s + 1 == steps.size();
+      if (steps[s].index >= 0) {
+        if (!here.IsSequence() || steps[s].index >= static_cast<long>(here.size()))
+          throw CaseError(fmt::format("{}: sweep.parameters: {}: there is no list item [{}] there", plan.file, plan.paths[p], steps[s].index));
+        if (last) here[steps[s].index] = plan.variants[k][p];
+        else chain.push_back(here[steps[s].index]);
+      } else {
+        if (!here.IsMap() && !here.IsNull())
+          throw CaseError(fmt::format("{}: sweep.parameters: {}: '{}' is inside a value that is not a map", plan.file, plan.paths[p], steps[s].key));
+        if (last) here[steps[s].key] = plan.variants[k][p];
+        else chain.push_back(here[steps[s].key]);
+      }
+    }
+  }
+  return copy;
+}
+
+int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
+  namespace fs = std::filesystem;
+  const size_t n = plan.variants.size();
+  const int cores = std::max(1, omp_get_num_procs());
+  const int threads = options.threads > 0 ? options.threads : (static_cast<int>(n) >= cores ? 1 : cores);
+  const int parallel = plan.parallel > 0 ? plan.parallel : std::max(1, cores / threads);
+  fs::create_directories(options.out + "/variants");
+  log << fmt::format("sweep: {} variants of {}, {} at a time with {} thread(s) each\n", n, options.case_path, parallel, threads);
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+
+  struct Running {
+    pid_t pid;
+    size_t variant;
+    std::chrono::steady_clock::time_point started;
+  };
+  std::vector<Running> running;
+  std::vector<int> status(n, -1);
+  const auto start = std::chrono::steady_clock::now();
+  size_t next = 0, done = 0;
+  double busy_seconds = 0;
+  while (done < n) {
+    while (next < n && static_cast<int>(running.size()) < parallel) {
+      const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(next));
+      fs::create_directories(dir);
+      std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(next), "--out", dir,
+                                       "--threads", std::to_string(threads), "--quiet"};
+      if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
+      if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      // The child's output goes to its log file; no shell is involved.
+      posix_spawn_file_actions_t files;
+      posix_spawn_file_actions_init(&files);
+      const std::string log_path = dir + "/log.txt";
+      posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+      pid_t pid = 0;
+      const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), environ);
+      posix_spawn_file_actions_destroy(&files);
+      if (err != 0) {
+        log << fmt::format("  {} could not be started: {}\n", plan.name(next), std::strerror(err));
+        status[next] = 127;
+        ++done;
+      } else {
+        log << fmt::format("  {} started: {}\n", plan.name(next), plan.label(next));
+        running.push_back({pid, next, std::chrono::steady_clock::now()});
+      }
+      ++next;
+    }
+    if (running.empty()) continue;
+    int wstatus = 0;
+    const pid_t pid = waitpid(-1, &wstatus, 0);
+    if (pid < 0) break;
+    const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
+    if (it == running.end()) continue;
+    const size_t v = it->variant;
+    status[v] = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->started).count();
+    busy_seconds += took;
+    running.erase(it);
+    ++done;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double left = busy_seconds / done * static_cast<double>(n - done) / parallel;
+    log << fmt::format("  {} {} in {} ({}/{} done, about {} left){}\n", plan.name(v), status[v] == 0 ? "finished" : "FAILED",
+                       format_seconds(took), done, n, format_seconds(left),
+                       status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", options.out, plan.name(v)));
+    (void)elapsed;
+  }
+  // The comparison: each variant's metrics (from its report) and its last flow image.
+  report::SweepReportInput input;
+  input.case_path = options.case_path, input.version = DEMDESIGN_VERSION;
+  input.title = fmt::format("Design sweep: {}", fs::path(options.case_path).filename().string());
+  for (const SweepCriterion& c : plan.criteria) input.criteria.push_back({c.metric, !c.minimize, c.weight});
+  for (size_t k = 0; k < n; ++k) {
+    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+    report::SweepVariant v;
+    v.name = plan.name(k);
+    for (size_t p = 0; p < plan.paths.size(); ++p) v.parameters.emplace_back(plan.paths[p], YAML::Dump(plan.variants[k][p]));
+    v.report_path = fmt::format("variants/{}/report/report.html", plan.name(k));
+    v.ok = status[k] == 0;
+    if (v.ok) {
+      try {
+        v.metrics = report::read_metrics(dir + "/report/metrics.csv");
+      } catch (const std::exception& e) {
+        v.ok = false, v.message = e.what();
+      }
+      std::string last;
+      if (fs::is_directory(dir + "/renders"))
+        for (const auto& entry : fs::directory_iterator(dir + "/renders"))
+          if (entry.path().extension() == ".png" && entry.path().filename().string().rfind("frame_", 0) == 0)
+            last = std::max(last, entry.path().string());
+      v.image_path = last;
+    } else {
+      // The last lines of the variant's log say why it failed.
+      std::ifstream in(dir + "/log.txt");
+      std::vector<std::string> lines;
+      for (std::string line; std::getline(in, line);) lines.push_back(line);
+      for (size_t l = lines.size() > 3 ? lines.size() - 3 : 0; l < lines.size(); ++l) v.message += lines[l] + " ";
+      if (v.message.empty()) v.message = fmt::format("exit status {}", status[k]);
+    }
+    input.variants.push_back(std::move(v));
+  }
+  // A criterion no variant reports is a typo in the case, not a tie: say so.
+  for (const SweepCriterion& c : plan.criteria) {
+    const bool known = std::any_of(input.variants.begin(), input.variants.end(), [&](const report::SweepVariant& v) {
+      return std::any_of(v.metrics.values.begin(), v.metrics.values.end(), [&](const auto& kv) { return kv.first == c.metric; });
+    });
+    if (known) continue;
+    std::string names;
+    for (const auto& v : input.variants)
+      if (v.ok) {
+        for (const auto& kv : v.metrics.values) names += (names.empty() ? "" : ", ") + kv.first;
+        break;
+      }
+    log << fmt::format("warning: sweep.rank_by metric '{}' is not in any variant's metrics.csv (it scores 0 everywhere); "
+                       "metrics: {}\n", c.metric, names);
+  }
+  report::write_sweep_report(input, options.out + "/report");
+  const auto ranked = report::rank_variants(input);
+  log << fmt::format("sweep report: {}/report/sweep.html\nranking:\n", options.out);
+  for (size_t r = 0; r < ranked.size(); ++r)
+    log << fmt::format("  {}. {} ({}) score {:.3f}\n", r + 1, input.variants[ranked[r].variant].name, plan.label(ranked[r].variant), ranked[r].score);
+  return std::all_of(status.begin(), status.end(), [](int s) { return s == 0; }) ? 0 : 1;
+}
+
+}  // namespace dem::app

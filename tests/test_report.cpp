@@ -1,0 +1,289 @@
+// Run and sweep reports: self-contained HTML, steady interval and mean, metrics round trip,
+// the report without gnuplot, sweep ranking.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "model.h"
+#include "report.h"
+#include "spec.h"
+
+namespace dem::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A flat two-triangle liner, an inlet of 2 kg/s and one outlet.
+const char* kCase = R"(title: report test chute
+simulation: {duration: 4.0}
+materials:
+  gravel: {density: 2600, youngs_modulus: 5e7, restitution: 0.4, friction: 0.5}
+  steel: {density: 7800, youngs_modulus: 2e11, restitution: 0.4, friction: 0.4}
+contact: {normal: hertz, damping: restitution, tangential: mindlin}
+meshes:
+  - name: chute_liner
+    material: steel
+    vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    triangles: [[0, 1, 2], [0, 2, 3]]
+inlets:
+  - {name: feed, material: gravel, diameter: 0.01, mass_rate_kgs: 2.0, region: {min: [0, 0, 0.5], max: [0.5, 0.5, 0.8]}}
+outlets:
+  - {name: bin, region: {min: [-1, -1, -2], max: [2, 2, -0.5]}}
+)";
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool gnuplot_installed() {
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "");
+  std::string dir;
+  while (std::getline(dirs, dir, ':'))
+    if (!dir.empty() && fs::exists(fs::path(dir) / "gnuplot")) return true;
+  return false;
+}
+
+/// Every <img> embeds its picture as a data URI; nothing refers outside the file.
+void expect_self_contained(const std::string& html) {
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_EQ(html.find("src=\"file"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  for (std::size_t at = html.find("<img"); at != std::string::npos; at = html.find("<img", at + 1)) {
+    const std::size_t src = html.find("src=\"", at);
+    ASSERT_NE(src, std::string::npos);
+    EXPECT_EQ(html.compare(src, 16, "src=\"data:image/"), 0) << html.substr(at, 80);
+  }
+}
+
+struct Fixture {
+  fs::path dir;
+  Model model;
+  State state;
+  report::RunReportInput input;
+
+  explicit Fixture(const std::string& name) : dir(fs::temp_directory_path() / name), model(compile(parse_case_text(kCase, "report.yaml"))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    // Final state: the liner's records, accumulated from t = 1 s to 4 s.
+    state.time = 4.0;
+    TriangleRecords records;
+    records.normal_impulse = {1, 2};
+    records.shear_impulse = {1, 2};
+    records.shear_work = {30, 120};   // [J] -> 20 and 80 W/m^2 over 3 s on 0.5 m^2
+    records.impacts = {5, 6};
+    records.impact_energy = {1.5, 3};
+    state.records.push_back(records);
+
+    // Rows: outflow rises to 2 kg/s (7.2 t/h) with time constant 0.3 s, noisy; the drive
+    // power rises to 50 W.
+    std::mt19937_64 random(42);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    double out = 0;
+    for (int i = 0; i <= 400; ++i) {
+      Scalars r;
+      r.time = 0.01 * i;
+      r.step = i * 100;
+      const double q = 2.0 * (1 - std::exp(-r.time / 0.3));
+      if (i > 0) out += std::max(0.0, q + 0.2 * gauss(random)) * 0.01;
+      r.inserted_mass = 2.0 * r.time + 0.5;
+      r.removed_mass = out;
+      r.outlet_mass = {out};
+      r.particles = static_cast<std::size_t>(100 * (r.inserted_mass - out));
+      r.kinetic_translation = 3 + 0.1 * gauss(random);
+      r.kinetic_rotation = 0.3;
+      r.contacts = 200;
+      r.max_overlap_ratio = 0.01;
+      r.mean_overlap_ratio = 0.002;
+      r.mesh_force = {100};
+      r.mesh_power = {50 * (1 - std::exp(-r.time / 0.3)) + 2 * gauss(random)};
+      r.mesh_torque = {10 + gauss(random)};
+      SensorReading plane;
+      plane.flow = q + 0.2 * gauss(random);
+      SensorReading box;
+      box.mass = 5, box.vx = 2.0, box.vy = 0.05, box.vz = -1.5, box.offset = 0.01 + 0.002 * gauss(random);
+      r.sensors = {plane, box};
+      input.scalars.push_back(r);
+    }
+    SensorSpec plane;
+    plane.kind = SensorSpec::Kind::plane;
+    plane.name = "chute_exit";
+    SensorSpec box;
+    box.kind = SensorSpec::Kind::box;
+    box.name = "receiving_belt_load";
+    box.region_min = Vec3(0, -0.5, 0), box.region_max = Vec3(1, 0.5, 0.2);  // 1 m wide along y
+    input.sensors = {plane, box};
+    input.design = {{"design_capacity_t_h", 7.2}, {"receiving_belt_speed_m_s", 2.5}, {"feed_belt_speed_m_s", 1.5}};
+    input.model = &model;
+    input.state = &state;
+    input.case_path = "cases/report.yaml";
+    input.case_text = std::string(kCase) + "# see https://example.org <b>not bold</b>\n";
+    input.version = "test";
+    input.wall_seconds = 12.5;
+    input.records_from = 1.0;
+    input.wear_coefficient = {{"chute_liner", 1e-13}};
+    // A caller's image (any bytes: the report embeds, it does not decode).
+    const fs::path image = dir / "flow.png";
+    std::ofstream(image, std::ios::binary) << "\x89PNG\r\n\x1a\nnot really a picture";
+    input.images = {{"Flow at the end", image.string(), "particles coloured by speed"}};
+  }
+};
+
+TEST(RunReport, SelfContainedWithSteadyIntervalMeanAndFiles) {
+  Fixture f("demdesign_report_test");
+  const fs::path out = f.dir / "report";
+  const report::RunMetrics metrics = report::write_run_report(f.input, out.string());
+
+  ASSERT_TRUE(fs::exists(out / "report.html"));
+  const std::string html = read(out / "report.html");
+  expect_self_contained(html);
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos) << "the caller's image is embedded";
+  EXPECT_NE(html.find("&lt;b&gt;not bold&lt;/b&gt;"), std::string::npos) << "case text is escaped";
+
+  // The steady state is detected after the transient, and the mean is the plateau.
+  ASSERT_TRUE(metrics.steady) << metrics.steady_text;
+  const double from = metrics.get("steady_from_s");
+  EXPECT_GT(from, 0.5);
+  EXPECT_LT(from, 2.0);
+  const double throughput = metrics.get("throughput_t_h");
+  EXPECT_NEAR(throughput, 7.2, 0.3);
+  EXPECT_NE(html.find(metrics.steady_text), std::string::npos) << metrics.steady_text;
+  ASSERT_GE(throughput, 1.0);
+  ASSERT_LT(throughput, 10.0);
+  EXPECT_NE(html.find(fmt::format("Throughput {:.3f} t/h", throughput)), std::string::npos);
+  EXPECT_NEAR(metrics.get("throughput_of_capacity_pct"), 100, 5);
+  EXPECT_DOUBLE_EQ(metrics.get("spillage_kg"), 0.0);
+  EXPECT_DOUBLE_EQ(metrics.get("blockage"), 0.0);
+  EXPECT_NEAR(metrics.get("power_chute_liner_W"), 50, 2);
+  // Wear: 120 J over 3 s on 0.5 m^2 = 80 W/m^2; Archard 1e-13 m^3/J -> 8e-12 m/s = 0.252 mm/yr.
+  EXPECT_NEAR(metrics.get("shear_power_max_W_m2"), 80, 1e-9);
+  EXPECT_NEAR(metrics.get("wear_rate_max_mm_yr"), 80e-13 * 1000 * 8760 * 3600, 1e-9);
+  // Belt loading: 10 mm offset on a 1 m box = 1 %; along speed 2.0 / 2.5 (the receiving belt).
+  EXPECT_NEAR(metrics.get("centring_offset_receiving_belt_load_pct"), 1.0, 0.05);
+  EXPECT_NEAR(metrics.get("speed_ratio_receiving_belt_load"), 0.8, 1e-9);
+  EXPECT_NEAR(metrics.get("vertical_speed_receiving_belt_load_m_s"), -1.5, 1e-9);
+  for (const char* section : {"Throughput", "Power and torque", "Wear", "Belt loading", "Reproducibility", "mass scaling"})
+    EXPECT_NE(html.find(section), std::string::npos) << section;
+
+  // Files beside the report.
+  for (const char* file : {"steady_state.csv", "wear_hotspots.csv", "metrics.csv"}) EXPECT_TRUE(fs::exists(out / file)) << file;
+  const std::string hot = read(out / "wear_hotspots.csv");
+  EXPECT_NE(hot.find("\n1,chute_liner,1,"), std::string::npos) << hot;
+  EXPECT_NE(read(out / "steady_state.csv").find("throughput (intended outlets)"), std::string::npos);
+  if (gnuplot_installed()) {
+    EXPECT_TRUE(fs::exists(out / "plots" / "outlet_flow.png"));
+    EXPECT_TRUE(fs::exists(out / "plots" / "outlet_flow.gp"));
+    EXPECT_TRUE(fs::exists(out / "plots" / "outlet_flow.tsv"));
+    EXPECT_EQ(html.find("gnuplot not found"), std::string::npos);
+  }
+
+  // metrics.csv round trip.
+  const report::RunMetrics back = report::read_metrics((out / "metrics.csv").string());
+  EXPECT_EQ(back.steady, metrics.steady);
+  EXPECT_EQ(back.steady_text, metrics.steady_text);
+  ASSERT_EQ(back.values.size(), metrics.values.size());
+  for (std::size_t k = 0; k < back.values.size(); ++k) {
+    EXPECT_EQ(back.values[k].first, metrics.values[k].first);
+    if (std::isnan(metrics.values[k].second))
+      EXPECT_TRUE(std::isnan(back.values[k].second)) << back.values[k].first;
+    else
+      EXPECT_EQ(back.values[k].second, metrics.values[k].second) << back.values[k].first;
+  }
+}
+
+TEST(RunReport, WritesWithoutGnuplotAndSaysSo) {
+  Fixture f("demdesign_report_nognuplot_test");
+  const fs::path empty = f.dir / "empty_path";
+  fs::create_directories(empty);
+  const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", empty.c_str(), 1);
+  const report::RunMetrics metrics = report::write_run_report(f.input, (f.dir / "report").string());
+  setenv("PATH", saved.c_str(), 1);
+  const std::string html = read(f.dir / "report" / "report.html");
+  EXPECT_NE(html.find("gnuplot not found: install gnuplot-nox for the plots"), std::string::npos);
+  expect_self_contained(html);
+  EXPECT_TRUE(metrics.steady);
+  EXPECT_TRUE(fs::exists(f.dir / "report" / "plots" / "outlet_flow.gp")) << "the script is kept to draw it later";
+}
+
+TEST(RunReport, SpillageAndNoSteadyStateAreFlagged) {
+  Fixture f("demdesign_report_spill_test");
+  // The outflow keeps rising (a ramp), and 1 kg leaves the domain.
+  double out = 0;
+  for (Scalars& r : f.input.scalars) {
+    out = 0.05 * r.time * r.time;
+    r.outlet_mass = {out}, r.removed_mass = out, r.lost_mass = r.time > 2 ? 1.0 : 0.0;
+  }
+  const report::RunMetrics metrics = report::write_run_report(f.input, (f.dir / "report").string());
+  EXPECT_FALSE(metrics.steady);
+  EXPECT_NE(metrics.steady_text.find("still rising"), std::string::npos) << metrics.steady_text;
+  EXPECT_DOUBLE_EQ(metrics.get("spillage_kg"), 1.0);
+  const std::string html = read(f.dir / "report" / "report.html");
+  EXPECT_NE(html.find("No steady state reached"), std::string::npos);
+  EXPECT_NE(html.find("Spillage: 1"), std::string::npos);
+}
+
+TEST(SweepReport, RanksByNormalisedWeightedScore) {
+  const fs::path dir = fs::temp_directory_path() / "demdesign_sweep_report_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path image = dir / "a.png";
+  std::ofstream(image, std::ios::binary) << "\x89PNG\r\n\x1a\nbytes";
+
+  report::SweepReportInput input;
+  input.title = "chute angle sweep";
+  input.version = "test";
+  auto variant = [&](const std::string& name, double throughput, double power) {
+    report::SweepVariant v;
+    v.name = name;
+    v.parameters = {{"chute.angle_deg", name.substr(1)}};
+    v.metrics.values = {{"throughput_t_h", throughput}, {"power_total_W", power}};
+    v.metrics.steady = true;
+    v.image_path = image.string();
+    return v;
+  };
+  // Throughput (maximise, weight 2) and power (minimise, weight 1):
+  //   A: (2 * 1/3 + 1 * 0.75) / 3 = 0.472, B: (2 * 1 + 0) / 3 = 0.667, C: (0 + 1) / 3 = 0.333.
+  input.variants = {variant("a50", 100, 50), variant("b55", 120, 80), variant("c60", 90, 40)};
+  report::SweepVariant failed = variant("d65", 500, 1);
+  failed.ok = false;
+  failed.message = "numerical error at t = 0.3 s";
+  input.variants.push_back(failed);
+  input.criteria = {{"throughput_t_h", true, 2.0}, {"power_total_W", false, 1.0}};
+
+  const std::vector<report::Ranked> ranked = report::rank_variants(input);
+  ASSERT_EQ(ranked.size(), 4u);
+  EXPECT_EQ(ranked[0].variant, 1u);
+  EXPECT_EQ(ranked[1].variant, 0u);
+  EXPECT_EQ(ranked[2].variant, 2u);
+  EXPECT_EQ(ranked[3].variant, 3u) << "failed variants come last";
+  EXPECT_NEAR(ranked[0].score, 2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(ranked[1].score, (2.0 / 3.0 + 0.75) / 3.0, 1e-12);
+  EXPECT_NEAR(ranked[2].score, 1.0 / 3.0, 1e-12);
+  EXPECT_TRUE(std::isnan(ranked[3].score));
+
+  report::write_sweep_report(input, dir.string());
+  const std::string html = read(dir / "sweep.html");
+  expect_self_contained(html);
+  EXPECT_LT(html.find("b55"), html.find("a50"));
+  EXPECT_LT(html.find("a50"), html.find("c60"));
+  EXPECT_NE(html.find("numerical error at t = 0.3 s"), std::string::npos);
+  const std::string csv = read(dir / "ranking.csv");
+  EXPECT_NE(csv.find("1,\"b55\",ok"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("4,\"d65\",failed"), std::string::npos) << csv;
+}
+
+}  // namespace
+}  // namespace dem::test
