@@ -134,22 +134,23 @@ void render_wall_field(const Model& model, const State& s, const std::vector<std
     }
   }
   if (!std::isfinite(lo.x())) return;
+  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
+  if (!all.empty()) {
+    std::sort(all.begin(), all.end());
+    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
+  }
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     render::MeshLayer layer;
     layer.vertices = placed[m];
     layer.triangles = model.meshes[m].surface->triangles;
     layer.triangle_value = values[m];
+    // Walls that carry little of the field (side plates, skirts) are drawn faint and cut away
+    // where they face the camera, so they do not hide the hot spots behind them.
+    float highest = 0;
+    for (float v : values[m])
+      if (std::isfinite(v)) highest = std::max(highest, v);
+    if (highest < 0.35 * colours.max) layer.opacity = 0.25f, layer.cutaway = true;
     frame.meshes.push_back(layer);
-  }
-  // Particles faint, for orientation.
-  render::ParticleLayer particles;
-  particles.x = s.x, particles.y = s.y, particles.z = s.z, particles.radius = s.radius;
-  particles.colour = {0.55f, 0.55f, 0.55f};
-  frame.particles.push_back(particles);
-  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
-  if (!all.empty()) {
-    std::sort(all.begin(), all.end());
-    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
   }
   frame.mesh_colours = colours;
   frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);

@@ -20,8 +20,9 @@ struct ImageOptions {
 void render_state(const Model& model, const State& state, const ImageOptions& options, const std::string& path);
 
 /// Renders the meshes coloured by a per-triangle field (one vector per mesh, NaN: not coloured)
-/// with a colour bar titled `label`, particles faint; the colour scale ends at the field's 99th
-/// percentile so one hot triangle does not wash out the rest.
+/// with a colour bar titled `label` and no particles (they would hide the liners); the colour
+/// scale ends at the field's 99th percentile so one hot triangle does not wash out the rest, and
+/// walls that carry little of the field are drawn faint.
 void render_wall_field(const Model& model, const State& state, const std::vector<std::vector<double>>& field,
                        const std::string& label, const ImageOptions& options, const std::string& path);
 

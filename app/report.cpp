@@ -325,6 +325,27 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
     primary = {"kinetic energy", "J", column(rows, [](const Scalars& r) { return r.kinetic_translation + r.kinetic_rotation; }), {}, {}};
   }
   primary.own = find_steady_state(t, primary.y);
+  // ---- mass balance ---------------------------------------------------------------------------
+  const std::vector<double> inserted = column(rows, [](const Scalars& r) { return r.inserted_mass; });
+  const std::vector<double> removed = column(rows, [](const Scalars& r) { return r.removed_mass; });
+  const std::vector<double> lost = column(rows, [](const Scalars& r) { return r.lost_mass; });
+  std::vector<double> holdup(rows.size()), out_cumulative(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    holdup[i] = inserted[i] - removed[i] - lost[i], out_cumulative[i] = removed[i] + lost[i];
+  // A steady outflow is not a steady state while the plant is still filling (or emptying): the
+  // hold-up must not change by more than 5 % of the mass that passed over the interval.
+  if (primary.own.found && !model.outlets.empty() && primary.own.first + 2 < t.size()) {
+    const Trend fill = trend_of(t, holdup, primary.own.first, t.size());
+    const double duration = t_end - primary.own.t_start;
+    const double change = fill.slope * duration, passed = primary.own.mean / kTonnesPerHourPerKgPerSecond * duration;
+    if (std::abs(fill.t_stat) > 3 && std::abs(change) > 0.05 * std::max(passed, 1e-12)) {
+      primary.own.found = false;
+      primary.own.why = fmt::format("still {}: the hold-up {} by {} kg from {} s to {} s, {} % of the {} kg that left; run longer",
+                                    change > 0 ? "filling" : "emptying", change > 0 ? "rose" : "fell", num(std::abs(change)),
+                                    num(primary.own.t_start, 3), num(t_end, 3), num(100 * std::abs(change) / std::max(passed, 1e-12)),
+                                    num(passed));
+    }
+  }
   const bool steady = primary.own.found;
   // Not steady: averages over the last third are given for information, marked as such.
   const double run_t0 = steady ? primary.own.t_start : (t.empty() ? 0.0 : t_end - (t_end - t.front()) / 3.0);
@@ -346,13 +367,7 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
   for (Quantity& q : outlets) finish(q);
   for (Quantity& q : plane_sensors) finish(q);
 
-  // ---- mass balance, spillage, blockage ---------------------------------------------------
-  const std::vector<double> inserted = column(rows, [](const Scalars& r) { return r.inserted_mass; });
-  const std::vector<double> removed = column(rows, [](const Scalars& r) { return r.removed_mass; });
-  const std::vector<double> lost = column(rows, [](const Scalars& r) { return r.lost_mass; });
-  std::vector<double> holdup(rows.size()), out_cumulative(rows.size());
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    holdup[i] = inserted[i] - removed[i] - lost[i], out_cumulative[i] = removed[i] + lost[i];
+  // ---- spillage, blockage ---------------------------------------------------------------------
   const std::vector<double> outflow = rate_of(t, out_cumulative);
   const Blockage blockage = detect_blockage(t, outflow, holdup);
   double spill_outlets = 0;

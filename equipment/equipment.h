@@ -58,7 +58,8 @@ struct TransferChuteLayout {
   double hood_exit_x = 0, hood_exit_z = 0;
   double spoon_radius = 0, spoon_lip_height = 0, spoon_setback = 0;
   double spoon_centre_x = 0, spoon_centre_z = 0;
-  double spoon_start_angle = 0;    ///< [rad] from the lip (0) towards the back (pi/2); pi/2: full quarter
+  double spoon_start_angle = 0;    ///< [rad] from the bottom of the arc (0) towards the back (pi/2); pi/2: full quarter
+  double spoon_exit_angle = 0;     ///< [rad] where the arc ends, before its bottom: the lip's slope below horizontal
   double spoon_top_x = 0, spoon_top_z = 0, spoon_lip_x = 0;
   double back_plate_top = 0;       ///< the back plate spans x = spoon_top_x, z in [spoon_top_z, back_plate_top]
   double side_x_min = 0, side_x_max = 0, side_z_min = 0, side_z_max = 0;

@@ -17,8 +17,8 @@
 //    cut shorter when its end would be lower than 0.15 spoon.radius + 0.05 above the spoon lip
 //    (the spoon keeps at least a 32 deg arc); an error when that leaves less than 5 deg of hood
 //    below the impact point.
-//  - Spoon: arc of spoon.radius [0.8] from vertical (at its back, -x) to horizontal at its lip
-//    spoon.lip_height [0.15] above the receiving belt. Its top edge lies spoon.setback [0.15]
+//  - Spoon: arc of spoon.radius [0.8] from vertical (at its back, -x) to spoon.exit_angle_deg [15]
+//    before horizontal at its lip, spoon.lip_height [0.15] above the receiving belt. Its top edge lies spoon.setback [0.15]
 //    behind (-x of) the hood exit and at most 0.05 below it: when the full quarter would reach
 //    higher, the arc starts lower (its vertical-tangent point is then virtual, above the top
 //    edge). A vertical back plate rises from the spoon top edge to 0.1 above the hood exit.
@@ -78,6 +78,9 @@ TransferChuteLayout read_layout(MapReader& reader) {
   c.spoon_radius = spoon.number("radius", 0.8, 0.2, 5.0, "m");
   c.spoon_lip_height = spoon.number("lip_height", 0.15, 0.02, 2.0, "m");
   c.spoon_setback = spoon.number("setback", 0.15, 0.0, 1.0, "m");
+  // The arc ends this far before its lowest point, so the stream leaves the lip sloping down onto
+  // the belt instead of having to be pushed out of a flat bottom (a dead bed forms there).
+  c.spoon_exit_angle = radians(spoon.number("exit_angle_deg", 15.0, 0.0, 45.0, "deg"));
   spoon.finish();
 
   MapReader receiving = sub_map(reader, "receiving_belt");
@@ -108,12 +111,16 @@ TransferChuteLayout read_layout(MapReader& reader) {
   c.hood_exit_z = c.hood_centre_z + c.hood_radius * std::sin(c.hood_end_angle);
 
   // Spoon: top edge `setback` behind the hood exit and at least 0.05 below it.
-  c.spoon_top_z = std::min(c.spoon_lip_height + c.spoon_radius, c.hood_exit_z - 0.05);
-  c.spoon_start_angle = std::acos(std::clamp((c.spoon_lip_height + c.spoon_radius - c.spoon_top_z) / c.spoon_radius, -1.0, 1.0));
+  c.spoon_centre_z = c.spoon_lip_height + c.spoon_radius * std::cos(c.spoon_exit_angle);
+  c.spoon_top_z = std::min(c.spoon_centre_z, c.hood_exit_z - 0.05);
+  c.spoon_start_angle = std::acos(std::clamp((c.spoon_centre_z - c.spoon_top_z) / c.spoon_radius, -1.0, 1.0));
+  if (c.spoon_start_angle < c.spoon_exit_angle + radians(20.0))
+    spoon.fail("exit_angle_deg", fmt::format("leaves a spoon arc of {:.0f} deg under the hood; valid: a smaller exit angle, a "
+                                             "smaller spoon radius or a larger drop height",
+                                             (c.spoon_start_angle - c.spoon_exit_angle) * 180 / kPi));
   c.spoon_top_x = c.hood_exit_x - c.spoon_setback;
   c.spoon_centre_x = c.spoon_top_x + c.spoon_radius * std::sin(c.spoon_start_angle);
-  c.spoon_centre_z = c.spoon_lip_height + c.spoon_radius;
-  c.spoon_lip_x = c.spoon_centre_x;
+  c.spoon_lip_x = c.spoon_centre_x - c.spoon_radius * std::sin(c.spoon_exit_angle);
   c.back_plate_top = c.hood_exit_z + 0.1;
 
   // Side plates: from behind the pulley to past the hood and the lip, from the belt to the roof.
@@ -209,7 +216,7 @@ Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
   {
     MeshBuilder spoon;
     spoon.grid([&](double u, double w) {
-      const double angle = c.spoon_start_angle * (1 - u);  // from the lip: 0
+      const double angle = c.spoon_start_angle * (1 - u) + c.spoon_exit_angle * u;  // back to lip
       return Vec3(c.spoon_centre_x - c.spoon_radius * std::sin(angle), half - w * c.chute_width,
                   c.spoon_centre_z - c.spoon_radius * std::cos(angle));
     }, segments(c.spoon_start_angle * c.spoon_radius, kChuteCell, 6), segments(c.chute_width, kChuteCell));

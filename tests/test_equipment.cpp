@@ -190,10 +190,13 @@ TEST(TransferChute, LayoutHoldsOverARangeOfDropHeightsAndRadii) {
           EXPECT_LT(c.receiving_x_min, c.side_x_min);
           EXPECT_LE(c.spoon_lip_x, c.side_x_max);
         }
-  // With defaults the spoon is a full quarter when it fits under the hood exit, else cut.
+  // The spoon is a full quarter when it fits under the hood exit, else cut; its lip lies
+  // exit_angle_deg before the bottom of the arc.
   const TransferChuteLayout small = transfer_chute_layout(make("transfer_chute", "spoon: {radius: 0.25}\n"));
   EXPECT_NEAR(small.spoon_start_angle, kPi / 2, 1e-12);
-  EXPECT_NEAR(small.spoon_top_x, small.spoon_lip_x - 0.25, 1e-12);
+  EXPECT_NEAR(small.spoon_top_x, small.spoon_centre_x - 0.25, 1e-12);
+  EXPECT_NEAR(small.spoon_lip_x, small.spoon_centre_x - 0.25 * std::sin(15 * kPi / 180), 1e-12);
+  EXPECT_NEAR(small.spoon_centre_z - 0.25 * std::cos(15 * kPi / 180), small.spoon_lip_height, 1e-12);
   // A hood that cannot fit is an error naming the drop height.
   const std::string message = error_of("transfer_chute", "drop_height: 0.4\nhood: {radius: 2}\n");
   EXPECT_NE(message.find("equipment.transfer_chute.drop_height"), std::string::npos) << message;
