@@ -1,8 +1,12 @@
 // Run and sweep reports: self-contained HTML, steady interval and mean, metrics round trip,
-// the report without gnuplot, sweep ranking.
+// the report without gnuplot, a plant still filling, the report in headless Chromium, sweep ranking.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -14,6 +18,8 @@
 #include "model.h"
 #include "report.h"
 #include "spec.h"
+
+extern "C" char** environ;
 
 namespace dem::test {
 namespace {
@@ -233,6 +239,70 @@ TEST(RunReport, SpillageAndNoSteadyStateAreFlagged) {
   const std::string html = read(f.dir / "report" / "report.html");
   EXPECT_NE(html.find("No steady state reached"), std::string::npos);
   EXPECT_NE(html.find("Spillage: 1"), std::string::npos);
+}
+
+TEST(RunReport, PlantStillFillingIsNotSteadyEvenWithASteadyOutflow) {
+  Fixture f("demdesign_report_filling_test");
+  // 2.5 kg/s in, 2 kg/s out: the outflow settles, the hold-up grows by 0.5 kg/s.
+  for (Scalars& r : f.input.scalars) r.inserted_mass = 2.5 * r.time + 0.5;
+  const report::RunMetrics metrics = report::write_run_report(f.input, (f.dir / "report").string());
+  EXPECT_FALSE(metrics.steady);
+  EXPECT_NE(metrics.steady_text.find("still filling"), std::string::npos) << metrics.steady_text;
+}
+
+/// Runs `argv` without a shell, its standard output and error into `output`; returns the exit
+/// status (127 when it cannot be started).
+int run_program(std::vector<std::string> argv, const fs::path& output) {
+  std::vector<char*> args;
+  for (auto& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, output.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int error = posix_spawnp(&pid, args[0], &files, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (error != 0) return 127;
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// The report opens in a real browser (Debian's chromium, headless): a probe page loads it in a
+// frame and counts the images that decoded; the browser's console must show no errors.
+TEST(RunReport, OpensInHeadlessChromiumWithEveryImageShown) {
+  Fixture f("demdesign_report_browser_test");
+  f.input.images.clear();  // the fixture's image is not a real PNG; the plots are
+  const fs::path out = f.dir / "report";
+  report::write_run_report(f.input, out.string());
+  std::ofstream(f.dir / "probe.html") << R"(<!DOCTYPE html><html><body><pre id="result">pending</pre>
+<iframe id="report" src="report/report.html" width="1200" height="800"></iframe>
+<script>
+document.getElementById('report').addEventListener('load', () => {
+  const doc = document.getElementById('report').contentDocument;
+  const images = [...doc.images];
+  const shown = images.filter(i => i.complete && i.naturalWidth > 0).length;
+  document.getElementById('result').textContent = 'images ' + shown + '/' + images.length + ' title ' + doc.title;
+});
+</script></body></html>)";
+  const fs::path log = f.dir / "chromium.txt";
+  const int status = run_program({"chromium", "--headless", "--no-sandbox", "--disable-gpu", "--allow-file-access-from-files",
+                                  "--enable-logging=stderr", "--v=0", "--virtual-time-budget=10000", "--dump-dom",
+                                  "file://" + (f.dir / "probe.html").string()},
+                                 log);
+  ASSERT_NE(status, 127) << "chromium is not installed (Debian package chromium; .ci/install-deps installs it)";
+  const std::string text = read(log);
+  ASSERT_EQ(status, 0) << text;
+  const std::size_t at = text.find("images ");
+  ASSERT_NE(at, std::string::npos) << text;
+  int shown = 0, total = 0;
+  ASSERT_EQ(std::sscanf(text.c_str() + at, "images %d/%d", &shown, &total), 2) << text.substr(at, 80);
+  EXPECT_GE(total, gnuplot_installed() ? 5 : 0);
+  EXPECT_EQ(shown, total) << "every image must decode";
+  EXPECT_NE(text.find("title report test chute"), std::string::npos) << text.substr(at, 200);
+  EXPECT_EQ(text.find("Uncaught"), std::string::npos) << text;
+  EXPECT_EQ(text.find(":ERROR:CONSOLE"), std::string::npos) << text;
 }
 
 TEST(SweepReport, RanksByNormalisedWeightedScore) {
