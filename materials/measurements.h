@@ -1,0 +1,43 @@
+// Measurement files (the format of the calibration protocol): what was measured directly (size,
+// density, wall materials) and the experiments with their set-ups and observations. Read with
+// errors that name file, line and key and say what is valid.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "spec.h"
+#include "virtual_tests.h"
+
+namespace dem::materials {
+
+/// One observation with its one-sigma repeatability.
+struct Observation {
+  double value = 0;
+  double sigma = 0;
+  SourceLocation location;
+};
+
+struct Experiment {
+  std::string id;
+  TestSetup setup;                               ///< setup.test names the test
+  std::map<std::string, Observation> observed;   ///< observable name -> value
+  std::string outcome;                           ///< "" or an observed outcome: blocked, no_heap
+  SourceLocation location;
+};
+
+struct MeasurementSet {
+  std::string file;
+  std::string material;           ///< free text
+  SizeDistributionSpec diameter;  ///< measured particle size
+  double density = 0;             // [kg/m^3] solid density
+  std::vector<MaterialSpec> walls;
+  std::vector<Experiment> experiments;
+};
+
+/// Reads a measurement file; throws CaseError naming file, line and key.
+MeasurementSet read_measurements(const std::string& path);
+MeasurementSet parse_measurements(const std::string& text, const std::string& name);
+
+}  // namespace dem::materials

@@ -1,0 +1,74 @@
+// Virtual laboratory tests: the calibration experiments of the measurement file format, each
+// simulated with exactly its set-up and observed with exactly its extraction rule (see
+// docs in README, section "Calibration"). A test takes the material model being calibrated and
+// the set-up of one experiment, builds a case (CaseSpec) in code, runs it with the engine and
+// returns the observables.
+//
+//   dem::materials::MaterialModel model = dem::materials::read_material_model("materials/gravel.yaml");
+//   dem::materials::TestSetup setup{"rotating_drum", {{"drum_diameter", 0.2}, {"rpm", 20}, ...}, {...}};
+//   dem::materials::SimulatedOutcome out = dem::materials::run_virtual_test(model, setup, {});
+//   out.observables["dynamic_angle_deg"]
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "model.h"
+#include "spec.h"
+#include "state.h"
+
+namespace dem::materials {
+
+/// The material being calibrated: one particle material with its contact model and its size
+/// (and optionally shape), plus the wall materials the tests use and the particle-wall pairs.
+struct MaterialModel {
+  std::string name;                 ///< e.g. "gravel"
+  MaterialSpec particle;            ///< density, E, nu, effect parameters (restitution, friction, ...)
+  ContactSpec contact;              ///< the effects switched on
+  SizeDistributionSpec diameter;    ///< particle size
+  std::vector<ClumpTemplateSpec> shape;  ///< empty: spheres; one template: clumps of it
+  std::vector<MaterialSpec> walls;       ///< wall materials by name (steel, ...)
+  std::vector<InteractionSpec> wall_pairs;  ///< particle-wall pair parameters
+  std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max]
+  double mass_scaling = 1.0, stiffness_scaling = 1.0;  ///< applied to the virtual tests (reported)
+};
+
+/// The set-up of one experiment as the measurement file gives it: numbers (lengths in m,
+/// stresses in Pa, speeds in m/s, angles in deg) and words (wall material names, `ends`).
+struct TestSetup {
+  std::string test;  ///< drop_rebound, bulk_density, angle_of_repose_cylinder, rotating_drum, hopper_discharge, direct_shear
+  std::map<std::string, double> numbers;
+  std::map<std::string, std::string> words;
+  SourceLocation location;  ///< of the experiment in the measurement file, for errors
+};
+
+/// What a virtual test observed.
+struct SimulatedOutcome {
+  std::map<std::string, double> observables;  ///< by the measurement file's observable names
+  std::vector<std::string> flags;             ///< outcomes: no_heap, blocked, slipping
+  std::int64_t particles = 0;
+  double simulated_seconds = 0, wall_seconds = 0;
+  std::vector<std::string> notes;  ///< e.g. "stress tensor agrees with the plate stress to 1.3 %"
+};
+
+struct TestOptions {
+  std::uint64_t seed = 1;     ///< packing replica: a different seed gives a different packing
+  int threads = 0;            ///< 0: OpenMP default
+  double size_factor = 1.0;   ///< < 1 shrinks the apparatus (fewer particles) for fast screening; 1 = as measured
+  bool progress = false;      ///< progress lines to stdout
+  /// Called with the final state of the test (the app renders it); may be empty.
+  std::function<void(const Model&, const State&)> on_final;
+};
+
+/// Names of the tests and of each test's observables.
+std::vector<std::string> test_names();
+std::vector<std::string> observable_names(const std::string& test);
+
+/// Runs one virtual test. Throws CaseError naming the experiment's location for a set-up that
+/// is missing a key or has a value out of range (what is valid is said).
+SimulatedOutcome run_virtual_test(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+
+}  // namespace dem::materials
