@@ -5,6 +5,8 @@
 //   demdesign check-mesh FILE...   import, check and repair meshes, print their health reports
 //   demdesign render OUT           images of a run's saved frames
 //   demdesign effects              the table of contact effects and their parameters
+//   demdesign materials            the material library
+//   demdesign test | compare | calibrate | diagnose   virtual lab tests and material calibration
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
@@ -14,9 +16,11 @@
 #include <iostream>
 #include <sstream>
 
+#include "calibration_commands.h"
 #include "diagnostics.h"
 #include "equipment.h"
 #include "flow_images.h"
+#include "library.h"
 #include "mesh_health.h"
 #include "model.h"
 #include "particles.h"
@@ -297,11 +301,25 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--width", render_options.width, "[px]");
   render_cmd->add_option("--height", render_options.height, "[px]");
   CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
+  CLI::App* materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
+
+  // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
+  dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
+    dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
+  });
 
   CLI11_PARSE(app, argc, argv);
   try {
+    if (calibration.parsed()) return calibration.run();
     if (effects_cmd->parsed()) {
       std::cout << dem::describe_effects();
+      return 0;
+    }
+    if (materials_cmd->parsed()) {
+      std::cout << fmt::format("material library: {}\n", dem::materials::library_folder());
+      for (const auto& m : dem::materials::list_library())
+        std::cout << fmt::format("  {:<20} {}\n", m.name, m.description);
+      std::cout << "use in a case: materials: {NAME: {library: FILE_STEM}}\n";
       return 0;
     }
     if (check_cmd->parsed()) {

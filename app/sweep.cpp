@@ -158,7 +158,7 @@ YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k)
         if (last) here[steps[s].index] = plan.variants[k][p];
         else chain.push_back(here[steps[s].index]);
       } else {
-        if (!here.IsMap() && !here.IsNull())
+        if (here.IsDefined() && !here.IsMap() && !here.IsNull())
           throw CaseError(fmt::format("{}: sweep.parameters: {}: '{}' is inside a value that is not a map", plan.file, plan.paths[p], steps[s].key));
         if (last) here[steps[s].key] = plan.variants[k][p];
         else chain.push_back(here[steps[s].key]);

@@ -31,6 +31,7 @@ struct MeasurementSet {
   std::string file;
   std::string material;           ///< free text
   SizeDistributionSpec diameter;  ///< measured particle size
+  bool has_diameter = false;      ///< the file gives particles.diameter
   double density = 0;             // [kg/m^3] solid density
   std::vector<MaterialSpec> walls;
   std::vector<Experiment> experiments;

@@ -13,7 +13,7 @@ namespace dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '4'};
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
 
 /// Every field of the State, in one order, for both directions.
 template <typename Io, typename S>
@@ -23,7 +23,7 @@ void visit(Io& io, S& s) {
                   &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
                   &s.z_built})
     io(*c);
-  io(s.material), io(s.id), io(s.body);
+  io(s.material), io(s.id), io(s.body), io(s.attached);
   auto& b = s.bodies;
   for (auto* c : {&b.x, &b.y, &b.z, &b.vx, &b.vy, &b.vz, &b.qw, &b.qx, &b.qy, &b.qz, &b.lx, &b.ly, &b.lz, &b.fx, &b.fy,
                   &b.fz, &b.tx, &b.ty, &b.tz, &b.mass, &b.ix, &b.iy, &b.iz})

@@ -298,6 +298,24 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     ParticleSource source{p, material_or_fail(p.material, p.location, key + ".material"),
                           clump_or_fail(p.clump, p.location, key + ".clump")};
     extend_radii(p.diameter, source.clump);
+    // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
+    if (!p.attach_to.empty()) {
+      for (size_t w = 0; w < model.planes.size(); ++w)
+        if (model.planes[w].name == p.attach_to) source.attached = static_cast<int>(w);
+      std::vector<std::string> names;
+      for (const PlaneWall& w : model.planes) names.push_back(w.name);
+      const std::string hint = nearest_word(p.attach_to, names);
+      if (source.attached < 0)
+        throw CaseError(fmt::format("{}: {}.attach_to: no wall named '{}'{}; particles glue to a plane wall under `walls:`",
+                                    p.location.str(), key, p.attach_to,
+                                    hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
+      if (model.planes[source.attached].cylinder)
+        throw CaseError(fmt::format("{}: {}.attach_to: '{}' is a cylinder; particles glue only to plane walls",
+                                    p.location.str(), key, p.attach_to));
+      if (source.clump >= 0)
+        throw CaseError(fmt::format("{}: {}.attach_to: glued particles must be spheres (drop `clump`)", p.location.str(), key));
+      model.has_attached = true;
+    }
     model.sources.push_back(std::move(source));
   }
   const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());

@@ -218,7 +218,8 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
         tx += mf.tix[slot], ty += mf.tiy[slot], tz += mf.tiz[slot];
       }
     }
-    const double mass = s.body[p] >= 0 ? 0.0 : 1.0 / s.inv_mass[p];  // a body carries its own weight
+    // A body carries its own weight; a glued sphere is part of its wall, which has none.
+    const double mass = s.body[p] >= 0 || s.attached[p] >= 0 ? 0.0 : 1.0 / s.inv_mass[p];
     s.fx[p] = fx + mass * gx, s.fy[p] = fy + mass * gy, s.fz[p] = fz + mass * gz;
     s.tx[p] = tx, s.ty[p] = ty, s.tz[p] = tz;
   }
@@ -247,6 +248,13 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
     if (!wf.active[k]) continue;
     const std::int32_t w = s.wall_pairs.j[k];
     s.walls.fx[w] -= wf.fx[k], s.walls.fy[w] -= wf.fy[k], s.walls.fz[w] -= wf.fz[k];
+  }
+  // Glued spheres pass their contact forces to their wall, summed in slot order.
+  if (!model.has_attached) return;
+  for (long p = 0; p < n; ++p) {
+    const std::int32_t w = s.attached[p];
+    if (w < 0) continue;
+    s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
   }
 }
 

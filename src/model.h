@@ -91,6 +91,7 @@ struct ParticleSource {
   ParticleSetSpec spec;
   int material;
   int clump = -1;  ///< template index, -1: spheres
+  int attached = -1;  ///< plane wall the spheres are glued to, -1: free
 };
 
 struct Inlet {
@@ -127,6 +128,7 @@ struct Model {
   std::vector<MeshWall> meshes;
   std::vector<ClumpTemplate> clumps;
   std::vector<ParticleSource> sources;
+  bool has_attached = false;  ///< some particle source is glued to a wall
   std::vector<Inlet> inlets;
   std::vector<OutletSpec> outlets;
   std::vector<SensorSpec> sensors;  ///< normals and `across` unit, plane thickness > 0

@@ -292,6 +292,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
           const int cell = (axis_cells[2][iz] * grid.dims[1] + axis_cells[1][iy]) * grid.dims[0] + axis_cells[0][ix];
           for (int j = std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1); j < work.cell_start[cell + 1]; ++j) {
             if (s.body[i] >= 0 && s.body[i] == s.body[j]) continue;  // spheres of one clump
+            if (s.attached[i] >= 0 && s.attached[i] == s.attached[j]) continue;  // glued to one wall
             double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
             minimum_image(model, d);
             const double cut = s.radius[i] + s.radius[j] + reach;
@@ -324,6 +325,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   s.wall_pairs.i.clear();
   s.wall_pairs.j.clear();
   for (size_t p = 0; p < n; ++p) {
+    if (s.attached[p] >= 0) continue;  // part of a wall: walls do not touch walls
     for (size_t w = 0; w < model.planes.size(); ++w) {
       const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[p], s.y[p], s.z[p]};
       double normal[3];

@@ -220,30 +220,39 @@ State initial_state(const Model& model) {
   for (size_t set = 0; set < model.sources.size(); ++set) {
     const ParticleSource& source = model.sources[set];
     const ParticleSetSpec& spec = source.spec;
+    const size_t first = state.size();
     if (!spec.positions.empty()) {
       for (const Vec3& c : spec.positions) {
         const Shape shape{source.material, source.clump, draw_diameter(spec.diameter, random)};
         const Quaternion q = source.clump >= 0 ? random_orientation(random) : Quaternion{1, 0, 0, 0};
         add_particle(model, state, grid, shape, c, q, spec.velocity, spec.angular_velocity);
       }
-      continue;
-    }
-    // Random sequential addition, largest first (they are the hardest to fit).
-    std::vector<double> diameters(static_cast<size_t>(spec.count));
-    for (double& d : diameters) d = draw_diameter(spec.diameter, random);
-    std::sort(diameters.begin(), diameters.end(), std::greater<>());
-    const Vec3 size = spec.region_max - spec.region_min;
-    double solid = 0;
-    for (double d : diameters) solid += std::numbers::pi / 6.0 * d * d * d;
-    for (size_t k = 0; k < diameters.size(); ++k) {
-      const Shape shape{source.material, source.clump, diameters[k]};
-      if (!try_place(model, state, grid, random, shape, spec.region_min, spec.region_max, spec.velocity,
-                     spec.angular_velocity, kAttempts)) {
-        throw CaseError(fmt::format(
-            "{}: particles[{}]: placed {} of {} particles; the region holds {:.0f} % solid by volume, and random "
-            "placement without overlap stops near 30-35 %. Enlarge the region or lower `count`.",
-            spec.location.str(), set, k, diameters.size(), 100.0 * solid / (size.x() * size.y() * size.z())));
+    } else {
+      // Random sequential addition, largest first (they are the hardest to fit).
+      std::vector<double> diameters(static_cast<size_t>(spec.count));
+      for (double& d : diameters) d = draw_diameter(spec.diameter, random);
+      std::sort(diameters.begin(), diameters.end(), std::greater<>());
+      const Vec3 size = spec.region_max - spec.region_min;
+      double solid = 0;
+      for (double d : diameters) solid += std::numbers::pi / 6.0 * d * d * d;
+      for (size_t k = 0; k < diameters.size(); ++k) {
+        const Shape shape{source.material, source.clump, diameters[k]};
+        if (!try_place(model, state, grid, random, shape, spec.region_min, spec.region_max, spec.velocity,
+                       spec.angular_velocity, kAttempts)) {
+          throw CaseError(fmt::format(
+              "{}: particles[{}]: placed {} of {} particles; the region holds {:.0f} % solid by volume, and random "
+              "placement without overlap stops near 30-35 %. Enlarge the region or lower `count`.",
+              spec.location.str(), set, k, diameters.size(), 100.0 * solid / (size.x() * size.y() * size.z())));
+        }
       }
+    }
+    // Glued spheres move with their wall from the start.
+    if (source.attached < 0) continue;
+    const int w = source.attached;
+    for (size_t p = first; p < state.size(); ++p) {
+      state.attached[p] = w;
+      state.vx[p] = state.walls.vx[w], state.vy[p] = state.walls.vy[w], state.vz[p] = state.walls.vz[w];
+      state.wx[p] = state.wy[p] = state.wz[p] = 0.0;
     }
   }
   state.x_built.clear();  // the first step builds the contact lists

@@ -453,6 +453,7 @@ ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, 
   p.diameter = read_diameter(map, file);
   p.velocity = map.vec3("velocity", p.velocity);
   p.angular_velocity = map.vec3("angular_velocity", p.angular_velocity);
+  p.attach_to = map.string("attach_to", "");
   const YAML::Node positions = map.node("positions");
   if (positions) {
     if (!positions.IsSequence() || positions.size() == 0) map.fail("positions", "must be a list of [x, y, z] centres");

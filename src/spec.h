@@ -197,6 +197,9 @@ struct ParticleSetSpec {
   Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m] box
   Vec3 velocity{0, 0, 0};          // [m/s]
   Vec3 angular_velocity{0, 0, 0};  // [rad/s]
+  /// Name of a plane wall the spheres are glued to (`attach_to: top`): they move with the wall
+  /// and load it with their contact forces (rough plates); "" for free particles.
+  std::string attach_to;
   SourceLocation location;
 };
 

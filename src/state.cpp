@@ -52,6 +52,7 @@ std::size_t State::add_sphere(double px, double py, double pz, double r, double 
   material.push_back(mat);
   id.push_back(next_id++);
   body.push_back(-1);
+  attached.push_back(-1);
   offset_x.push_back(0.0), offset_y.push_back(0.0), offset_z.push_back(0.0);
   MeshContacts& mc = mesh_contacts;
   if (!has_meshes) return x.size() - 1;
@@ -89,6 +90,7 @@ void State::permute(const std::vector<std::int32_t>& order) {
   std::vector<std::int32_t> s32;
   apply_order(material, order, s32);
   apply_order(body, order, s32);
+  apply_order(attached, order, s32);
   std::vector<std::int64_t> s64;
   apply_order(id, order, s64);
   MeshContacts& mc = mesh_contacts;
@@ -108,6 +110,7 @@ void State::compact(const std::vector<std::uint8_t>& keep) {
   keep_only(material, keep);
   keep_only(id, keep);
   keep_only(body, keep);
+  keep_only(attached, keep);
   if (has_meshes) {
     MeshContacts& mc = mesh_contacts;
     keep_only(mc.count, keep);

@@ -91,7 +91,7 @@ struct State {
   std::int64_t lost = 0;  ///< particles removed because they left the domain
   double lost_mass = 0;   // [kg] of those particles (spillage)
 
-  // Particles (n): hot columns. 18 doubles + 12 bytes = 156 bytes a particle.
+  // Particles (n): hot columns. 18 doubles + 16 bytes = 160 bytes a particle.
   std::vector<double> x, y, z;     // [m] centre
   std::vector<double> vx, vy, vz;  // [m/s]
   std::vector<double> wx, wy, wz;  // [rad/s]
@@ -103,6 +103,9 @@ struct State {
   std::vector<std::int32_t> material;
   std::vector<std::int64_t> id;    ///< persistent, never reused
   std::vector<std::int32_t> body;  ///< clump index, -1 for a free sphere
+  /// Plane wall the sphere is glued to (moves rigidly with it, its contact forces load the
+  /// wall: the rough plates of a shear cell), -1 for a free sphere.
+  std::vector<std::int32_t> attached;
   std::vector<double> offset_x, offset_y, offset_z;  // [m] centre in the body's principal frame
 
   Bodies bodies;

@@ -19,7 +19,7 @@ void kick(State& s, double h) {
   const long n = static_cast<long>(s.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
-    if (s.body[p] >= 0) continue;  // moved by its body
+    if (s.body[p] >= 0 || s.attached[p] >= 0) continue;  // moved by its body or its wall
     const double a = h * s.inv_mass[p], b = h * s.inv_inertia[p];
     s.vx[p] += a * s.fx[p], s.vy[p] += a * s.fy[p], s.vz[p] += a * s.fz[p];
     s.wx[p] += b * s.tx[p], s.wy[p] += b * s.ty[p], s.wz[p] += b * s.tz[p];
@@ -36,7 +36,10 @@ void kick(State& s, double h) {
 void drift(State& s, const Workspace& work, const Model& model, double h) {
   const long n = static_cast<long>(s.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (long p = 0; p < n; ++p) s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
+  for (long p = 0; p < n; ++p) {
+    if (s.attached[p] >= 0) continue;  // moved by its wall
+    s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
+  }
   Bodies& b = s.bodies;
   if (b.size() == 0) return;
   for (size_t k = 0; k < b.size(); ++k) {
@@ -50,6 +53,7 @@ void drift(State& s, const Workspace& work, const Model& model, double h) {
 
 /// Walls move at their set velocity; servo walls add the normal speed that drives their
 /// stress towards the target: v_n = -clamp((sigma - target)/target, -1, 1) * max_speed.
+/// Spheres glued to a wall translate with it (same velocity, same displacement, no spin).
 void move_walls(const Model& model, State& s, double h) {
   for (size_t w = 0; w < model.planes.size(); ++w) {
     const PlaneWall& wall = model.planes[w];
@@ -62,6 +66,15 @@ void move_walls(const Model& model, State& s, double h) {
     }
     s.walls.vx[w] = v[0], s.walls.vy[w] = v[1], s.walls.vz[w] = v[2];
     s.walls.px[w] += h * v[0], s.walls.py[w] += h * v[1], s.walls.pz[w] += h * v[2];
+  }
+  if (!model.has_attached) return;
+  const long n = static_cast<long>(s.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (long p = 0; p < n; ++p) {
+    const std::int32_t w = s.attached[p];
+    if (w < 0) continue;
+    s.vx[p] = s.walls.vx[w], s.vy[p] = s.walls.vy[w], s.vz[p] = s.walls.vz[w];
+    s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
   }
 }
 
@@ -76,9 +89,15 @@ void prepare(const Model& model, State& state, Workspace& work) {
   place_meshes(model, state.time, work);
   if (state.x_built.size() == state.size() && state.size() > 0) {
     index_contacts(model, state, work);  // restored from a checkpoint: keep its lists as they are
-  } else {
-    rebuild_contacts(model, state, work);
+    // The checkpoint holds the forces and contact histories; evaluating the contacts on the
+    // state itself would advance the histories (tangential springs) a second time and the
+    // resumed run would leave the uninterrupted one. Per-contact forces for the workspace
+    // (stress tensor, scalars) come from a copy.
+    State scratch = state;
+    compute_forces(model, scratch, work);
+    return;
   }
+  rebuild_contacts(model, state, work);
   compute_forces(model, state, work);
 }
 

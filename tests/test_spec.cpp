@@ -112,3 +112,77 @@ TEST(CaseReading, MixingRulesAndInteractionOverrides) {
 
 }  // namespace
 }  // namespace dem::test
+
+namespace dem::test {
+namespace {
+
+TEST(MaterialLibrary, LibraryMaterialCarriesItsSourcesOverridesAndWallPairs) {
+  const CaseSpec spec = parse_case_text(R"(simulation: {duration: 0.1}
+materials:
+  ore: {library: gravel, friction: 0.7}
+  steel: {library: steel}
+particles:
+  - {material: ore, diameter: 0.02, positions: [[0, 0, 0.1]]}
+)", "case.yaml");
+  const MaterialSpec& ore = spec.materials[0];
+  EXPECT_EQ(ore.name, "ore");
+  EXPECT_DOUBLE_EQ(ore.density, 2650);
+  EXPECT_DOUBLE_EQ(ore.params.at("friction"), 0.7) << "the case's override wins";
+  EXPECT_EQ(ore.sources.at("friction"), "set in the case");
+  EXPECT_NE(ore.sources.at("density").find("g/cm^3"), std::string::npos) << "library provenance is kept";
+  EXPECT_NE(ore.library_file.find("gravel.yaml"), std::string::npos);
+  EXPECT_EQ(ore.tunable.at("friction").first, 0.2);
+  // The library's contact model and its pair parameters against steel.
+  EXPECT_EQ(spec.contact.rolling.model, "epsd");
+  ASSERT_EQ(spec.interactions.size(), 1u);
+  EXPECT_EQ(spec.interactions[0].material_b, "steel");
+  EXPECT_DOUBLE_EQ(spec.interactions[0].params.at("friction"), 0.45);
+  const Model model = compile(spec);
+  EXPECT_NEAR(model.pair_param(model.material_index("ore"), model.material_index("steel"), "friction"), 0.45, 1e-12);
+}
+
+TEST(MaterialLibrary, UnknownLibraryMaterialSaysWhereItLooked) {
+  const std::string message = error_of(replace(kGood, "glass: {density: 2500, youngs_modulus: 5e7, restitution: 0.5}", "glass: {library: unobtainium}"));
+  EXPECT_NE(message.find("case.yaml:3"), std::string::npos) << message;
+  EXPECT_NE(message.find("unobtainium.yaml"), std::string::npos) << message;
+  EXPECT_NE(message.find("looked in"), std::string::npos) << message;
+}
+
+TEST(Sensors, PlaneAndBoxAreReadAndBadOnesNamed) {
+  const std::string good = std::string(kGood) + R"(sensors:
+  - {name: flow, plane: {point: [0, 0, 0], normal: [0, 0, 2]}, region: {min: [-1, -1, -1], max: [1, 1, 1]}}
+  - {name: load, box: {min: [-1, -1, -1], max: [1, 1, 1], across: [0, 1, 0]}}
+)";
+  const Model model = compile(parse_case_text(good, "case.yaml"));
+  ASSERT_EQ(model.sensors.size(), 2u);
+  EXPECT_DOUBLE_EQ(model.sensors[0].normal.z(), 1.0) << "normal made unit";
+  EXPECT_GT(model.sensors[0].thickness, 0) << "slab thickness defaults to a few particle sizes";
+  const std::string both = replace(good, "box: {min", "plane: {point: [0, 0, 0]}, box: {min");
+  EXPECT_NE(error_of(both).find("sensors[1]"), std::string::npos) << error_of(both);
+  const std::string twice = replace(good, "name: load", "name: flow");
+  EXPECT_NE(error_of(twice).find("used twice"), std::string::npos) << error_of(twice);
+}
+
+TEST(Equipment, UnknownGeneratorSuggestsTheNearestAndPortsNeedEquipment) {
+  const std::string typo = std::string(kGood) + "equipment:\n  transfer_chut: {}\n";
+  const std::string message = error_of(typo);
+  EXPECT_NE(message.find("did you mean 'transfer_chute'"), std::string::npos) << message;
+  const std::string port = replace(kGood, "particles:\n  - {material: glass, diameter: 0.004, positions: [[0, 0, 0.01]]}",
+                                   "inlets:\n  - {port: feed_belt, material: glass, diameter: 0.004, mass_rate_tph: 1}");
+  EXPECT_NE(error_of(port).find("port"), std::string::npos) << error_of(port);
+}
+
+TEST(Output, ExplicitCameraIsReadAndCheckedPresetsListed) {
+  const std::string good = std::string(kGood) + "output: {render: {camera: {eye: [1, -2, 1], target: [0, 0, 0], up: [0, 0, 1], fov_deg: 40}}}\n";
+  const CaseSpec spec = parse_case_text(good, "case.yaml");
+  EXPECT_TRUE(spec.output.has_camera_pose);
+  EXPECT_DOUBLE_EQ(spec.output.camera_eye.y(), -2);
+  EXPECT_DOUBLE_EQ(spec.output.camera_fov_deg, 40);
+  const std::string bad = std::string(kGood) + "output: {render: {camera: sid}}\n";
+  EXPECT_NE(error_of(bad).find("valid: side, front, top, iso"), std::string::npos) << error_of(bad);
+  const std::string parallel = std::string(kGood) + "output: {render: {camera: {eye: [0, 0, 1], target: [0, 0, 0], up: [0, 0, 1]}}}\n";
+  EXPECT_NE(error_of(parallel).find("parallel"), std::string::npos) << error_of(parallel);
+}
+
+}  // namespace
+}  // namespace dem::test

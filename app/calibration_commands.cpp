@@ -1,0 +1,173 @@
+#include "calibration_commands.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+
+#include "calibration.h"
+#include "calibration_report.h"
+#include "material_model.h"
+#include "measurements.h"
+
+namespace dem::app {
+
+namespace {
+namespace fs = std::filesystem;
+using namespace dem::materials;
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text + ",") {
+    if (c == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else if (c != ' ') {
+      cur += c;
+    }
+  }
+  return out;
+}
+}  // namespace
+
+CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : render_(std::move(render)) {
+  test_ = app.add_subcommand("test", "run one virtual laboratory test on a material and print its observables");
+  test_->add_option("material", material_, "material file (YAML)")->required();
+  test_->add_option("--test", test_name_, "drop_rebound, bulk_density, angle_of_repose_cylinder, rotating_drum, hopper_discharge, direct_shear")->required();
+  test_->add_option("--set", set_, "set-up value KEY=VALUE (SI units; repeat)");
+  test_->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] for a fast look");
+  test_->add_option("--seed", seed_, "packing seed");
+  test_->add_option("--threads", threads_, "OpenMP threads");
+  test_->add_option("--measurements", measurements_, "measurement file whose size, density and walls to use");
+  test_->add_option("--png", png_, "render of the final state (default: test_NAME.png)");
+  for (CLI::App** cmd : {&compare_, &calibrate_, &diagnose_}) {
+    const char* name = cmd == &compare_ ? "compare" : cmd == &calibrate_ ? "calibrate" : "diagnose";
+    const char* what = cmd == &compare_ ? "simulate every experiment of a measurement file and compare (report in --out)"
+                       : cmd == &calibrate_ ? "fit the material's tunable parameters to the measurements (surrogate + NLopt)"
+                                            : "find the physical effect the material model lacks (signatures, recalibration, BIC)";
+    *cmd = app.add_subcommand(name, what);
+    (*cmd)->add_option("material", material_, "material file (YAML)")->required();
+    (*cmd)->add_option("measurements", measurements_, "measurement file (YAML)")->required();
+    (*cmd)->add_option("--replicas", replicas_, "packings per experiment (simulation noise)");
+    (*cmd)->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] (fewer particles)");
+    (*cmd)->add_option("--threads", threads_, "OpenMP threads");
+    (*cmd)->add_option("--seed", seed_, "first packing seed");
+    (*cmd)->add_option("--out", out_, "output folder (report, plots, ledger.yaml)");
+    (*cmd)->add_flag("--quiet", quiet_, "no progress lines");
+    if (cmd != &compare_) (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
+  }
+}
+
+bool CalibrationCommands::parsed() const { return test_->parsed() || compare_->parsed() || calibrate_->parsed() || diagnose_->parsed(); }
+
+int CalibrationCommands::run() {
+  if (test_->parsed()) return run_test();
+  if (compare_->parsed()) return run_measured("compare");
+  if (calibrate_->parsed()) return run_measured("calibrate");
+  return run_measured("diagnose");
+}
+
+int CalibrationCommands::run_test() {
+  MaterialModel model = read_material_model(material_);
+  if (!measurements_.empty()) apply_measured(model, read_measurements(measurements_));
+  TestSetup setup;
+  setup.test = test_name_;
+  setup.location.file = "--set";
+  for (const std::string& kv : set_) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw CaseError(fmt::format("--set {}: write KEY=VALUE", kv));
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    try {
+      size_t used = 0;
+      const double v = std::stod(value, &used);
+      if (used == value.size()) setup.numbers[key] = v;
+      else setup.words[key] = value;
+    } catch (const std::exception&) {
+      setup.words[key] = value;
+    }
+  }
+  TestOptions options;
+  options.seed = static_cast<std::uint64_t>(seed_);
+  options.size_factor = size_factor_;
+  options.threads = threads_;
+  options.progress = true;
+  const std::string png = png_.empty() ? fmt::format("test_{}.png", test_name_) : png_;
+  if (render_) options.on_final = [&](const Model& m, const State& s) { render_(m, s, png); };
+  const SimulatedOutcome out = run_virtual_test(model, setup, options);
+  std::cout << fmt::format("{} on {} ({} particles, {:.3g} s simulated, {:.1f} s wall)\n", test_name_, model.name, out.particles, out.simulated_seconds, out.wall_seconds);
+  for (const auto& [k, v] : out.observables) std::cout << fmt::format("  {} = {:.6g}\n", k, v);
+  for (const auto& f : out.flags) std::cout << "  outcome: " << f << "\n";
+  for (const auto& n : out.notes) std::cout << "  note: " << n << "\n";
+  if (render_ && fs::exists(png)) std::cout << "  render: " << png << "\n";
+  return 0;
+}
+
+int CalibrationCommands::run_measured(const std::string& command) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MaterialModel model = read_material_model(material_);
+  const MeasurementSet measured = read_measurements(measurements_);
+  apply_measured(model, measured);
+  CalibrationOptions options;
+  options.replicas = replicas_;
+  options.size_factor = size_factor_;
+  options.threads = threads_;
+  options.seed = static_cast<std::uint64_t>(seed_);
+  if (!quiet_) options.progress = [](const std::string& line) { std::cout << line << std::endl; };
+  std::vector<FitParameter> params;
+  if (!params_.empty()) {
+    try {
+      params = fit_parameters(model, split(params_));
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(fmt::format("--params: {}", e.what()));
+    }
+  }
+  fs::create_directories(out_);
+  const std::string ledger_path = (fs::path(out_) / "ledger.yaml").string();
+  report::CalibrationReportInput input;
+  input.title = fmt::format("{} {}", command, model.name);
+  input.material_path = material_, input.measurements_path = measurements_, input.version = "0.1.0";
+  input.measured = &measured;
+  Comparison comparison;
+  CalibrationResult calibration;
+  Diagnosis diagnosis;
+  std::vector<std::string> keys;
+  for (const auto& p : (params.empty() ? fit_parameters(model) : params)) keys.push_back(p.key);
+  if (command == "compare") {
+    comparison = compare(model, measured, options);
+    input.comparison = &comparison;
+    std::cout << fmt::format("chi^2/n = {:.2f} over {} observations\n", comparison.chi2_per_n(), comparison.n);
+    for (const auto& t : comparison.terms)
+      std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured, t.sigma_measured,
+                               t.simulated, t.sigma_simulated, t.residual);
+    for (const auto& p : comparison.patterns) std::cout << "  " << p.words << "\n";
+  } else if (command == "calibrate") {
+    calibration = calibrate(model, measured, params, options);
+    input.calibration = &calibration;
+    for (const auto& w : calibration.words) std::cout << w << "\n";
+    input.ledger = append_ledger(ledger_path, model.name,
+                                 {ledger_entry(model, calibration.before, "start", keys), ledger_entry(calibration.fitted, calibration.after, "calibrated", keys)});
+  } else {
+    diagnosis = diagnose(model, measured, params, options);
+    input.diagnosis = &diagnosis;
+    for (const auto& w : diagnosis.words) std::cout << w << "\n";
+    for (const auto& c : diagnosis.candidates) std::cout << "  " << c.words << "\n";
+    std::vector<LedgerEntry> entries = {ledger_entry(model, diagnosis.base.before, "start", keys),
+                                        ledger_entry(diagnosis.base.fitted, diagnosis.base.after, "calibrated", keys)};
+    for (const auto& c : diagnosis.candidates)
+      if (c.confirmed) {
+        std::vector<std::string> k = keys;
+        for (const auto& a : c.adds) k.push_back(a.key);
+        entries.push_back(ledger_entry(c.fit.fitted, c.fit.after, "+ " + c.name, k));
+      }
+    input.ledger = append_ledger(ledger_path, model.name, entries);
+  }
+  if (input.ledger.empty()) input.ledger = read_ledger(ledger_path);
+  input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string html = report::write_calibration_report(input, out_);
+  std::cout << fmt::format("report: {} ({:.0f} s)\n", html, input.wall_seconds);
+  return 0;
+}
+
+}  // namespace dem::app

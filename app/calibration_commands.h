@@ -1,0 +1,48 @@
+// The calibration commands of the CLI: test, compare, calibrate, diagnose.
+//   demdesign test MATERIAL.yaml --test rotating_drum --set rpm=20 --set drum_diameter=0.2 ... [--size-factor F]
+//   demdesign compare MATERIAL.yaml MEASUREMENTS.yaml [--replicas N] [--out DIR]
+//   demdesign calibrate MATERIAL.yaml MEASUREMENTS.yaml [--params friction,rolling_friction] [--out DIR]
+//   demdesign diagnose MATERIAL.yaml MEASUREMENTS.yaml [--out DIR]
+// Wiring in main(): construct before CLI11_PARSE, then inside the try block
+//   if (calibration.parsed()) return calibration.run();
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "model.h"
+#include "state.h"
+
+namespace dem::app {
+
+/// Renders a final state to a PNG (supplied by main, which owns the renderer).
+using RenderFinal = std::function<void(const Model&, const State&, const std::string& png_path)>;
+
+class CalibrationCommands {
+ public:
+  CalibrationCommands(CLI::App& app, RenderFinal render);
+  bool parsed() const;
+  /// Runs the parsed command; returns the exit status. Throws CaseError for bad input.
+  int run();
+
+ private:
+  int run_test();
+  int run_measured(const std::string& command);
+
+  RenderFinal render_;
+  CLI::App* test_ = nullptr;
+  CLI::App* compare_ = nullptr;
+  CLI::App* calibrate_ = nullptr;
+  CLI::App* diagnose_ = nullptr;
+  std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_;
+  std::vector<std::string> set_;
+  double size_factor_ = 1.0;
+  int replicas_ = 3, threads_ = 0;
+  long long seed_ = 1;
+  bool quiet_ = false;
+};
+
+}  // namespace dem::app

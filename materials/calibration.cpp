@@ -1,0 +1,935 @@
+// Compare, calibrate and diagnose (rules in calibration.h).
+#include "calibration.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "effect.h"
+
+namespace dem::materials {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string duration_text(double s) {
+  if (s < 90) return fmt::format("{:.0f} s", s);
+  if (s < 5400) return fmt::format("{:.0f} min", s / 60);
+  return fmt::format("{:.1f} h", s / 3600);
+}
+
+/// Counts simulations against a planned total and prints the time left.
+struct Progress {
+  const CalibrationOptions& options;
+  std::string what;
+  int total = 0, done = 0;
+  Clock::time_point t0 = Clock::now();
+  void step(const std::string& item) {
+    ++done;
+    if (!options.progress) return;
+    const double elapsed = seconds_since(t0);
+    const double left = done > 0 ? elapsed / done * std::max(0, total - done) : 0;
+    options.progress(fmt::format("{} {}/{}: {} ({} elapsed, about {} left)", what, done, total, item, duration_text(elapsed), duration_text(left)));
+  }
+};
+
+SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, const CalibrationOptions& options, std::uint64_t seed) {
+  TestOptions t;
+  t.seed = seed;
+  t.threads = options.threads;
+  t.size_factor = options.size_factor;
+  if (options.on_final) t.on_final = options.on_final;
+  return options.simulator ? options.simulator(model, setup, t) : run_virtual_test(model, setup, t);
+}
+
+/// The set-up number that varies most (relative) over the experiments of one test.
+std::map<std::string, std::string> varied_keys(const MeasurementSet& measured) {
+  std::map<std::string, std::vector<const Experiment*>> by_test;
+  for (const Experiment& e : measured.experiments) by_test[e.setup.test].push_back(&e);
+  std::map<std::string, std::string> out;
+  for (const auto& [test, list] : by_test) {
+    if (list.size() < 2) continue;
+    std::set<std::string> keys;
+    for (const Experiment* e : list)
+      for (const auto& kv : e->setup.numbers) keys.insert(kv.first);
+    double best = 0;
+    for (const std::string& key : keys) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo, scale = 0;
+      bool all = true;
+      for (const Experiment* e : list) {
+        const auto it = e->setup.numbers.find(key);
+        if (it == e->setup.numbers.end()) { all = false; break; }
+        lo = std::min(lo, it->second), hi = std::max(hi, it->second), scale = std::max(scale, std::abs(it->second));
+      }
+      if (!all || scale == 0) continue;
+      const double spread = (hi - lo) / scale;
+      if (spread > best + 1e-12) best = spread, out[test] = key;
+    }
+  }
+  return out;
+}
+
+std::string signed_sigma(double r) { return fmt::format("{:+.1f} sigma", r); }
+
+/// Least squares of y on basis columns; returns coefficients and their standard errors for
+/// unit-variance y (normalised residuals).
+void regress(const Eigen::MatrixXd& X, const Eigen::VectorXd& y, Eigen::VectorXd& coef, Eigen::VectorXd& se) {
+  const Eigen::MatrixXd XtX = X.transpose() * X;
+  coef = XtX.ldlt().solve(X.transpose() * y);
+  const Eigen::MatrixXd inv = XtX.inverse();
+  se = inv.diagonal().cwiseSqrt();
+}
+
+}  // namespace
+
+double Comparison::residual(const std::string& experiment, const std::string& observable) const {
+  for (const Term& t : terms)
+    if (t.experiment == experiment && t.observable == observable) return t.residual;
+  return kNaN;
+}
+
+// ---- comparison ---------------------------------------------------------------------------
+
+ExperimentRun simulate_experiment(const MaterialModel& model, const Experiment& experiment, const CalibrationOptions& options, int replicas) {
+  ExperimentRun run;
+  run.id = experiment.id;
+  run.test = experiment.setup.test;
+  run.replicas = std::max(1, replicas);
+  const Clock::time_point t0 = Clock::now();
+  std::map<std::string, int> flags;
+  for (int r = 0; r < run.replicas; ++r) {
+    const SimulatedOutcome out = run_one(model, experiment.setup, options, options.seed + static_cast<std::uint64_t>(r));
+    for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
+    for (const std::string& f : out.flags) ++flags[f];
+    if (r == 0) run.notes = out.notes, run.particles = out.particles;
+  }
+  for (const auto& [key, list] : run.values) {
+    const double n = static_cast<double>(list.size());
+    const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
+    double ss = 0;
+    for (double v : list) ss += (v - mean) * (v - mean);
+    run.mean[key] = mean;
+    run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+  }
+  for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
+  run.wall_seconds = seconds_since(t0);
+  return run;
+}
+
+Comparison compare_runs(const MeasurementSet& measured, const std::vector<ExperimentRun>& runs, const CalibrationOptions& options,
+                        const std::map<std::string, double>& sigma_floor) {
+  Comparison c;
+  c.runs = runs;
+  const auto varied = varied_keys(measured);
+  for (size_t k = 0; k < measured.experiments.size() && k < runs.size(); ++k) {
+    const Experiment& e = measured.experiments[k];
+    const ExperimentRun& run = runs[k];
+    const auto vit = varied.find(e.setup.test);
+    const std::string vkey = vit == varied.end() ? "" : vit->second;
+    const double vvalue = vkey.empty() ? 0.0 : e.setup.numbers.at(vkey);
+    for (const auto& [obs, o] : e.observed) {
+      Term t;
+      t.experiment = e.id, t.test = e.setup.test, t.observable = obs;
+      t.measured = o.value, t.sigma_measured = o.sigma;
+      t.varied = vkey, t.varied_value = vvalue;
+      const auto m = run.mean.find(obs);
+      if (m == run.mean.end() || !std::isfinite(m->second)) {
+        c.notes.push_back(fmt::format("{}: {} was not simulated (the test returned no value); left out of chi^2", e.id, obs));
+        continue;
+      }
+      t.simulated = m->second;
+      t.sigma_simulated = run.sigma.at(obs);
+      if (run.replicas < 2) {
+        const auto f = sigma_floor.find(t.name());
+        if (f != sigma_floor.end()) t.sigma_simulated = f->second;
+      }
+      t.residual = (t.simulated - t.measured) / std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
+      c.terms.push_back(t);
+    }
+    if (!e.outcome.empty()) {
+      Term t;
+      t.experiment = e.id, t.test = e.setup.test, t.observable = "outcome";
+      t.measured_outcome = e.outcome;
+      t.measured = 1.0, t.sigma_measured = 1.0 / options.outcome_residual;
+      const auto f = run.flag_fraction.find(e.outcome);
+      t.simulated = f == run.flag_fraction.end() ? 0.0 : f->second;
+      if (t.simulated > 0) t.simulated_outcome = e.outcome;
+      t.residual = options.outcome_residual * (t.simulated - 1.0);
+      t.varied = vkey, t.varied_value = vvalue;
+      c.terms.push_back(t);
+    }
+    // A simulated outcome where none was observed shows in the observable (0) and in a note.
+    for (const auto& [flag, fraction] : run.flag_fraction)
+      if (flag != e.outcome && (flag == "blocked" || flag == "no_heap"))
+        c.notes.push_back(fmt::format("{}: simulated {} in {:.0f} % of the replicas, not observed", e.id, flag, 100 * fraction));
+  }
+  for (const Term& t : c.terms) c.chi2 += t.residual * t.residual;
+  c.n = static_cast<int>(c.terms.size());
+  c.patterns = analyse_patterns(c.terms);
+  return c;
+}
+
+Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {
+  Progress progress{options, "compare", static_cast<int>(measured.experiments.size())};
+  std::vector<ExperimentRun> runs;
+  for (const Experiment& e : measured.experiments) {
+    runs.push_back(simulate_experiment(model, e, options, options.replicas));
+    progress.step(e.id);
+  }
+  return compare_runs(measured, runs, options);
+}
+
+std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms) {
+  std::map<std::pair<std::string, std::string>, std::vector<const Term*>> groups;
+  std::vector<std::pair<std::string, std::string>> order;
+  for (const Term& t : terms) {
+    if (t.is_outcome()) continue;
+    const auto key = std::make_pair(t.test, t.observable);
+    if (!groups.count(key)) order.push_back(key);
+    groups[key].push_back(&t);
+  }
+  std::vector<Pattern> out;
+  for (const auto& key : order) {
+    const auto& list = groups[key];
+    Pattern p;
+    p.test = key.first, p.observable = key.second, p.varied = list.front()->varied;
+    p.count = static_cast<int>(list.size());
+    for (const Term* t : list) p.mean += t->residual / p.count, p.chi2 += t->residual * t->residual;
+    const std::string what = fmt::format("{} ({})", p.observable, p.test);
+    const std::string sign_word = p.mean > 0 ? "higher" : "lower";
+    if (p.count == 1) {
+      p.kind = std::abs(p.mean) <= 2 ? "fits" : "single";
+      p.words = p.kind == "fits" ? fmt::format("{}: fits within the noise ({}).", what, signed_sigma(p.mean))
+                                 : fmt::format("{}: simulated {} than measured by {:.1f} sigma (one experiment: no pattern can be told).", what,
+                                               sign_word, std::abs(p.mean));
+      out.push_back(p);
+      continue;
+    }
+    // Normalised set-up quantity z in [-1, 1].
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Term* t : list) lo = std::min(lo, t->varied_value), hi = std::max(hi, t->varied_value);
+    const bool varies = !p.varied.empty() && hi > lo;
+    std::set<double> distinct;
+    for (const Term* t : list) distinct.insert(t->varied_value);
+    Eigen::VectorXd y(p.count);
+    Eigen::VectorXd z(p.count);
+    for (int i = 0; i < p.count; ++i) y[i] = list[i]->residual, z[i] = varies ? 2 * (list[i]->varied_value - lo) / (hi - lo) - 1 : 0;
+    const double mean_se = 1.0 / std::sqrt(static_cast<double>(p.count));
+    bool slope_significant = false, curve_significant = false;
+    if (varies && distinct.size() >= 2) {
+      Eigen::MatrixXd X(p.count, 2);
+      X.col(0).setOnes(), X.col(1) = z;
+      Eigen::VectorXd coef, se;
+      regress(X, y, coef, se);
+      p.slope = 2 * coef[1];  // change over the whole range
+      slope_significant = std::abs(coef[1]) > 2 * se[1] && std::abs(p.slope) > 1.5;
+      if (distinct.size() >= 4) {
+        Eigen::MatrixXd Q(p.count, 3);
+        Q.col(0).setOnes(), Q.col(1) = z, Q.col(2) = z.cwiseProduct(z);
+        regress(Q, y, coef, se);
+        p.curvature = coef[2];
+        curve_significant = std::abs(coef[2]) > 2 * se[2] && std::abs(coef[2]) > 1.0;
+      }
+    }
+    const bool offset_significant = std::abs(p.mean) > 2 * mean_se && std::abs(p.mean) > 1.0;
+    const std::string range = varies ? fmt::format("{} from {:g} to {:g}", p.varied, lo, hi) : "the experiments";
+    if (p.chi2 / p.count <= 2.0 && !slope_significant && !offset_significant) {
+      p.kind = "fits";
+      p.words = fmt::format("{}: fits within the noise over {} (mean residual {}).", what, range, signed_sigma(p.mean));
+    } else if (curve_significant) {
+      p.kind = "curvature";
+      p.words = fmt::format("{}: wrong curvature with {}: the residuals bend ({:+.1f} sigma at the ends relative to the middle) over {}.", what,
+                            p.varied, p.curvature, range);
+    } else if (slope_significant) {
+      p.kind = "trend";
+      p.words = fmt::format("{}: wrong trend with {}: the residual goes from {} to {} over {} (the simulated value {} faster with {} than the measured one).",
+                            what, p.varied, signed_sigma(p.mean - p.slope / 2), signed_sigma(p.mean + p.slope / 2), range,
+                            p.slope > 0 ? "rises" : "falls", p.varied);
+      if (p.test == "direct_shear" && p.observable == "peak_shear_stress")
+        p.words += " The yield locus has the wrong slope: the internal friction (sliding or rolling friction) is off.";
+      if (p.test == "rotating_drum") p.words += " The speed dependence of the dynamic angle is wrong (damping, rolling resistance or cohesion).";
+    } else if (offset_significant) {
+      p.kind = "offset";
+      p.words = fmt::format("{}: a constant offset: simulated {} than measured by {:.1f} sigma on average over {}, with no trend.", what, sign_word,
+                            std::abs(p.mean), range);
+      if (p.test == "direct_shear" && p.observable == "peak_shear_stress")
+        p.words += fmt::format(" The yield locus is offset by a constant while its slope fits: {}.",
+                               p.mean < 0 ? "cohesion is missing (liquid bridges or van der Waals)" : "the model has too much cohesion");
+    } else {
+      p.kind = "scatter";
+      p.words = fmt::format("{}: misfit without a pattern (chi^2/n = {:.1f} over {}): scattered beyond the stated noise.", what, p.chi2 / p.count, range);
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+// ---- surrogate ----------------------------------------------------------------------------
+
+namespace {
+
+/// Quadratic basis in normalised u: 1, u_i, u_i u_j (i <= j).
+int basis_size(int p) { return 1 + p + p * (p + 1) / 2; }
+
+Eigen::VectorXd basis(const Eigen::VectorXd& u) {
+  const int p = static_cast<int>(u.size());
+  Eigen::VectorXd b(basis_size(p));
+  int k = 0;
+  b[k++] = 1;
+  for (int i = 0; i < p; ++i) b[k++] = u[i];
+  for (int i = 0; i < p; ++i)
+    for (int j = i; j < p; ++j) b[k++] = u[i] * u[j];
+  return b;
+}
+
+/// d basis / d u: (basis x p).
+Eigen::MatrixXd basis_gradient(const Eigen::VectorXd& u) {
+  const int p = static_cast<int>(u.size());
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(basis_size(p), p);
+  int k = 1;
+  for (int i = 0; i < p; ++i) g(k++, i) = 1;
+  for (int i = 0; i < p; ++i)
+    for (int j = i; j < p; ++j) {
+      g(k, i) += u[j];
+      g(k, j) += u[i];
+      ++k;
+    }
+  return g;
+}
+
+Eigen::VectorXd to_unit(const std::vector<FitParameter>& box, const Eigen::VectorXd& x) {
+  Eigen::VectorXd u(x.size());
+  for (int i = 0; i < x.size(); ++i) u[i] = 2 * (x[i] - box[i].min) / (box[i].max - box[i].min) - 1;
+  return u;
+}
+
+Eigen::VectorXd from_unit(const std::vector<FitParameter>& box, const Eigen::VectorXd& u) {
+  Eigen::VectorXd x(u.size());
+  for (int i = 0; i < u.size(); ++i) x[i] = box[i].min + 0.5 * (u[i] + 1) * (box[i].max - box[i].min);
+  return x;
+}
+
+}  // namespace
+
+Eigen::VectorXd Surrogate::predict(const Eigen::VectorXd& x) const { return coefficients * basis(to_unit(box, x)); }
+
+Eigen::MatrixXd Surrogate::jacobian(const Eigen::VectorXd& x) const {
+  Eigen::MatrixXd j = coefficients * basis_gradient(to_unit(box, x));  // d/du
+  for (int i = 0; i < j.cols(); ++i) j.col(i) *= 2.0 / (box[i].max - box[i].min);
+  return j;
+}
+
+Surrogate fit_surrogate(const std::vector<FitParameter>& box, const std::vector<std::string>& terms, const Eigen::MatrixXd& points,
+                        const Eigen::MatrixXd& values, const Eigen::VectorXd& sigma) {
+  Surrogate s;
+  s.box = box, s.terms = terms, s.points = points, s.values = values;
+  const int n = static_cast<int>(points.rows()), p = static_cast<int>(box.size());
+  Eigen::MatrixXd X(n, basis_size(p));
+  for (int i = 0; i < n; ++i) X.row(i) = basis(to_unit(box, points.row(i).transpose())).transpose();
+  // Least squares through a rank-revealing QR: a design too small for a full quadratic still
+  // gives the minimum-norm-like fit of what it can resolve.
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> qr(X);
+  s.coefficients = qr.solve(values).transpose();
+  const Eigen::MatrixXd fitted = X * s.coefficients.transpose();
+  for (int t = 0; t < values.cols(); ++t) {
+    const double rms = std::sqrt((fitted.col(t) - values.col(t)).squaredNorm() / std::max(1, n));
+    s.fit_rms.push_back(sigma[t] > 0 ? rms / sigma[t] : rms);
+  }
+  return s;
+}
+
+Eigen::MatrixXd latin_hypercube(const std::vector<FitParameter>& box, int n, std::uint64_t seed) {
+  const int p = static_cast<int>(box.size());
+  std::mt19937_64 random(seed);
+  Eigen::MatrixXd best;
+  double best_distance = -1;
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::MatrixXd u(n, p);
+    for (int j = 0; j < p; ++j) {
+      std::vector<int> order(n);
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), random);
+      std::uniform_real_distribution<double> jitter(0.0, 1.0);
+      for (int i = 0; i < n; ++i) u(i, j) = (order[i] + jitter(random)) / n;
+    }
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b) nearest = std::min(nearest, (u.row(a) - u.row(b)).squaredNorm());
+    if (nearest > best_distance) best_distance = nearest, best = u;
+  }
+  Eigen::MatrixXd x(n, p);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < p; ++j) x(i, j) = box[j].min + best(i, j) * (box[j].max - box[j].min);
+  return x;
+}
+
+// ---- calibration --------------------------------------------------------------------------
+
+std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::vector<std::string>& keys) {
+  std::vector<FitParameter> out;
+  if (keys.empty()) {
+    for (const auto& [key, range] : model.tunable) out.push_back({key, range.first, range.second});
+    return out;
+  }
+  for (const std::string& key : keys) {
+    const auto it = model.tunable.find(key);
+    if (it != model.tunable.end()) {
+      out.push_back({key, it->second.first, it->second.second});
+      continue;
+    }
+    (void)get_parameter(model, key);  // throws for an unknown key
+    const ParamSpec* spec = nullptr;
+    for (const EffectSpec* e : effect_table())
+      for (const ParamSpec& p : e->params)
+        if (p.key == key) spec = &p;
+    if (!spec || !spec->tunable)
+      throw std::invalid_argument(fmt::format("'{}' has no calibration range: declare it under `tunable:` in the material file", key));
+    out.push_back({key, spec->min_value, spec->max_value});
+  }
+  return out;
+}
+
+namespace {
+
+struct SurrogateObjective {
+  const Surrogate* surrogate;
+  Eigen::VectorXd measured, sigma;
+  double chi2(const Eigen::VectorXd& x) const { return ((surrogate->predict(x) - measured).array() / sigma.array()).square().sum(); }
+};
+
+double nlopt_objective(const std::vector<double>& u, std::vector<double>&, void* data) {
+  const auto* o = static_cast<const SurrogateObjective*>(data);
+  const Eigen::VectorXd uu = Eigen::Map<const Eigen::VectorXd>(u.data(), static_cast<Eigen::Index>(u.size()));
+  return o->chi2(from_unit(o->surrogate->box, uu));
+}
+
+/// Minimises the surrogate chi^2 from several starts; returns the best point (physical).
+Eigen::VectorXd minimise(const SurrogateObjective& objective, const std::vector<Eigen::VectorXd>& starts) {
+  const auto& box = objective.surrogate->box;
+  const unsigned p = static_cast<unsigned>(box.size());
+  Eigen::VectorXd best = starts.front();
+  double best_value = objective.chi2(best);
+  for (const Eigen::VectorXd& start : starts) {
+    nlopt::opt opt(p >= 2 ? nlopt::LN_BOBYQA : nlopt::LN_COBYLA, p);
+    opt.set_lower_bounds(std::vector<double>(p, -1.0));
+    opt.set_upper_bounds(std::vector<double>(p, 1.0));
+    opt.set_min_objective(nlopt_objective, const_cast<SurrogateObjective*>(&objective));
+    opt.set_xtol_rel(1e-8);
+    opt.set_maxeval(4000);
+    const Eigen::VectorXd u0 = to_unit(box, start).cwiseMax(-1.0).cwiseMin(1.0);
+    std::vector<double> u(u0.data(), u0.data() + u0.size());
+    double value = 0;
+    try {
+      opt.optimize(u, value);
+    } catch (const std::exception&) {
+      value = nlopt_objective(u, u, const_cast<SurrogateObjective*>(&objective));  // keep the last point
+    }
+    if (value < best_value) best_value = value, best = from_unit(box, Eigen::Map<Eigen::VectorXd>(u.data(), p));
+  }
+  return best;
+}
+
+MaterialModel with_values(const MaterialModel& model, const std::vector<FitParameter>& box, const Eigen::VectorXd& x) {
+  MaterialModel m = model;
+  for (size_t i = 0; i < box.size(); ++i) set_parameter(m, box[i].key, x[static_cast<Eigen::Index>(i)]);
+  return m;
+}
+
+std::string join(const std::vector<std::string>& words, const std::string& sep = ", ") {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
+  return out;
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
+                            const CalibrationOptions& options, const Comparison* before) {
+  const Clock::time_point t0 = Clock::now();
+  CalibrationResult result;
+  if (parameters.empty()) parameters = fit_parameters(model);
+  if (parameters.empty()) throw std::invalid_argument("nothing to calibrate: the material declares no `tunable:` ranges and none were given");
+  result.parameters = parameters;
+  const int p = static_cast<int>(parameters.size());
+  for (const FitParameter& f : parameters) result.start.push_back(get_parameter(model, f.key));
+
+  // The start, with replicas: its simulation noise stands for the noise everywhere.
+  if (before) result.before = *before;
+  else result.before = compare(model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+  std::vector<Term> numeric;
+  for (const Term& t : result.before.terms)
+    if (!t.is_outcome()) numeric.push_back(t);
+  if (numeric.empty()) throw std::invalid_argument("no numeric observations to calibrate against");
+  std::vector<std::string> names;
+  Eigen::VectorXd measured_values(numeric.size()), sigma(numeric.size());
+  std::map<std::string, double> sigma_sim;
+  for (size_t i = 0; i < numeric.size(); ++i) {
+    names.push_back(numeric[i].name());
+    measured_values[i] = numeric[i].measured;
+    sigma[i] = std::sqrt(numeric[i].sigma_measured * numeric[i].sigma_measured + numeric[i].sigma_simulated * numeric[i].sigma_simulated);
+    sigma_sim[numeric[i].name()] = numeric[i].sigma_simulated;
+  }
+  std::map<std::string, int> index;
+  for (size_t i = 0; i < names.size(); ++i) index[names[i]] = static_cast<int>(i);
+
+  const int points = options.design_points > 0 ? options.design_points : 2 * basis_size(p) + 2;
+  const int rounds = std::max(1, options.rounds);
+  Progress progress{options, "design", rounds * points * static_cast<int>(measured.experiments.size()) + options.replicas * static_cast<int>(measured.experiments.size())};
+  std::vector<FitParameter> box = parameters;
+  Eigen::VectorXd x_best(p);
+  for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].min, parameters[i].max);
+  Eigen::MatrixXd all_points(0, p), all_values(0, static_cast<Eigen::Index>(names.size()));
+  for (int round = 0; round < rounds; ++round) {
+    if (round > 0) {
+      // A box a quarter of each range wide around the last optimum.
+      for (int i = 0; i < p; ++i) {
+        const double half = 0.125 * (parameters[i].max - parameters[i].min);
+        const double lo = std::max(parameters[i].min, x_best[i] - half), hi = std::min(parameters[i].max, x_best[i] + half);
+        box[i].min = lo, box[i].max = hi;
+        if (hi - lo < 2 * half) {  // at a bound: keep the width
+          if (lo == parameters[i].min) box[i].max = lo + 2 * half;
+          else box[i].min = hi - 2 * half;
+        }
+      }
+    }
+    const Eigen::MatrixXd design = latin_hypercube(box, points, options.seed + 7919u * static_cast<std::uint64_t>(round));
+    Eigen::MatrixXd values(points, static_cast<Eigen::Index>(names.size()));
+    std::vector<int> good;
+    for (int k = 0; k < points; ++k) {
+      const MaterialModel m = with_values(model, parameters, design.row(k).transpose());
+      bool ok = true;
+      values.row(k).setConstant(kNaN);
+      for (const Experiment& e : measured.experiments) {
+        try {
+          const SimulatedOutcome out = run_one(m, e.setup, options, options.seed);
+          for (const auto& [obs, v] : out.observables) {
+            const auto it = index.find(e.id + "/" + obs);
+            if (it != index.end()) values(k, it->second) = v;
+          }
+        } catch (const CaseError&) {
+          throw;
+        } catch (const std::exception& error) {
+          if (options.progress) options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, error.what()));
+          ok = false;
+        }
+        ++result.simulations;
+        progress.step(fmt::format("round {} point {} {}", round + 1, k + 1, e.id));
+      }
+      if (ok && values.row(k).allFinite()) good.push_back(k);
+    }
+    // Round 1 and 2 points both feed the last surrogate when they lie in its box.
+    for (int k : good) {
+      all_points.conservativeResize(all_points.rows() + 1, p);
+      all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
+      all_points.row(all_points.rows() - 1) = design.row(k);
+      all_values.row(all_values.rows() - 1) = values.row(k);
+    }
+    std::vector<int> inside;
+    for (int k = 0; k < all_points.rows(); ++k) {
+      bool in = true;
+      for (int i = 0; i < p; ++i) in = in && all_points(k, i) >= box[i].min - 1e-12 && all_points(k, i) <= box[i].max + 1e-12;
+      if (in) inside.push_back(k);
+    }
+    if (static_cast<int>(inside.size()) < basis_size(p))
+      throw std::runtime_error(fmt::format("calibration: only {} of {} design points simulated; need {} for the surrogate", inside.size(), points, basis_size(p)));
+    Eigen::MatrixXd P(inside.size(), p), V(inside.size(), all_values.cols());
+    for (size_t r = 0; r < inside.size(); ++r) P.row(r) = all_points.row(inside[r]), V.row(r) = all_values.row(inside[r]);
+    result.surrogate = fit_surrogate(box, names, P, V, sigma);
+    // Starts: the best design points and the centre of the box.
+    SurrogateObjective objective{&result.surrogate, measured_values, sigma};
+    std::vector<std::pair<double, int>> ranked;
+    for (int r = 0; r < P.rows(); ++r) ranked.push_back({objective.chi2(P.row(r).transpose()), r});
+    std::sort(ranked.begin(), ranked.end());
+    std::vector<Eigen::VectorXd> starts = {from_unit(box, Eigen::VectorXd::Zero(p))};
+    if (round == 0) starts.push_back(x_best);
+    for (int s = 0; s < std::min<int>(options.starts, static_cast<int>(ranked.size())); ++s) starts.push_back(P.row(ranked[s].second).transpose());
+    x_best = minimise(objective, starts);
+    result.surrogate_chi2 = objective.chi2(x_best);
+    if (options.progress)
+      options.progress(fmt::format("round {}: surrogate optimum {} (surrogate chi^2/n {:.2f})", round + 1,
+                                   [&] {
+                                     std::vector<std::string> v;
+                                     for (int i = 0; i < p; ++i) v.push_back(fmt::format("{} = {:.4g}", parameters[i].key, x_best[i]));
+                                     return join(v);
+                                   }(),
+                                   result.surrogate_chi2 / static_cast<double>(names.size())));
+  }
+  for (int i = 0; i < p; ++i) result.value.push_back(x_best[i]);
+  result.fitted = with_values(model, parameters, x_best);
+
+  // Uncertainty and identifiability from the surrogate's Jacobian at the optimum.
+  const Eigen::MatrixXd J = result.surrogate.jacobian(x_best);
+  const Eigen::VectorXd w = sigma.cwiseInverse().cwiseAbs2();
+  const Eigen::MatrixXd F = J.transpose() * w.asDiagonal() * J;
+  Eigen::VectorXd half(p);
+  for (int i = 0; i < p; ++i) half[i] = 0.5 * (parameters[i].max - parameters[i].min);
+  const Eigen::MatrixXd Fn = half.asDiagonal() * F * half.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Fn);
+  const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
+  const double lmax = lambda.maxCoeff();
+  result.condition = lambda.minCoeff() > 0 ? lmax / lambda.minCoeff() : std::numeric_limits<double>::infinity();
+  // Pseudo-inverse in normalised coordinates: directions with eigenvalue below 1e-12 lmax are unconstrained.
+  Eigen::MatrixXd cov_n = Eigen::MatrixXd::Zero(p, p);
+  std::vector<bool> flagged(p, false);
+  for (int k = 0; k < p; ++k) {
+    const Eigen::VectorXd v = eig.eigenvectors().col(k);
+    result.eigenvalues.push_back(lambda[k]);
+    result.eigenvectors.emplace_back(v.data(), v.data() + p);
+    const bool free = !(lambda[k] > 1e-12 * std::max(lmax, 1e-300));
+    // sigma along this direction, in half-ranges; > 0.5 means a quarter of the range or more.
+    const double spread = free ? std::numeric_limits<double>::infinity() : 1.0 / std::sqrt(lambda[k]);
+    if (!free) cov_n += v * v.transpose() / lambda[k];
+    if (spread > 0.5)
+      for (int i = 0; i < p; ++i)
+        if (std::abs(v[i]) > 0.3) flagged[i] = true;
+    if (free)
+      for (int i = 0; i < p; ++i)
+        if (std::abs(v[i]) > 1e-6) cov_n(i, i) = std::numeric_limits<double>::infinity();
+  }
+  result.correlation.assign(p, std::vector<double>(p, kNaN));
+  for (int i = 0; i < p; ++i) {
+    result.sigma.push_back(std::sqrt(cov_n(i, i)) * half[i]);
+    if (result.sigma.back() > 0.25 * (parameters[i].max - parameters[i].min)) flagged[i] = true;
+    for (int j = 0; j < p; ++j)
+      result.correlation[i][j] = std::isfinite(cov_n(i, j)) && std::isfinite(cov_n(i, i) * cov_n(j, j)) && cov_n(i, i) > 0 && cov_n(j, j) > 0
+                                     ? cov_n(i, j) / std::sqrt(cov_n(i, i) * cov_n(j, j))
+                                     : (i == j ? 1.0 : kNaN);
+  }
+  for (int i = 0; i < p; ++i)
+    if (flagged[i]) result.unidentified.push_back(parameters[i].key);
+
+  // Confirmation with real simulations (replicas; noise floor from the start where one replica).
+  result.after = compare(result.fitted, measured, options);
+  result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+  result.wall_seconds = seconds_since(t0);
+
+  // Words.
+  std::vector<std::string> fitted;
+  for (int i = 0; i < p; ++i)
+    fitted.push_back(fmt::format("{} = {:.4g} +- {:.2g} (start {:.4g}, range [{:g}, {:g}])", parameters[i].key, result.value[i], result.sigma[i],
+                                 result.start[i], parameters[i].min, parameters[i].max));
+  result.words.push_back("Fitted: " + join(fitted, "; ") + ".");
+  result.words.push_back(fmt::format("chi^2/n from {:.2f} at the start to {:.2f} at the fit (real simulations, n = {}); the surrogate predicted {:.2f}.",
+                                     result.before.chi2_per_n(), result.after.chi2_per_n(), result.after.n,
+                                     result.surrogate_chi2 / static_cast<double>(names.size())));
+  if (result.after.chi2_per_n() <= options.fits_within_noise) result.words.push_back("The fitted model reproduces the measurements within their noise.");
+  for (int i = 0; i < p; ++i)
+    for (int j = i + 1; j < p; ++j)
+      if (std::abs(result.correlation[i][j]) > 0.9)
+        result.words.push_back(fmt::format("{} and {} are strongly correlated ({:+.2f}): the data fix a combination of them, not each one.",
+                                           parameters[i].key, parameters[j].key, result.correlation[i][j]));
+  if (!result.unidentified.empty())
+    result.words.push_back(fmt::format("Not identified by these data: {} (uncertainty over a quarter of the range, or a direction of the "
+                                       "information matrix with no constraint; condition number {:.3g}). Add a test that responds to them "
+                                       "differently (Fig. 5: two tests whose contours cross).",
+                                       join(result.unidentified), result.condition));
+  else result.words.push_back(fmt::format("All parameters are identified (condition number {:.3g}).", result.condition));
+  for (size_t t = 0; t < names.size(); ++t)
+    if (result.surrogate.fit_rms[t] > 1.0)
+      result.words.push_back(fmt::format("The surrogate of {} misses its design points by {:.1f} sigma RMS: it is not quadratic over the box.", names[t],
+                                         result.surrogate.fit_rms[t]));
+  if (p >= 2) result.contours.push_back(contour_map(result, 0, 1));
+  return result;
+}
+
+ContourMap contour_map(const CalibrationResult& result, int px, int py, int grid) {
+  const Surrogate& s = result.surrogate;
+  ContourMap map;
+  map.x_key = s.box[px].key, map.y_key = s.box[py].key;
+  const int p = static_cast<int>(s.box.size());
+  Eigen::VectorXd x0(p);
+  for (int i = 0; i < p; ++i) x0[i] = result.value[i];
+  map.fit_x = x0[px], map.fit_y = x0[py];
+  // Measured values and sigma of the terms, from the comparison at the start.
+  std::map<std::string, std::pair<double, double>> meas;
+  std::map<std::string, std::string> test_of;
+  for (const Term& t : result.before.terms)
+    if (!t.is_outcome())
+      meas[t.name()] = {t.measured, std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated)}, test_of[t.name()] = t.test;
+  // The two terms whose gradients (in sigma per half-range) cross most steeply.
+  const Eigen::MatrixXd J = s.jacobian(x0);
+  const double hx = 0.5 * (s.box[px].max - s.box[px].min), hy = 0.5 * (s.box[py].max - s.box[py].min);
+  int a = 0, b = s.terms.size() > 1 ? 1 : 0;
+  double best = -1;
+  for (size_t i = 0; i < s.terms.size(); ++i)
+    for (size_t j = i + 1; j < s.terms.size(); ++j) {
+      const double si = meas[s.terms[i]].second, sj = meas[s.terms[j]].second;
+      const double gi[2] = {J(i, px) * hx / si, J(i, py) * hy / si}, gj[2] = {J(j, px) * hx / sj, J(j, py) * hy / sj};
+      double score = std::abs(gi[0] * gj[1] - gi[1] * gj[0]);
+      if (test_of[s.terms[i]] != test_of[s.terms[j]]) score *= 1.5;
+      if (score > best) best = score, a = static_cast<int>(i), b = static_cast<int>(j);
+    }
+  for (int k = 0; k < grid; ++k) {
+    map.x.push_back(s.box[px].min + (s.box[px].max - s.box[px].min) * k / (grid - 1));
+    map.y.push_back(s.box[py].min + (s.box[py].max - s.box[py].min) * k / (grid - 1));
+  }
+  for (int term : {a, b}) {
+    ContourMap::Field f;
+    f.term = s.terms[term];
+    f.label = f.term;
+    std::replace(f.label.begin(), f.label.end(), '/', ' ');
+    f.measured = meas[f.term].first, f.sigma = meas[f.term].second;
+    f.value.assign(grid, std::vector<double>(grid));
+    map.fields.push_back(f);
+    if (a == b) break;
+  }
+  map.chi2.assign(grid, std::vector<double>(grid));
+  Eigen::VectorXd m(s.terms.size()), sg(s.terms.size());
+  for (size_t t = 0; t < s.terms.size(); ++t) m[t] = meas[s.terms[t]].first, sg[t] = meas[s.terms[t]].second;
+  for (int iy = 0; iy < grid; ++iy)
+    for (int ix = 0; ix < grid; ++ix) {
+      Eigen::VectorXd x = x0;
+      x[px] = map.x[ix], x[py] = map.y[iy];
+      const Eigen::VectorXd v = s.predict(x);
+      for (auto& f : map.fields) f.value[iy][ix] = v[std::find(s.terms.begin(), s.terms.end(), f.term) - s.terms.begin()];
+      map.chi2[iy][ix] = ((v - m).array() / sg.array()).square().sum();
+    }
+  return map;
+}
+
+// ---- diagnosis ----------------------------------------------------------------------------
+
+double bic(double chi2, int k, int n) { return chi2 + k * std::log(static_cast<double>(std::max(n, 1))); }
+
+namespace {
+
+/// Why an effect fits the residual pattern, in words.
+std::string physics_words(const std::string& effect) {
+  if (effect == "rolling_resistance") return "heaps and drum beds stand steeper than spheres allow while single contacts fit: resistance to rolling (particle shape, roughness)";
+  if (effect == "liquid_bridges") return "strength that does not come from the load (steeper heaps, looser packing, slower or blocked discharge, a yield locus offset by a constant): cohesion (liquid bridges)";
+  if (effect == "jkr_cohesion") return "strength that does not come from the load: cohesion (van der Waals, JKR adhesion)";
+  if (effect == "clump_shape") return "interlocking of non-spherical particles (steeper heaps, higher shear strength, looser packing)";
+  return "the effect's signature matches the residuals";
+}
+
+}  // namespace
+
+Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& options) {
+  Diagnosis d;
+  if (parameters.empty()) parameters = fit_parameters(model);
+  if (options.progress) options.progress("diagnose: calibrating the model as it is");
+  d.base = calibrate(model, measured, parameters, options);
+  const Comparison& base = d.base.after;
+  const int n = base.n;
+  d.base_bic = bic(base.chi2, static_cast<int>(parameters.size()), n);
+  const bool fits = base.chi2_per_n() <= options.fits_within_noise;
+
+  // Sigma of each term (measurement and simulation noise) and the residual vector.
+  const int nt = static_cast<int>(base.terms.size());
+  Eigen::VectorXd r(nt), sig(nt);
+  for (int i = 0; i < nt; ++i) {
+    const Term& t = base.terms[i];
+    r[i] = t.residual;
+    sig[i] = t.is_outcome() ? 1.0 / options.outcome_residual : std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
+  }
+  // What the fitted parameters can already do (surrogate Jacobian, in sigma units), to take out of each signature.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nt, static_cast<Eigen::Index>(parameters.size()));
+  {
+    Eigen::VectorXd x(parameters.size());
+    for (size_t i = 0; i < parameters.size(); ++i) x[static_cast<Eigen::Index>(i)] = d.base.value[i];
+    const Eigen::MatrixXd J = d.base.surrogate.jacobian(x);
+    for (int i = 0; i < nt; ++i) {
+      const auto it = std::find(d.base.surrogate.terms.begin(), d.base.surrogate.terms.end(), base.terms[i].name());
+      if (it != d.base.surrogate.terms.end()) A.row(i) = J.row(it - d.base.surrogate.terms.begin()) * 0.5 / sig[i];
+    }
+    for (size_t j = 0; j < parameters.size(); ++j) A.col(static_cast<Eigen::Index>(j)) *= (parameters[j].max - parameters[j].min);
+  }
+  Progress progress{options, "signature", static_cast<int>(missing_effects(d.base.fitted).size() * measured.experiments.size())};
+  for (const EffectCandidate& c : missing_effects(d.base.fitted)) {
+    CandidateResult cr;
+    cr.name = c.name, cr.description = c.description;
+    for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
+    cr.k = static_cast<int>(parameters.size() + cr.adds.size());
+    MaterialModel with = d.base.fitted;
+    c.add(with);
+    for (const auto& [key, v] : c.start) set_parameter(with, key, v);
+    // Signature: the change of every term, one replica each, same packing seed as the base run's first replica.
+    std::vector<ExperimentRun> runs;
+    CalibrationOptions one = options;
+    one.replicas = 1;
+    for (const Experiment& e : measured.experiments) {
+      runs.push_back(simulate_experiment(with, e, one, 1));
+      progress.step(c.name + " " + e.id);
+    }
+    std::map<std::string, double> floor;
+    for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
+    const Comparison changed = compare_runs(measured, runs, options, floor);
+    Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
+    for (int i = 0; i < nt; ++i) {
+      const Term& t = base.terms[i];
+      for (const Term& u : changed.terms)
+        if (u.name() == t.name()) s[i] = (u.simulated - t.simulated) / sig[i];
+      cr.signature.push_back(s[i]);
+    }
+    // Remove what the existing parameters can do, then project the residual on what is left.
+    Eigen::VectorXd s_perp = s;
+    if (A.cols() > 0 && A.norm() > 0) s_perp = s - A * A.completeOrthogonalDecomposition().solve(s);
+    const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
+    if (ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0) {
+      const double alpha = -s_perp.dot(r) / ss;  // multiple of the added strength that best cancels r
+      cr.explained = alpha > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
+    }
+    d.candidates.push_back(std::move(cr));
+  }
+  std::sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
+
+  if (fits) {
+    d.words.push_back(fmt::format("No effect recommended: the model as it is fits within the noise after calibration (chi^2/n = {:.2f} <= {:.2g}).",
+                                  base.chi2_per_n(), options.fits_within_noise));
+  } else {
+    // Confirm the leading candidates by adding each and recalibrating.
+    int confirmed = 0;
+    for (CandidateResult& cr : d.candidates) {
+      if (confirmed >= options.confirm_candidates || cr.explained < 0.05) break;
+      const auto all = missing_effects(d.base.fitted);
+      const auto it = std::find_if(all.begin(), all.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
+      MaterialModel with = d.base.fitted;
+      it->add(with);
+      for (const auto& [key, v] : it->start) set_parameter(with, key, v);
+      std::vector<FitParameter> params = parameters;
+      params.insert(params.end(), cr.adds.begin(), cr.adds.end());
+      if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
+      cr.fit = calibrate(with, measured, params, options);
+      cr.confirmed = true;
+      cr.chi2 = cr.fit.after.chi2;
+      cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);
+      cr.delta_bic = d.base_bic - cr.bic;
+      ++confirmed;
+    }
+    std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) {
+      if (a.confirmed != b.confirmed) return a.confirmed;
+      return a.confirmed ? a.bic < b.bic : a.explained > b.explained;
+    });
+    const CandidateResult* best = d.candidates.empty() || !d.candidates.front().confirmed ? nullptr : &d.candidates.front();
+    if (best && best->delta_bic > options.bic_margin) {
+      d.recommended = best->name;
+      // Which patterns the effect answers.
+      std::vector<std::string> misfits;
+      for (const Pattern& p : d.base.after.patterns)
+        if (p.kind != "fits") misfits.push_back(p.words);
+      d.words.push_back(fmt::format("Most likely missing: {}. {} It could explain {:.0f} % of the weighted residual of the calibrated model; "
+                                    "added and recalibrated, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} "
+                                    "(by {:.1f} > margin {:.0f}, with {} more parameter{}).",
+                                    best->name, "Why: " + physics_words(best->name) + ".", 100 * best->explained, base.chi2_per_n(),
+                                    best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
+                                    best->adds.size() == 1 ? "" : "s"));
+      if (!misfits.empty()) d.words.push_back("Where the model without it fails: " + join(misfits, " "));
+    } else {
+      d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}) but no candidate lowers BIC by more than {:.0f}{}.",
+                                    base.chi2_per_n(), options.bic_margin,
+                                    best ? fmt::format(" (best: {}, by {:.1f})", best->name, best->delta_bic) : ""));
+    }
+  }
+  for (CandidateResult& cr : d.candidates) {
+    cr.words = cr.confirmed ? fmt::format("{}: explains {:.0f} % of the residual; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).",
+                                          cr.name, 100 * cr.explained, cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
+                            : fmt::format("{}: explains {:.0f} % of the residual (signature only, not confirmed).", cr.name, 100 * cr.explained);
+  }
+  return d;
+}
+
+// ---- ledger -------------------------------------------------------------------------------
+
+std::vector<std::string> model_effects(const MaterialModel& model) {
+  std::vector<std::string> out;
+  for (const ContactSpec::Choice* c : {&model.contact.normal, &model.contact.damping, &model.contact.tangential, &model.contact.rolling, &model.contact.twisting})
+    if (c->model != "none") out.push_back(c->model);
+  for (const auto& c : model.contact.adhesion) out.push_back(c.model);
+  for (const auto& c : model.contact.extra) out.push_back(c.model);
+  if (!model.shape.empty()) out.push_back(fmt::format("clump (aspect {:.2f})", get_parameter(model, "clump_aspect_ratio")));
+  return out;
+}
+
+LedgerEntry ledger_entry(const MaterialModel& model, const Comparison& comparison, const std::string& label, const std::vector<std::string>& parameter_keys) {
+  LedgerEntry e;
+  e.label = label;
+  const std::time_t t = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&t, &local);
+  char buffer[64];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S", &local);
+  e.time = buffer;
+  e.effects = model_effects(model);
+  for (const std::string& key : parameter_keys) e.parameters[key] = get_parameter(model, key);
+  for (const Term& term : comparison.terms) e.residuals[term.name()] = term.residual;
+  e.chi2 = comparison.chi2;
+  e.n = comparison.n;
+  return e;
+}
+
+std::vector<LedgerEntry> read_ledger(const std::string& path) {
+  std::vector<LedgerEntry> out;
+  if (!std::filesystem::exists(path)) return out;
+  try {
+    const YAML::Node root = YAML::LoadFile(path);
+    for (const YAML::Node& v : root["versions"]) {
+      LedgerEntry e;
+      e.version = v["version"].as<int>();
+      e.label = v["label"].as<std::string>("");
+      e.time = v["time"].as<std::string>("");
+      if (v["effects"])
+        for (const auto& x : v["effects"]) e.effects.push_back(x.as<std::string>());
+      if (v["parameters"])
+        for (const auto& kv : v["parameters"]) e.parameters[kv.first.as<std::string>()] = kv.second.as<double>();
+      if (v["residuals"])
+        for (const auto& kv : v["residuals"]) e.residuals[kv.first.as<std::string>()] = kv.second.as<double>();
+      e.chi2 = v["chi2"].as<double>(0);
+      e.n = v["n"].as<int>(0);
+      out.push_back(std::move(e));
+    }
+  } catch (const YAML::Exception& error) {
+    throw CaseError(fmt::format("{}:{}:{}: the error ledger cannot be read: {}", path, error.mark.line + 1, error.mark.column + 1, error.msg));
+  }
+  return out;
+}
+
+std::vector<LedgerEntry> append_ledger(const std::string& path, const std::string& material, std::vector<LedgerEntry> entries) {
+  std::vector<LedgerEntry> all = read_ledger(path);
+  int next = all.empty() ? 1 : all.back().version + 1;
+  for (LedgerEntry& e : entries) e.version = next++, all.push_back(std::move(e));
+  YAML::Emitter out;
+  out << YAML::Comment("Error ledger: every model version of this material with its normalised residual on every observation "
+                       "(simulated - measured, in sigma) and chi^2/n. Appended by demdesign calibrate and diagnose.");
+  out << YAML::BeginMap << YAML::Key << "material" << YAML::Value << material << YAML::Key << "versions" << YAML::Value << YAML::BeginSeq;
+  for (const LedgerEntry& e : all) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "version" << YAML::Value << e.version;
+    out << YAML::Key << "label" << YAML::Value << e.label;
+    out << YAML::Key << "time" << YAML::Value << e.time;
+    out << YAML::Key << "effects" << YAML::Value << YAML::Flow << e.effects;
+    out << YAML::Key << "parameters" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    for (const auto& [k, v] : e.parameters) out << YAML::Key << k << YAML::Value << v;
+    out << YAML::EndMap;
+    out << YAML::Key << "chi2" << YAML::Value << e.chi2 << YAML::Key << "n" << YAML::Value << e.n;
+    out << YAML::Key << "chi2_per_n" << YAML::Value << e.chi2_per_n();
+    out << YAML::Key << "residuals" << YAML::Value << YAML::BeginMap;
+    for (const auto& [k, v] : e.residuals) out << YAML::Key << k << YAML::Value << v;
+    out << YAML::EndMap << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  const std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  std::ofstream file(path);
+  if (!file) throw std::runtime_error(fmt::format("{}: cannot write the error ledger", path));
+  file << out.c_str() << "\n";
+  return all;
+}
+
+}  // namespace dem::materials

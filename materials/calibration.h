@@ -1,0 +1,257 @@
+// Compare, calibrate, diagnose: the material model against a measurement file.
+//
+//   compare    simulates every experiment with replicas (different seeds, so different packings)
+//              and forms one normalised residual per observation,
+//                r = (simulated mean - measured) / sqrt(sigma_measured^2 + sigma_simulated^2),
+//              sigma_simulated being the standard error of the replica mean. Outcomes (blocked,
+//              no_heap, slipping) are observations: a mismatch is a residual of
+//              outcome_residual x |measured fraction - simulated fraction| (3 sigma by default).
+//              Residuals of one test are regressed on the set-up quantity varied across its
+//              experiments (constant, linear, quadratic) to name the pattern of the misfit.
+//   calibrate  fits parameters inside their ranges through a surrogate: a Latin hypercube design
+//              (fixed seed) in the parameter box, one simulation of every experiment per point
+//              (common random numbers: the same packing seed at every point), a quadratic
+//              response surface per observation fitted by least squares, chi^2 of the surrogate
+//              minimised with NLopt (BOBYQA) from several starts, a second, smaller box around
+//              that optimum, and finally real simulations (with replicas) at the optimum.
+//              Uncertainty from the surrogate's Jacobian J at the optimum: cov = (J^T W J)^-1,
+//              W = diag(1/sigma^2); identifiability from the eigenvalues of J^T W J in
+//              range-normalised coordinates.
+//   diagnose   calibrates the model as it is, then for every effect it lacks measures the
+//              effect's signature (change of each observation, in sigma, when added at a moderate
+//              strength) and the fraction of the remaining chi^2 a least-squares multiple of it
+//              could remove (signature made orthogonal to what the fitted parameters can already
+//              do); the leading two are confirmed by adding each and recalibrating, and ranked
+//              by BIC = chi^2 + k ln n.
+//
+// The simulator is a std::function, so tests replace the DEM virtual tests by analytic
+// stand-ins with known answers.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "material_model.h"
+#include "measurements.h"
+#include "virtual_tests.h"
+
+namespace dem::materials {
+
+/// Runs one virtual test; the default is run_virtual_test.
+using Simulator = std::function<SimulatedOutcome(const MaterialModel&, const TestSetup&, const TestOptions&)>;
+
+struct CalibrationOptions {
+  Simulator simulator;          ///< empty: run_virtual_test
+  int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
+  double size_factor = 1.0;     ///< passed to the virtual tests
+  int threads = 0;              ///< OpenMP threads of each simulation; 0: default
+  std::uint64_t seed = 1;       ///< first packing seed; the design uses this one
+  int design_points = 0;        ///< per round; 0: 2 x (quadratic coefficients) + 2
+  int rounds = 2;               ///< surrogate rounds; round 2 spans a quarter of each range around round 1's optimum
+  int starts = 8;               ///< NLopt starts (best design points and the centre)
+  double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
+  double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise
+  double bic_margin = 10.0;         ///< an effect is recommended when it lowers BIC by more than this
+  int confirm_candidates = 2;       ///< leading candidates confirmed by recalibration
+  /// Progress lines (with time left); empty: quiet.
+  std::function<void(const std::string&)> progress;
+  /// Final state of every simulation (the app renders the last); may be empty.
+  std::function<void(const Model&, const State&)> on_final;
+};
+
+// ---- comparison ---------------------------------------------------------------------------
+
+/// One experiment simulated with replicas.
+struct ExperimentRun {
+  std::string id, test;
+  std::map<std::string, double> mean;                  ///< observable -> mean over replicas
+  std::map<std::string, double> sigma;                 ///< observable -> standard error of the mean (0 with one replica)
+  std::map<std::string, std::vector<double>> values;   ///< observable -> per replica
+  std::map<std::string, double> flag_fraction;         ///< outcome flag -> fraction of replicas
+  std::vector<std::string> notes;
+  int replicas = 0;
+  std::int64_t particles = 0;
+  double wall_seconds = 0;
+};
+
+/// One compared quantity: an observation, or an observed outcome.
+struct Term {
+  std::string experiment, test, observable;  ///< observable "outcome" for an outcome term
+  double measured = 0, sigma_measured = 0;
+  double simulated = 0, sigma_simulated = 0;
+  double residual = 0;                        ///< normalised, simulated - measured
+  std::string measured_outcome, simulated_outcome;  ///< outcome terms: "" when none
+  std::string varied;                         ///< the set-up key this test's experiments vary ("" if none)
+  double varied_value = 0;
+  bool is_outcome() const { return observable == "outcome"; }
+  std::string name() const { return experiment + "/" + observable; }
+};
+
+/// The misfit pattern of one observable of one test over its experiments.
+struct Pattern {
+  std::string test, observable, varied;
+  std::string kind;   ///< fits, offset, trend, curvature, scatter, single
+  int count = 0;
+  double mean = 0;    ///< mean residual [sigma]
+  double slope = 0;   ///< residual change from the lowest to the highest varied value [sigma] (linear fit)
+  double curvature = 0;  ///< quadratic coefficient in normalised x in [-1, 1] [sigma]
+  double chi2 = 0;
+  std::string words;
+};
+
+struct Comparison {
+  std::vector<ExperimentRun> runs;
+  std::vector<Term> terms;
+  double chi2 = 0;
+  int n = 0;
+  std::vector<Pattern> patterns;
+  std::vector<std::string> notes;  ///< e.g. observations not simulated
+  double chi2_per_n() const { return n > 0 ? chi2 / n : 0.0; }
+  /// The residual of `experiment/observable`; NaN when absent.
+  double residual(const std::string& experiment, const std::string& observable) const;
+};
+
+/// Simulates one experiment `replicas` times (seeds options.seed, +1, ...).
+ExperimentRun simulate_experiment(const MaterialModel& model, const Experiment& experiment, const CalibrationOptions& options, int replicas);
+
+/// Terms, chi^2 and patterns of simulated runs (one per experiment, in file order).
+/// `sigma_floor`: per term name, a simulation noise to use when a run has none (one replica).
+Comparison compare_runs(const MeasurementSet& measured, const std::vector<ExperimentRun>& runs, const CalibrationOptions& options,
+                        const std::map<std::string, double>& sigma_floor = {});
+
+/// Simulates every experiment with options.replicas replicas and compares.
+Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options);
+
+/// Residual patterns per (test, observable): regression on the varied set-up quantity.
+std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms);
+
+// ---- calibration --------------------------------------------------------------------------
+
+struct FitParameter {
+  std::string key;
+  double min = 0, max = 1;
+};
+
+/// The model's tunable ranges; with `keys`, only those (each must have a range, from the
+/// material file or the effect table's full range). Throws std::invalid_argument naming the key.
+std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::vector<std::string>& keys = {});
+
+/// Quadratic response surfaces, one per numeric term, in x normalised to [-1, 1] over `box`.
+struct Surrogate {
+  std::vector<FitParameter> box;
+  std::vector<std::string> terms;   ///< term names (experiment/observable)
+  Eigen::MatrixXd coefficients;     ///< (terms x basis)
+  Eigen::MatrixXd points;           ///< (design points x parameters), physical units
+  Eigen::MatrixXd values;           ///< (design points x terms)
+  std::vector<double> fit_rms;      ///< per term: RMS of the fit residual, in units of the term's sigma
+  Eigen::VectorXd predict(const Eigen::VectorXd& x) const;   ///< x physical -> (terms)
+  Eigen::MatrixXd jacobian(const Eigen::VectorXd& x) const;  ///< (terms x parameters), physical units
+};
+
+/// Fits quadratic surfaces to values (points x terms) at points (points x parameters).
+Surrogate fit_surrogate(const std::vector<FitParameter>& box, const std::vector<std::string>& terms, const Eigen::MatrixXd& points,
+                        const Eigen::MatrixXd& values, const Eigen::VectorXd& sigma);
+
+/// n points of a Latin hypercube in the box (best of 20 by the smallest distance), fixed seed.
+Eigen::MatrixXd latin_hypercube(const std::vector<FitParameter>& box, int n, std::uint64_t seed);
+
+/// A 2-D map of the surrogate (Fig. 5): two observations over two parameters, the others at the fit.
+struct ContourMap {
+  std::string x_key, y_key;
+  std::vector<double> x, y;                 ///< grid axes (physical)
+  struct Field {
+    std::string term;                       ///< experiment/observable
+    std::string label;                      ///< "aor_1 angle_deg"
+    double measured = 0, sigma = 0;
+    std::vector<std::vector<double>> value; ///< [iy][ix]
+  };
+  std::vector<Field> fields;
+  std::vector<std::vector<double>> chi2;    ///< [iy][ix] surrogate chi^2 of all terms
+  double fit_x = 0, fit_y = 0;
+};
+
+struct CalibrationResult {
+  std::vector<FitParameter> parameters;
+  std::vector<double> start, value, sigma;          ///< physical units
+  std::vector<std::vector<double>> correlation;
+  std::vector<double> eigenvalues;                  ///< of J^T W J in half-range units, ascending
+  std::vector<std::vector<double>> eigenvectors;    ///< [k] = direction of eigenvalues[k]
+  double condition = 0;                             ///< largest / smallest eigenvalue
+  std::vector<std::string> unidentified;            ///< keys the data do not pin down
+  std::vector<std::string> words;
+  Surrogate surrogate;                              ///< of the last round
+  double surrogate_chi2 = 0;                        ///< at the optimum
+  MaterialModel fitted;
+  Comparison before, after;                         ///< real simulations at the start and at the fit
+  std::vector<ContourMap> contours;
+  int simulations = 0;
+  double wall_seconds = 0;
+};
+
+/// Fits `parameters` (empty: the model's tunable ranges). `before`: an existing comparison of
+/// `model` (its simulation noise is reused); nullptr: compared first.
+CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
+                            const CalibrationOptions& options, const Comparison* before = nullptr);
+
+/// The Fig. 5 map for parameters px, py of a result, for the two observations whose contours
+/// cross most steeply (from different tests when there are).
+ContourMap contour_map(const CalibrationResult& result, int px, int py, int grid = 41);
+
+// ---- diagnosis ----------------------------------------------------------------------------
+
+struct CandidateResult {
+  std::string name, description;
+  std::vector<FitParameter> adds;    ///< parameters the effect adds to the fit
+  std::vector<double> signature;     ///< per term of the base comparison: change in units of its sigma
+  double explained = 0;              ///< fraction of the base chi^2 the signature could remove
+  bool confirmed = false;
+  CalibrationResult fit;             ///< when confirmed
+  double chi2 = 0, bic = 0, delta_bic = 0;  ///< confirmed: after recalibration; delta = base BIC - this BIC
+  int k = 0;                         ///< fitted parameters
+  std::string words;
+};
+
+struct Diagnosis {
+  CalibrationResult base;
+  double base_bic = 0;
+  std::vector<CandidateResult> candidates;  ///< ranked: confirmed by BIC, then by explained fraction
+  std::string recommended;                  ///< candidate name, "" for none
+  std::vector<std::string> words;
+};
+
+/// BIC = chi^2 + k ln n.
+double bic(double chi2, int k, int n);
+
+Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
+                   const CalibrationOptions& options);
+
+// ---- error ledger -------------------------------------------------------------------------
+
+/// One model version with its error on every experiment.
+struct LedgerEntry {
+  int version = 0;
+  std::string label;   ///< "start", "calibrated", "+ liquid_bridges", ...
+  std::string time;    ///< local time of the run
+  std::vector<std::string> effects;               ///< contact effects switched on (and clump shape)
+  std::map<std::string, double> parameters;       ///< fitted (or tunable) parameter values
+  std::map<std::string, double> residuals;        ///< term name -> normalised residual
+  double chi2 = 0;
+  int n = 0;
+  double chi2_per_n() const { return n > 0 ? chi2 / n : 0.0; }
+};
+
+/// The effects of a model as words: "hertz", "restitution", "mindlin", "epsd", "liquid_bridge", "clump".
+std::vector<std::string> model_effects(const MaterialModel& model);
+LedgerEntry ledger_entry(const MaterialModel& model, const Comparison& comparison, const std::string& label,
+                         const std::vector<std::string>& parameter_keys);
+/// Reads OUT/ledger.yaml (empty when the file does not exist).
+std::vector<LedgerEntry> read_ledger(const std::string& path);
+/// Appends `entries` (numbered after the existing ones) and rewrites the file.
+std::vector<LedgerEntry> append_ledger(const std::string& path, const std::string& material, std::vector<LedgerEntry> entries);
+
+}  // namespace dem::materials

@@ -1,0 +1,170 @@
+// Reading measurement files (../shared/protocols/CALIBRATION_TESTS.md). Every key goes through
+// MapReader, so a misspelt key names the nearest valid one; tests and observables are checked
+// against the virtual tests' own tables (test_names, observable_names).
+#include "measurements.h"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "yaml_check.h"
+
+namespace dem::materials {
+
+namespace {
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& valid) {
+  const std::string hint = nearest_word(word, valid);
+  return hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint);
+}
+
+/// Outcomes an experiment of `test` may report instead of (or beside) a value.
+std::vector<std::string> outcome_names(const std::string& test) {
+  if (test == "hopper_discharge") return {"blocked"};
+  if (test == "angle_of_repose_cylinder") return {"no_heap"};
+  if (test == "rotating_drum") return {"slipping"};
+  return {};
+}
+
+/// Wall materials measured directly: {youngs_modulus, poisson_ratio, density}.
+MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const std::string& file) {
+  MapReader map(node, file, "walls." + name);
+  MaterialSpec m;
+  m.name = name;
+  m.location = map.location();
+  m.youngs_modulus = map.required_number("youngs_modulus", 1e3, 1e15, "Pa");
+  m.poisson_ratio = map.number("poisson_ratio", 0.3, -0.99, 0.499, "-");
+  m.density = map.number("density", 7800, 1.0, 1e5, "kg/m^3");
+  map.finish();
+  return m;
+}
+
+Experiment read_experiment(const YAML::Node& node, const std::string& file, size_t index, const std::vector<MaterialSpec>& walls) {
+  MapReader map(node, file, fmt::format("experiments[{}]", index));
+  Experiment e;
+  e.location = map.location();
+  e.id = map.required_string("id", "a name for the experiment, unique in the file");
+  const std::vector<std::string> tests = test_names();
+  const std::string test = map.required_string("test", "one of " + join(tests));
+  if (std::find(tests.begin(), tests.end(), test) == tests.end())
+    map.fail("test", fmt::format("'{}' is not a test{}; valid: {}", test, did_you_mean(test, tests), join(tests)));
+  e.setup.test = test;
+  e.setup.location = e.location;
+  // Set-up: numbers and words; which keys a test needs is checked by the test itself.
+  const YAML::Node setup = map.node("setup");
+  if (!setup) map.fail("setup", fmt::format("missing: the set-up of the {} test, {{key: value, ...}}", test));
+  MapReader s(setup, file, map.key_path("setup"));
+  for (const std::string& key : s.keys()) {
+    const YAML::Node v = s.node(key);
+    if (!v.IsScalar()) s.fail(key, "must be a number (SI units) or a word (a wall material, `periodic`, ...)");
+    double number = 0;
+    if (YAML::convert<double>::decode(v, number)) {
+      if (!std::isfinite(number)) s.fail(key, "must be a finite number");
+      e.setup.numbers[key] = number;
+    } else {
+      e.setup.words[key] = v.Scalar();
+    }
+  }
+  // Words that name wall materials must be ones the file declares.
+  std::vector<std::string> wall_names;
+  for (const auto& w : walls) wall_names.push_back(w.name);
+  for (const char* key : {"base", "wall", "plate"}) {
+    const auto it = e.setup.words.find(key);
+    if (it == e.setup.words.end() || wall_names.empty()) continue;
+    if (std::find(wall_names.begin(), wall_names.end(), it->second) == wall_names.end())
+      s.fail(key, fmt::format("'{}' is not a wall material of this file{}; valid: {} (declared under `walls:`)", it->second,
+                              did_you_mean(it->second, wall_names), join(wall_names)));
+  }
+  s.finish();
+  // Observations: each {value, sigma > 0}, of an observable this test has.
+  const std::vector<std::string> observables = observable_names(test);
+  if (const YAML::Node observed = map.node("observed")) {
+    MapReader o(observed, file, map.key_path("observed"));
+    for (const std::string& key : o.keys()) {
+      if (std::find(observables.begin(), observables.end(), key) == observables.end())
+        o.fail(key, fmt::format("'{}' is not an observable of {}{}; valid: {}", key, test, did_you_mean(key, observables), join(observables)));
+      MapReader v(o.node(key), file, o.key_path(key));
+      Observation obs;
+      obs.location = v.location();
+      obs.value = v.required_number("value", -1e12, 1e12);
+      if (!v.has("sigma")) v.fail("sigma", "missing: the one-standard-deviation repeatability of the value, > 0");
+      obs.sigma = v.required_number("sigma", 0, 1e12);
+      if (!(obs.sigma > 0)) v.fail("sigma", fmt::format("is {:g}; valid: > 0 (one standard deviation of the measurement)", obs.sigma));
+      v.finish();
+      e.observed[key] = obs;
+    }
+    o.finish();
+  }
+  if (map.has("outcome")) {
+    const std::vector<std::string> outcomes = outcome_names(test);
+    if (outcomes.empty()) map.fail("outcome", fmt::format("{} has no outcomes; remove the key", test));
+    e.outcome = map.string("outcome", "", outcomes);
+  }
+  if (e.observed.empty() && e.outcome.empty())
+    map.fail("observed", fmt::format("missing: what was observed, e.g. {{{}: {{value: V, sigma: S}}}}{}", observables.front(),
+                                     outcome_names(test).empty() ? "" : fmt::format(", or outcome: {}", join(outcome_names(test)))));
+  map.finish();
+  return e;
+}
+
+}  // namespace
+
+MeasurementSet parse_measurements(const std::string& text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+  try {
+    MeasurementSet set;
+    set.file = name;
+    MapReader top(root, name, "");
+    set.material = top.string("material", "");
+    if (const YAML::Node particles = top.node("particles")) {
+      MapReader p(particles, name, "particles");
+      if (p.has("diameter")) set.diameter = read_size_distribution(p, name), set.has_diameter = true;
+      set.density = p.number("density", 0, 1.0, 1e5, "kg/m^3");
+      p.finish();
+    }
+    if (const YAML::Node walls = top.node("walls")) {
+      if (!walls.IsMap()) top.fail("walls", "must map wall material names to {youngs_modulus, poisson_ratio, density}");
+      for (const auto& kv : walls) set.walls.push_back(read_wall(kv.first.as<std::string>(), kv.second, name));
+    }
+    const YAML::Node experiments = top.node("experiments");
+    if (!experiments || !experiments.IsSequence() || experiments.size() == 0)
+      top.fail("experiments", "missing: a list of {id, test, setup, observed}");
+    std::set<std::string> ids;
+    for (size_t k = 0; k < experiments.size(); ++k) {
+      Experiment e = read_experiment(experiments[k], name, k, set.walls);
+      if (!ids.insert(e.id).second)
+        throw CaseError(fmt::format("{}: experiments[{}].id: '{}' is used twice; ids must be unique", e.location.str(), k, e.id));
+      set.experiments.push_back(std::move(e));
+    }
+    top.finish();
+    return set;
+  } catch (const YAML::Exception& e) {
+    throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+}
+
+MeasurementSet read_measurements(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw CaseError(fmt::format("{}: cannot open the measurement file", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_measurements(text.str(), path);
+}
+
+}  // namespace dem::materials

@@ -1,0 +1,145 @@
+// rotating_drum: a drum (`drum_diameter`, `drum_depth` along its horizontal axis y, wall material
+// `wall`) filled to `fill_fraction` of its volume (bulk volume at the poured solid fraction,
+// optional `poured_solid_fraction`, default 0.6) rotates at `rpm`. `ends: walls` (default) closes
+// it with flat ends of the drum's material; `ends: periodic` makes the axis periodic. After one
+// revolution of spin-up the surface is sampled 24 times over the next revolution: particles in
+// the middle half of the depth (all when periodic) projected on the cross-section; the extent of
+// their centres split into bins of width d50, surface = largest height + radius in a bin, a line
+// fitted to the bins in the middle 60 % of the extent; dynamic_angle_deg = mean |atan(slope)|.
+// Flag `slipping` when the particles within one diameter of the drum wall move along it at less
+// than half the wall speed on average (the bed slides as a block instead of being carried up).
+//
+// Set-up decisions: the drum is a static inline mesh (tube, and end discs for `walls`) whose
+// surface moves as a rotation about the axis (SurfaceVelocitySpec rotation). A cylinder turning
+// about its own axis occupies the same space at every instant, so only the contact velocity
+// changes; a rotating Motion was rejected because it makes the contact lists rebuild as the
+// facets move, for the same physics. Facets are at most d50/2 long, so the wall velocity leaves
+// the facet plane by at most 1.5 %. Periodic: the tube reaches two diameters beyond the period.
+// The fill is a jittered cubic lattice (spacing 1.05 largest bounding diameters) in the lowest
+// part of the drum; it collapses during the spin-up revolution.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "particles.h"
+#include "virtual_test_support.h"
+
+namespace dem::materials::detail {
+
+namespace {
+
+/// The protocol's surface-line extraction on one sample; returns |angle| [deg], or -1 when the
+/// bed has fewer than two bins to fit.
+double surface_angle(const State& s, double d50, double half_depth, bool periodic) {
+  double lo = 1e300, hi = -1e300;
+  auto use = [&](size_t p) { return periodic || std::abs(s.y[p]) <= 0.5 * half_depth; };
+  for (size_t p = 0; p < s.size(); ++p)
+    if (use(p)) lo = std::min(lo, s.x[p]), hi = std::max(hi, s.x[p]);
+  if (!(hi > lo)) return -1;
+  const int bins = std::max(1, static_cast<int>(std::ceil((hi - lo) / d50)));
+  std::vector<double> surface(bins, -1e300);
+  for (size_t p = 0; p < s.size(); ++p) {
+    if (!use(p)) continue;
+    const int b = std::min(bins - 1, static_cast<int>((s.x[p] - lo) / d50));
+    surface[b] = std::max(surface[b], s.z[p] + s.radius[p]);
+  }
+  std::vector<double> x, z;
+  const double extent = hi - lo;
+  for (int b = 0; b < bins; ++b) {
+    const double centre = lo + (b + 0.5) * d50;
+    if (surface[b] > -1e300 && centre >= lo + 0.2 * extent && centre <= hi - 0.2 * extent) x.push_back(centre), z.push_back(surface[b]);
+  }
+  if (x.size() < 2) return -1;
+  return std::abs(std::atan(fit_line(x, z).second)) * 180 / std::numbers::pi;
+}
+
+}  // namespace
+
+SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
+  const Clock clock;
+  const SetupReader read(model, setup);
+  const double scale = options.size_factor;
+  const double diameter = scale * read.number("drum_diameter", 1e-3, 20.0, "m");
+  const double depth = scale * read.number("drum_depth", 1e-3, 20.0, "m");
+  const double fill = read.number("fill_fraction", 0.05, 0.7, "-");
+  const double rpm = read.number("rpm", 0.01, 1000.0, "rev/min");
+  const double poured = read.number("poured_solid_fraction", 0.6, 0.2, 0.74, "-");
+  const bool periodic = read.word("ends", "walls", {"walls", "periodic"}) == "periodic";
+  const std::string wall_material = read.wall("wall");
+  const SizeFigures size = size_figures(model);
+  const double radius = 0.5 * diameter, d50 = size.d50, spacing = 1.05 * size.largest * size.bounding_factor;
+  const double omega = rpm * 2 * std::numbers::pi / 60, revolution = 60 / rpm;
+  if (radius < 3 * spacing)
+    read.fail("drum_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than six particles across; make it at least {:g} m",
+                                           diameter / scale, scale, 6 * spacing / scale));
+
+  CaseSpec spec = base_case(model, options, {wall_material}, "rotating_drum");
+  // The drum about the y axis: built about z, turned by 90 deg about x (z -> y).
+  const int around = segments_around(radius, 0.5 * d50);
+  const double reach = periodic ? 2 * spacing : 0.0;
+  Mesh drum;
+  drum.tube(radius, -0.5 * depth - reach, 0.5 * depth + reach, around, std::max(d50, depth / 4));
+  if (!periodic) drum.disc(radius, -0.5 * depth, around, true), drum.disc(radius, 0.5 * depth, around, false);
+  MeshWallSpec wall = drum.wall("drum", wall_material);
+  wall.rotate_deg = Vec3(90, 0, 0);
+  wall.surface.kind = SurfaceVelocitySpec::Kind::rotation;
+  wall.surface.axis = Vec3(0, 1, 0), wall.surface.point = Vec3::Zero(), wall.surface.angular_speed = omega;
+  spec.meshes.push_back(wall);
+  spec.simulation.has_domain = true;
+  spec.simulation.domain_min = Vec3(-radius - 0.01, -0.5 * depth - (periodic ? 0.0 : 0.01), -radius - 0.01);
+  spec.simulation.domain_max = Vec3(radius + 0.01, 0.5 * depth + (periodic ? 0.0 : 0.01), radius + 0.01);
+  spec.simulation.periodic[1] = periodic;
+
+  // The fill: the lowest sites of a jittered cubic lattice inside the drum.
+  const auto count = static_cast<std::int64_t>(std::ceil(fill * std::numbers::pi * radius * radius * depth * poured / size.mean_volume));
+  const int layers = std::max(1, static_cast<int>(std::floor((periodic ? depth : depth - spacing) / spacing + (periodic ? 0 : 1))));
+  const double sy = periodic ? depth / layers : spacing;
+  ParticleSetSpec set = particle_box(model, 0, Vec3::Zero(), Vec3::Zero());
+  Random jitter(options.seed * 7919 + 13);
+  const double inner = radius - 0.5 * spacing;
+  for (double z = -inner; z <= inner && static_cast<std::int64_t>(set.positions.size()) < count; z += spacing) {
+    const double half_chord = std::sqrt(std::max(0.0, inner * inner - z * z));
+    for (double x = -half_chord; x <= half_chord && static_cast<std::int64_t>(set.positions.size()) < count; x += spacing)
+      for (int k = 0; k < layers && static_cast<std::int64_t>(set.positions.size()) < count; ++k) {
+        const double y = -0.5 * depth + (periodic ? 0.5 * sy : 0.5 * spacing) + k * sy;
+        set.positions.push_back(Vec3(x + 0.02 * spacing * (jitter.uniform() - 0.5), y + 0.02 * spacing * (jitter.uniform() - 0.5), z));
+      }
+  }
+  if (static_cast<std::int64_t>(set.positions.size()) < count)
+    read.fail("fill_fraction", fmt::format("{:g}: the drum cannot be filled from a lattice with {} particles; use a smaller fill", fill, count));
+  spec.particles.push_back(set);
+
+  SimulatedOutcome out;
+  Runner run(spec);
+  const std::int64_t particles = static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
+  progress(options, fmt::format("rotating_drum: {} particles, {:.3g} m drum at {:g} rpm", particles, diameter, rpm));
+  // Spin-up, then 24 samples over one revolution.
+  run.advance_until([] { return false; }, revolution, revolution);
+  const int samples = 24;
+  double angle_sum = 0, carried_sum = 0;
+  int used = 0;
+  for (int k = 1; k <= samples; ++k) {
+    run.advance_until([] { return false; }, revolution * (1 + double(k) / samples), revolution);
+    const double angle = surface_angle(run.state, d50, 0.5 * depth, periodic);
+    if (angle >= 0) angle_sum += angle, ++used;
+    // How fast the wall layer moves along the wall, as a share of the wall speed.
+    double along = 0;
+    int n = 0;
+    for (size_t p = 0; p < run.state.size(); ++p) {
+      const double x = run.state.x[p], z = run.state.z[p], rho = std::hypot(x, z);
+      if (rho < radius - spacing || rho == 0) continue;
+      along += (run.state.vx[p] * z - run.state.vz[p] * x) / rho, ++n;  // omega along +y: v = w y x r
+    }
+    carried_sum += n ? along / n / (omega * radius) : 0.0;
+  }
+  const double carried = carried_sum / samples;
+  out.observables["dynamic_angle_deg"] = used ? angle_sum / used : 0.0;
+  if (carried < 0.5) out.flags.push_back("slipping");
+  out.notes.push_back(fmt::format("wall layer moves at {:.0f} % of the wall speed; {} of {} samples fitted", 100 * carried, used, samples));
+  finish(out, run, clock, particles, options);
+  return out;
+}
+
+}  // namespace dem::materials::detail

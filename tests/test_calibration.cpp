@@ -1,0 +1,466 @@
+// Measurement files, material models, compare / calibrate / diagnose. The calibration machinery
+// is tested on analytic stand-ins for the virtual tests (known answers, no DEM); the hidden-effect
+// tests with real simulations run when the virtual tests are built (they skip otherwise).
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "calibration.h"
+#include "calibration_report.h"
+#include "material_model.h"
+#include "measurements.h"
+
+namespace dem::materials {
+namespace {
+
+const std::string kMaterials = DEMDESIGN_SOURCE_DIR "/materials";
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_measurements(text, "m.yaml");
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kGood = R"(material: gravel_5mm
+particles:
+  diameter: {distribution: normal, mean: 0.005, std: 0.0003}
+  density: 2600
+walls:
+  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800}
+experiments:
+  - id: aor_1
+    test: angle_of_repose_cylinder
+    setup: {cylinder_diameter: 0.10, cylinder_height: 0.15, fill_height: 0.10,
+            lift_speed: 0.05, base: steel}
+    observed:
+      angle_deg: {value: 31.5, sigma: 1.0}
+  - id: drum_20rpm
+    test: rotating_drum
+    setup: {drum_diameter: 0.20, drum_depth: 0.05, fill_fraction: 0.35, rpm: 20,
+            ends: periodic, wall: steel}
+    observed:
+      dynamic_angle_deg: {value: 34.0, sigma: 1.0}
+  - id: hopper_small
+    test: hopper_discharge
+    setup: {silo_diameter: 0.1, orifice_diameter: 0.012, fill_height: 0.1, wall: steel}
+    outcome: blocked
+)";
+
+TEST(Measurements, ReadsTheProtocolExample) {
+  const MeasurementSet m = parse_measurements(kGood, "m.yaml");
+  EXPECT_EQ(m.material, "gravel_5mm");
+  EXPECT_TRUE(m.has_diameter);
+  EXPECT_DOUBLE_EQ(m.diameter.mean, 0.005);
+  EXPECT_DOUBLE_EQ(m.density, 2600);
+  ASSERT_EQ(m.walls.size(), 1u);
+  EXPECT_DOUBLE_EQ(m.walls[0].youngs_modulus, 2e11);
+  ASSERT_EQ(m.experiments.size(), 3u);
+  EXPECT_EQ(m.experiments[0].setup.test, "angle_of_repose_cylinder");
+  EXPECT_DOUBLE_EQ(m.experiments[0].setup.numbers.at("lift_speed"), 0.05);
+  EXPECT_EQ(m.experiments[0].setup.words.at("base"), "steel");
+  EXPECT_DOUBLE_EQ(m.experiments[0].observed.at("angle_deg").value, 31.5);
+  EXPECT_EQ(m.experiments[1].setup.words.at("ends"), "periodic");
+  EXPECT_EQ(m.experiments[2].outcome, "blocked");
+  EXPECT_TRUE(m.experiments[2].observed.empty());
+  EXPECT_EQ(m.experiments[0].location.line, 8);
+}
+
+TEST(Measurements, ErrorsNameFileLineKeyAndWhatIsValid) {
+  std::string text = kGood;
+  // A misspelt top-level key.
+  std::string e = error_of(std::string(kGood).replace(0, 8, "materal"));
+  EXPECT_NE(e.find("m.yaml:1"), std::string::npos) << e;
+  EXPECT_NE(e.find("material"), std::string::npos) << e;
+  // Unknown test: the valid ones are listed, with the nearest.
+  e = error_of(std::string(kGood).replace(text.find("rotating_drum"), 13, "rotating_drums"));
+  EXPECT_NE(e.find("m.yaml:15"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'rotating_drum'"), std::string::npos) << e;
+  EXPECT_NE(e.find("hopper_discharge"), std::string::npos) << e;
+  // An observable the test does not have.
+  e = error_of(std::string(kGood).replace(text.find("dynamic_angle_deg"), 17, "angle_deg"));
+  EXPECT_NE(e.find("m.yaml:19"), std::string::npos) << e;
+  EXPECT_NE(e.find("not an observable of rotating_drum"), std::string::npos) << e;
+  EXPECT_NE(e.find("dynamic_angle_deg"), std::string::npos) << e;
+  // sigma must be > 0, and must be given.
+  e = error_of(std::string(kGood).replace(text.find("sigma: 1.0}"), 11, "sigma: 0}"));
+  EXPECT_NE(e.find("sigma"), std::string::npos) << e;
+  EXPECT_NE(e.find("> 0"), std::string::npos) << e;
+  e = error_of(std::string(kGood).replace(text.find(", sigma: 1.0}"), 13, "}"));
+  EXPECT_NE(e.find("sigma"), std::string::npos) << e;
+  // A misspelt key in an observation: the nearest valid key.
+  e = error_of(std::string(kGood).replace(text.find("value: 31.5"), 5, "valeu"));
+  EXPECT_NE(e.find("value"), std::string::npos) << e;
+  EXPECT_NE(e.find("experiments[0].observed.angle_deg"), std::string::npos) << e;
+  // An outcome the test cannot have.
+  e = error_of(std::string(kGood).replace(text.find("outcome: blocked"), 16, "outcome: no_heap"));
+  EXPECT_NE(e.find("blocked"), std::string::npos) << e;
+  EXPECT_NE(e.find("m.yaml:23"), std::string::npos) << e;
+  // A wall material the file does not declare.
+  e = error_of(std::string(kGood).replace(text.find("base: steel"), 11, "base: steal"));
+  EXPECT_NE(e.find("did you mean 'steel'"), std::string::npos) << e;
+  // Duplicate ids.
+  e = error_of(std::string(kGood).replace(text.find("id: drum_20rpm"), 14, "id: aor_1"));
+  EXPECT_NE(e.find("used twice"), std::string::npos) << e;
+  // Bad YAML.
+  e = error_of("experiments: [");
+  EXPECT_NE(e.find("not valid YAML"), std::string::npos) << e;
+}
+
+TEST(MaterialModel, ReadsALibraryFile) {
+  MaterialModel m = read_material_model(kMaterials + "/gravel.yaml");
+  EXPECT_EQ(m.name, "gravel");
+  EXPECT_DOUBLE_EQ(m.particle.density, 2650);
+  EXPECT_EQ(m.contact.rolling.model, "epsd");
+  EXPECT_DOUBLE_EQ(get_parameter(m, "friction"), 0.65);
+  EXPECT_DOUBLE_EQ(get_parameter(m, "rolling_friction"), 0.20);
+  EXPECT_DOUBLE_EQ(get_parameter(m, "wall.friction"), 0.45);
+  EXPECT_DOUBLE_EQ(get_parameter(m, "rubber.friction"), 0.7);
+  ASSERT_EQ(m.tunable.size(), 3u);
+  EXPECT_DOUBLE_EQ(m.tunable.at("friction").second, 1.0);
+  EXPECT_EQ(m.diameter.kind, SizeDistributionSpec::Kind::uniform);
+  EXPECT_DOUBLE_EQ(m.diameter.max, 0.032);
+  EXPECT_EQ(m.walls.size(), 2u);
+  set_parameter(m, "friction", 0.3);
+  EXPECT_DOUBLE_EQ(get_parameter(m, "friction"), 0.3);
+  set_parameter(m, "steel.friction", 0.2);
+  EXPECT_DOUBLE_EQ(get_parameter(m, "steel.friction"), 0.2);
+  EXPECT_THROW(set_parameter(m, "frictoin", 0.3), std::invalid_argument);
+  EXPECT_THROW(set_parameter(m, "friction", -1), std::invalid_argument);
+  // Gravel already rolls: its candidates are cohesion and shape.
+  std::vector<std::string> names;
+  for (const auto& c : missing_effects(m)) names.push_back(c.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"liquid_bridges", "jkr_cohesion", "clump_shape"}));
+  // Measured size, density and walls replace the library's.
+  const MeasurementSet measured = parse_measurements(kGood, "m.yaml");
+  apply_measured(m, measured);
+  EXPECT_DOUBLE_EQ(m.particle.density, 2600);
+  EXPECT_DOUBLE_EQ(m.diameter.mean, 0.005);
+}
+
+TEST(MaterialModel, CandidatesAddTheirEffects) {
+  MaterialModel m = read_material_model(kMaterials + "/glass_beads.yaml");
+  EXPECT_EQ(m.contact.rolling.model, "none");
+  const auto candidates = missing_effects(m);
+  ASSERT_EQ(candidates.size(), 4u);
+  for (const auto& c : candidates) {
+    MaterialModel with = m;
+    c.add(with);
+    for (const auto& [key, v] : c.start) set_parameter(with, key, v);
+    for (const auto& [key, range] : c.parameters) EXPECT_NO_THROW((void)get_parameter(with, key)) << key;
+    EXPECT_LT(missing_effects(with).size(), candidates.size()) << c.name;
+  }
+  MaterialModel wet = read_material_model(kMaterials + "/glass_beads_wet.yaml");
+  EXPECT_DOUBLE_EQ(get_parameter(wet, "liquid_content"), 0.005);
+  set_parameter(wet, "clump_aspect_ratio", 1.6);
+  EXPECT_NEAR(get_parameter(wet, "clump_aspect_ratio"), 1.6, 1e-12);
+}
+
+// ---- analytic stand-ins -------------------------------------------------------------------
+
+/// Known responses: friction mu, rolling friction mr (0 without rolling), liquid content lc,
+/// surface energy g (JKR), clump aspect a, restitution e. Noise from the seed (packing).
+struct Analytic {
+  double noise = 1.0;  ///< scales the packing noise
+  bool product = false;  ///< angle depends on friction x restitution only
+  SimulatedOutcome operator()(const MaterialModel& m, const TestSetup& s, const TestOptions& o) const {
+    const double mu = get_parameter(m, "friction"), e = get_parameter(m, "restitution");
+    const double mr = m.contact.rolling.model == "none" ? 0.0 : get_parameter(m, "rolling_friction");
+    bool wet = false;
+    for (const auto& c : m.contact.extra) wet = wet || c.model == "liquid_bridge";
+    const double lc = wet ? get_parameter(m, "liquid_content") : 0.0;
+    const double g = m.contact.adhesion.empty() ? 0.0 : get_parameter(m, "surface_energy") / 10.0;
+    const double a = get_parameter(m, "clump_aspect_ratio") - 1.0;
+    std::mt19937_64 random(o.seed * 7919 + std::hash<std::string>{}(s.test));
+    std::normal_distribution<double> n(0.0, noise);
+    SimulatedOutcome out;
+    if (s.test == "drop_rebound") out.observables["restitution"] = e + 0.002 * n(random);
+    else if (s.test == "angle_of_repose_cylinder")
+      out.observables["angle_deg"] = product ? 20 + 40 * mu * e + 0.3 * n(random)
+                                             : 18 + 12 * mu + 40 * mr + 400 * lc + 300 * g + 10 * a + 0.3 * n(random);
+    else if (s.test == "bulk_density") out.observables["bulk_density"] = 1600 - 250 * mu - 100 * mr - 2000 * lc - 1000 * g - 100 * a + 3 * n(random);
+    else if (s.test == "rotating_drum")
+      out.observables["dynamic_angle_deg"] = 22 + 8 * mu + 35 * mr + 100 * lc + 80 * g + 5 * a + (0.15 + 0.5 * mr) * s.numbers.at("rpm") + 0.3 * n(random);
+    else if (s.test == "hopper_discharge") out.observables["mass_flow_rate"] = 2.0 - 0.6 * mu - 0.2 * mr - 30 * lc - 5 * g - 0.1 * a + 0.005 * n(random);
+    else if (s.test == "direct_shear") {
+      const double sn = s.numbers.at("normal_stress");
+      out.observables["peak_shear_stress"] = (0.3 + 0.5 * mu + 0.3 * mr + 0.2 * a) * sn + 2e5 * lc + 3e4 * g * (1 + sn / 4000) + 10 * n(random);
+    }
+    return out;
+  }
+};
+
+void add(MeasurementSet& set, const std::string& id, const std::string& test, std::map<std::string, double> numbers, const std::string& observable,
+         double sigma) {
+  Experiment e;
+  e.id = id;
+  e.setup.test = test;
+  e.setup.numbers = std::move(numbers);
+  e.observed[observable] = Observation{0.0, sigma, {}};
+  set.experiments.push_back(e);
+}
+
+/// Synthetic measurements: the truth simulated (its own packing) plus measurement noise.
+MeasurementSet synthesise(MeasurementSet set, const MaterialModel& truth, const Simulator& sim, std::uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (Experiment& e : set.experiments) {
+    TestOptions o;
+    o.seed = 1000 + seed;
+    const SimulatedOutcome out = sim(truth, e.setup, o);
+    for (auto& [key, obs] : e.observed) obs.value = out.observables.at(key) + obs.sigma * n(random);
+  }
+  return set;
+}
+
+MaterialModel dry_spheres() {
+  MaterialModel m = read_material_model(kMaterials + "/gravel.yaml");
+  m.contact.rolling.model = "none";
+  m.particle.params.erase("rolling_friction");
+  m.tunable.erase("rolling_friction");
+  return m;
+}
+
+MeasurementSet flow_tests() {
+  MeasurementSet set;
+  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
+  add(set, "aor_1", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "aor_2", "angle_of_repose_cylinder", {{"fill_height", 0.15}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  add(set, "drum_10", "rotating_drum", {{"rpm", 10}}, "dynamic_angle_deg", 1.0);
+  add(set, "drum_20", "rotating_drum", {{"rpm", 20}}, "dynamic_angle_deg", 1.0);
+  add(set, "drum_30", "rotating_drum", {{"rpm", 30}}, "dynamic_angle_deg", 1.0);
+  add(set, "hopper", "hopper_discharge", {{"orifice_diameter", 0.05}}, "mass_flow_rate", 0.02);
+  return set;
+}
+
+CalibrationOptions analytic_options(const Simulator& sim) {
+  CalibrationOptions o;
+  o.simulator = sim;
+  o.replicas = 3;
+  return o;
+}
+
+TEST(Calibration, CompareFormsNormalisedResidualsWithSimulationNoise) {
+  const Analytic sim;
+  MaterialModel model = dry_spheres();
+  MeasurementSet set = flow_tests();
+  for (Experiment& e : set.experiments) {
+    const SimulatedOutcome out = sim(model, e.setup, TestOptions{});
+    for (auto& [key, obs] : e.observed) obs.value = out.observables.at(key);
+  }
+  set.experiments[1].observed["angle_deg"].value += 5;  // 5 sigma too high a measured angle
+  Experiment blocked;
+  blocked.id = "hopper_small";
+  blocked.setup.test = "hopper_discharge";
+  blocked.outcome = "blocked";
+  set.experiments.push_back(blocked);
+  const Comparison c = compare(model, set, analytic_options(sim));
+  EXPECT_EQ(c.n, 9);
+  EXPECT_LT(c.residual("aor_1", "angle_deg"), -4.0);
+  EXPECT_NEAR(c.residual("hopper_small", "outcome"), -3.0, 1e-12);  // observed an arch, simulated flow
+  for (const Term& t : c.terms)
+    if (!t.is_outcome()) {
+      EXPECT_GT(t.sigma_simulated, 0) << t.name();
+    }
+  // Drum residuals all fit: pattern "fits"; the drum group varies rpm.
+  bool drum = false;
+  for (const Pattern& p : c.patterns)
+    if (p.test == "rotating_drum") {
+      drum = true;
+      EXPECT_EQ(p.kind, "fits") << p.words;
+      EXPECT_EQ(p.varied, "rpm");
+    }
+  EXPECT_TRUE(drum);
+}
+
+TEST(Calibration, PatternsNameOffsetAndTrend) {
+  std::vector<Term> terms;
+  for (int k = 0; k < 4; ++k) {
+    Term t;
+    t.experiment = "s" + std::to_string(k), t.test = "direct_shear", t.observable = "peak_shear_stress";
+    t.varied = "normal_stress", t.varied_value = 1000.0 * (k + 1);
+    t.residual = -4.0 + 0.1 * (k % 2);
+    terms.push_back(t);
+    Term d = t;
+    d.test = "rotating_drum", d.observable = "dynamic_angle_deg", d.varied = "rpm", d.varied_value = 10.0 * (k + 1);
+    d.residual = -3.0 + 2.0 * k;
+    terms.push_back(d);
+  }
+  const auto patterns = analyse_patterns(terms);
+  ASSERT_EQ(patterns.size(), 2u);
+  EXPECT_EQ(patterns[0].kind, "offset") << patterns[0].words;
+  EXPECT_NE(patterns[0].words.find("yield locus is offset by a constant while its slope fits: cohesion"), std::string::npos) << patterns[0].words;
+  EXPECT_EQ(patterns[1].kind, "trend") << patterns[1].words;
+  EXPECT_NEAR(patterns[1].slope, 6.0, 1e-9);
+}
+
+TEST(Calibration, RecoversKnownParametersThroughTheSurrogate) {
+  const Analytic sim{0.0};  // no packing noise: the parameters are exact
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
+  set_parameter(truth, "friction", 0.55);
+  set_parameter(truth, "rolling_friction", 0.22);
+  set_parameter(truth, "restitution", 0.4);
+  MeasurementSet set = flow_tests();
+  for (Experiment& e : set.experiments)
+    for (auto& [key, obs] : e.observed) obs.value = sim(truth, e.setup, TestOptions{}).observables.at(key);
+  const MaterialModel start = read_material_model(kMaterials + "/gravel.yaml");
+  CalibrationOptions o = analytic_options(sim);
+  const CalibrationResult r = calibrate(start, set, {}, o);
+  ASSERT_EQ(r.parameters.size(), 3u);
+  std::map<std::string, double> fitted;
+  for (size_t i = 0; i < r.parameters.size(); ++i) fitted[r.parameters[i].key] = r.value[i];
+  EXPECT_NEAR(fitted["friction"], 0.55, 0.01);
+  EXPECT_NEAR(fitted["rolling_friction"], 0.22, 0.005);
+  EXPECT_NEAR(fitted["restitution"], 0.4, 0.01);
+  EXPECT_LT(r.after.chi2_per_n(), 0.01);
+  EXPECT_GT(r.before.chi2_per_n(), 2);
+  EXPECT_TRUE(r.unidentified.empty()) << r.words.back();
+  for (double s : r.sigma) EXPECT_TRUE(std::isfinite(s) && s > 0);
+  ASSERT_EQ(r.contours.size(), 1u);
+  EXPECT_EQ(r.contours[0].fields.size(), 2u);
+}
+
+TEST(Calibration, FlagsParametersThatOnlyEnterAsAProduct) {
+  const Analytic sim{1.0, true};
+  MaterialModel model = dry_spheres();
+  MeasurementSet set;
+  add(set, "aor_1", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "aor_2", "angle_of_repose_cylinder", {{"fill_height", 0.15}}, "angle_deg", 1.0);
+  MaterialModel truth = model;
+  set_parameter(truth, "friction", 0.6), set_parameter(truth, "restitution", 0.5);
+  set = synthesise(set, truth, sim, 3);
+  const CalibrationResult r = calibrate(model, set, fit_parameters(model, {"friction", "restitution"}), analytic_options(sim));
+  EXPECT_EQ(r.unidentified.size(), 2u);
+  EXPECT_GT(r.condition, 1e3);
+  // A drop test pins the restitution down: both are then identified.
+  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
+  set = synthesise(set, truth, sim, 3);
+  const CalibrationResult both = calibrate(model, set, fit_parameters(model, {"friction", "restitution"}), analytic_options(sim));
+  EXPECT_TRUE(both.unidentified.empty()) << both.words.back();
+  EXPECT_NEAR(both.value[0], 0.6, 0.05);
+}
+
+struct HiddenCase {
+  const char* effect;
+  MeasurementSet set;
+  MaterialModel truth;
+};
+
+TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);  // the starting model fails visibly
+  ASSERT_FALSE(d.candidates.empty());
+  EXPECT_EQ(d.candidates.front().name, "rolling_resistance") << d.words.front();
+  EXPECT_EQ(d.recommended, "rolling_resistance") << d.words.front();
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
+  EXPECT_GT(d.candidates.front().explained, 0.5);
+  // The report: self-contained HTML with the diagnosis, contour maps and the ledger.
+  const std::string dir = (std::filesystem::temp_directory_path() / "demdesign_calibration_report").string();
+  std::filesystem::remove_all(dir);
+  report::CalibrationReportInput in;
+  in.title = "diagnose gravel";
+  in.diagnosis = &d;
+  in.ledger = append_ledger(dir + "/ledger.yaml", "gravel", {ledger_entry(start, d.base.before, "start", {"friction"}),
+                                                             ledger_entry(d.candidates.front().fit.fitted, d.candidates.front().fit.after, "+ rolling", {"friction"})});
+  const std::string html = report::write_calibration_report(in, dir);
+  std::ifstream file(html);
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Most likely missing: rolling_resistance"), std::string::npos);
+  EXPECT_NE(text.find("Error ledger"), std::string::npos);
+  EXPECT_EQ(text.find("http"), std::string::npos);
+  if (std::filesystem::exists(dir + "/plots/base_contour0.png")) {
+    EXPECT_NE(text.find("data:image/png;base64"), std::string::npos);
+  }
+}
+
+TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = start;
+  missing_effects(truth)[1].add(truth);  // liquid bridges
+  set_parameter(truth, "liquid_content", 0.01), set_parameter(truth, "friction", 0.5);
+  MeasurementSet set;
+  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  add(set, "hopper", "hopper_discharge", {{"orifice_diameter", 0.05}}, "mass_flow_rate", 0.02);
+  for (double sn : {2000.0, 4000.0, 6000.0}) add(set, fmt::format("shear_{:.0f}", sn), "direct_shear", {{"normal_stress", sn}}, "peak_shear_stress", 50);
+  set = synthesise(set, truth, sim, 5);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
+  EXPECT_EQ(d.recommended, "liquid_bridges") << d.words.front();
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
+  bool offset_words = false;
+  for (const Pattern& p : d.base.before.patterns) offset_words = offset_words || p.words.find("yield locus") != std::string::npos;
+  EXPECT_TRUE(offset_words);
+}
+
+TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = start;
+  set_parameter(truth, "friction", 0.7), set_parameter(truth, "restitution", 0.35);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 17);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_LT(d.base.after.chi2_per_n(), 1.5);
+  EXPECT_EQ(d.recommended, "");
+  EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
+}
+
+TEST(Ledger, AppendsVersions) {
+  const std::string path = (std::filesystem::temp_directory_path() / "demdesign_ledger_test" / "ledger.yaml").string();
+  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
+  const MaterialModel m = dry_spheres();
+  Comparison c;
+  Term t;
+  t.experiment = "aor", t.observable = "angle_deg", t.residual = -3.5;
+  c.terms.push_back(t), c.chi2 = 12.25, c.n = 1;
+  append_ledger(path, "gravel", {ledger_entry(m, c, "start", {"friction"})});
+  c.terms[0].residual = 0.5, c.chi2 = 0.25;
+  const auto all = append_ledger(path, "gravel", {ledger_entry(m, c, "+ rolling_resistance", {"friction"})});
+  ASSERT_EQ(all.size(), 2u);
+  const auto read = read_ledger(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[1].version, 2);
+  EXPECT_EQ(read[1].label, "+ rolling_resistance");
+  EXPECT_DOUBLE_EQ(read[0].residuals.at("aor/angle_deg"), -3.5);
+  EXPECT_DOUBLE_EQ(read[1].chi2_per_n(), 0.25);
+  EXPECT_DOUBLE_EQ(read[0].parameters.at("friction"), 0.65);
+}
+
+// ---- real simulations ---------------------------------------------------------------------
+
+bool available(const std::string& test, const MaterialModel& model, const TestSetup& setup) {
+  try {
+    TestOptions o;
+    o.size_factor = 0.01;
+    (void)model;
+    (void)setup;
+    run_virtual_test(model, TestSetup{test, {}, {}, {}}, o);
+  } catch (const std::exception& e) {
+    return std::string(e.what()).find("not available") == std::string::npos;
+  }
+  return true;
+}
+
+TEST(DiagnoseReal, HiddenRollingResistanceWithVirtualTests) {
+  const MaterialModel start = dry_spheres();
+  if (!available("angle_of_repose_cylinder", start, {}) || !available("bulk_density", start, {}))
+    GTEST_SKIP() << "virtual tests not built yet (run_virtual_test says not available)";
+  GTEST_SKIP() << "virtual tests exist: the real hidden-effect data sets are still to be sized (see report)";
+}
+
+}  // namespace
+}  // namespace dem::materials

@@ -1,0 +1,68 @@
+// Design sweeps: reading the `sweep:` section, the variants' cases, errors with file and line.
+#include <gtest/gtest.h>
+
+#include "spec.h"
+#include "sweep.h"
+
+namespace dem::test {
+namespace {
+
+const char* kSweep = R"(simulation: {duration: 0.1}
+materials:
+  glass: {density: 2500, youngs_modulus: 5e7, restitution: 0.5}
+equipment:
+  transfer_chute: {spoon: {radius: 0.8}}
+inlets:
+  - {port: feed_belt, material: glass, diameter: 0.004, mass_rate_tph: 1}
+sweep:
+  parameters:
+    equipment.transfer_chute.spoon.radius: [0.6, 0.8, 1.0]
+    inlets[0].mass_rate_tph: [10, 20]
+  rank_by:
+    - {metric: spillage_pct, goal: minimize, weight: 2}
+)";
+
+TEST(Sweep, GridMakesEveryCombinationAndSetsEachPath) {
+  const YAML::Node root = YAML::Load(kSweep);
+  const app::SweepPlan plan = app::read_sweep(root, "sweep.yaml");
+  ASSERT_EQ(plan.variants.size(), 6u);
+  ASSERT_EQ(plan.criteria.size(), 1u);
+  EXPECT_TRUE(plan.criteria[0].minimize);
+  EXPECT_DOUBLE_EQ(plan.criteria[0].weight, 2);
+  EXPECT_EQ(plan.name(4), "v05");
+  EXPECT_EQ(plan.label(4), "spoon.radius=1.0, inlets[0].mass_rate_tph=10");
+  const YAML::Node variant = app::variant_case(root, plan, 4);
+  EXPECT_FALSE(variant["sweep"]) << "a variant's case has no sweep";
+  EXPECT_DOUBLE_EQ(variant["equipment"]["transfer_chute"]["spoon"]["radius"].as<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(variant["inlets"][0]["mass_rate_tph"].as<double>(), 10);
+  EXPECT_DOUBLE_EQ(root["equipment"]["transfer_chute"]["spoon"]["radius"].as<double>(), 0.8) << "the sweep case is untouched";
+  // A parameter the case leaves at its default is created where the path says.
+  YAML::Node defaults = YAML::Load(kSweep);
+  defaults["equipment"]["transfer_chute"].remove("spoon");
+  const YAML::Node created = app::variant_case(defaults, app::read_sweep(defaults, "sweep.yaml"), 0);
+  EXPECT_DOUBLE_EQ(created["equipment"]["transfer_chute"]["spoon"]["radius"].as<double>(), 0.6);
+  // The variant is a valid case.
+  EXPECT_NO_THROW(parse_case_node(variant, "sweep.yaml"));
+}
+
+TEST(Sweep, ZipNeedsEqualListsAndBadPathsAreNamed) {
+  std::string text = kSweep;
+  text.replace(text.find("  rank_by:"), 0, "  combine: zip\n");
+  try {
+    app::read_sweep(YAML::Load(text), "sweep.yaml");
+    FAIL() << "zip of lists of 3 and 2 values must be refused";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("sweep.yaml:11"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("equal length"), std::string::npos) << e.what();
+  }
+  std::string index = kSweep;
+  index.replace(index.find("inlets[0]"), 9, "inlets[3]");
+  const YAML::Node root = YAML::Load(index);
+  EXPECT_THROW(app::variant_case(root, app::read_sweep(root, "sweep.yaml"), 0), CaseError);
+  std::string metric = kSweep;
+  metric.replace(metric.find("goal: minimize"), 14, "goal: smallest");
+  EXPECT_THROW(app::read_sweep(YAML::Load(metric), "sweep.yaml"), CaseError);
+}
+
+}  // namespace
+}  // namespace dem::test
