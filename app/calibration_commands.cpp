@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <set>
 #include <filesystem>
 #include <iostream>
 
@@ -42,6 +46,7 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
   test_->add_option("--threads", threads_, "OpenMP threads");
   test_->add_option("--measurements", measurements_, "measurement file whose size, density and walls to use");
   test_->add_option("--png", png_, "render of the final state (default: test_NAME.png)");
+  test_->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
   for (CLI::App** cmd : {&compare_, &calibrate_, &diagnose_}) {
     const char* name = cmd == &compare_ ? "compare" : cmd == &calibrate_ ? "calibrate" : "diagnose";
     const char* what = cmd == &compare_ ? "simulate every experiment of a measurement file and compare (report in --out)"
@@ -56,7 +61,22 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
     (*cmd)->add_option("--seed", seed_, "first packing seed");
     (*cmd)->add_option("--out", out_, "output folder (report, plots, ledger.yaml)");
     (*cmd)->add_flag("--quiet", quiet_, "no progress lines");
-    if (cmd != &compare_) (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
+    (*cmd)->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
+    if (cmd != &compare_) {
+      (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
+      (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)");
+      (*cmd)->add_option("--design-factor", design_factor_, "design points per round = max(b+1, ceil(factor b)+2), b quadratic coefficients");
+    }
+    if (cmd == &diagnose_) {
+      (*cmd)->add_option("--effects", effects_, "effects to consider, comma separated (default: every effect the material lacks)");
+      (*cmd)->add_option("--confirm", confirm_, "leading candidates confirmed by recalibration");
+    }
+    if (cmd == &compare_) {
+      (*cmd)->add_option("--synthetic-from", synthetic_from_,
+                         "instead of comparing: simulate this TRUTH material on every experiment of MEASUREMENTS, add Gaussian noise of "
+                         "each observation's sigma and write OUT/synthetic_measurements.yaml (synthetic data)");
+      (*cmd)->add_option("--noise-seed", noise_seed_, "seed of the added measurement noise (--synthetic-from)");
+    }
   }
 }
 
@@ -64,7 +84,7 @@ bool CalibrationCommands::parsed() const { return test_->parsed() || compare_->p
 
 int CalibrationCommands::run() {
   if (test_->parsed()) return run_test();
-  if (compare_->parsed()) return run_measured("compare");
+  if (compare_->parsed()) return synthetic_from_.empty() ? run_measured("compare") : write_synthetic();
   if (calibrate_->parsed()) return run_measured("calibrate");
   return run_measured("diagnose");
 }
@@ -72,6 +92,7 @@ int CalibrationCommands::run() {
 int CalibrationCommands::run_test() {
   MaterialModel model = read_material_model(material_);
   if (!measurements_.empty()) apply_measured(model, read_measurements(measurements_));
+  model.stiffness_scaling = stiffness_scaling_;
   TestSetup setup;
   setup.test = test_name_;
   setup.location.file = "--set";
@@ -109,8 +130,13 @@ int CalibrationCommands::run_measured(const std::string& command) {
   MaterialModel model = read_material_model(material_);
   const MeasurementSet measured = read_measurements(measurements_);
   apply_measured(model, measured);
+  model.stiffness_scaling = stiffness_scaling_;
   CalibrationOptions options;
   options.replicas = replicas_;
+  options.rounds = rounds_;
+  options.design_factor = design_factor_;
+  options.confirm_candidates = confirm_;
+  options.effects = split(effects_);
   options.size_factor = size_factor_;
   options.threads = threads_;
   options.seed = static_cast<std::uint64_t>(seed_);
@@ -164,9 +190,82 @@ int CalibrationCommands::run_measured(const std::string& command) {
     input.ledger = append_ledger(ledger_path, model.name, entries);
   }
   if (input.ledger.empty()) input.ledger = read_ledger(ledger_path);
+  // Renders of final states: the model as compared, the fitted one, or the recommended one.
+  const MaterialModel* shown = &model;
+  if (command == "calibrate") shown = &calibration.fitted;
+  if (command == "diagnose") {
+    shown = &diagnosis.base.fitted;
+    for (const auto& c : diagnosis.candidates)
+      if (c.name == diagnosis.recommended && c.confirmed) shown = &c.fit.fitted;
+  }
+  input.images = render_tests(*shown, measured, options);
   input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::string html = report::write_calibration_report(input, out_);
   std::cout << fmt::format("report: {} ({:.0f} s)\n", html, input.wall_seconds);
+  return 0;
+}
+
+std::vector<std::string> CalibrationCommands::render_tests(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {
+  std::vector<std::string> out;
+  if (!render_) return out;
+  std::set<std::string> done;
+  fs::create_directories(fs::path(out_) / "renders");
+  for (const Experiment& e : measured.experiments) {
+    if (!done.insert(e.setup.test).second) continue;
+    const std::string png = (fs::path(out_) / "renders" / fmt::format("{}_{}.png", e.setup.test, e.id)).string();
+    TestOptions t;
+    t.seed = options.seed, t.threads = options.threads, t.size_factor = options.size_factor;
+    t.on_final = [&](const Model& m, const State& s) { render_(m, s, png); };
+    try {
+      (void)run_virtual_test(model, e.setup, t);
+      if (fs::exists(png)) out.push_back(png);
+    } catch (const std::exception& error) {
+      std::cerr << fmt::format("render of {}: {}\n", e.id, error.what());
+    }
+  }
+  return out;
+}
+
+/// Text of the template with each observation's `value:` replaced (at the observation's line).
+int CalibrationCommands::write_synthetic() {
+  MaterialModel truth = read_material_model(synthetic_from_);
+  const MeasurementSet measured = read_measurements(measurements_);
+  apply_measured(truth, measured);
+  truth.stiffness_scaling = stiffness_scaling_;
+  std::ifstream in(measurements_);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::mt19937_64 random(static_cast<std::uint64_t>(noise_seed_));
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (const Experiment& e : measured.experiments) {
+    TestOptions t;
+    t.seed = static_cast<std::uint64_t>(seed_), t.threads = threads_, t.size_factor = size_factor_;
+    const SimulatedOutcome sim = run_virtual_test(truth, e.setup, t);
+    for (const auto& [key, obs] : e.observed) {
+      const auto it = sim.observables.find(key);
+      if (it == sim.observables.end()) throw CaseError(fmt::format("{}: {}: the truth's simulation gave no {}", obs.location.str(), e.id, key));
+      const double value = it->second + obs.sigma * normal(random);
+      std::cout << fmt::format("{:<16} {:<20} truth {:.6g}  + noise -> {:.6g} (sigma {:.3g})\n", e.id, key, it->second, value, obs.sigma);
+      const int line = obs.location.line - 1;
+      if (line < 0 || line >= static_cast<int>(lines.size())) throw CaseError(fmt::format("{}: {}: no line for {}", measurements_, e.id, key));
+      std::string& text = lines[line];
+      const size_t from = text.find("value:", obs.location.column > 0 ? obs.location.column - 1 : 0);
+      if (from == std::string::npos) throw CaseError(fmt::format("{}: write `{}: {{value: ..., sigma: ...}}` on one line", obs.location.str(), key));
+      size_t start = from + 6;
+      while (start < text.size() && text[start] == ' ') ++start;
+      size_t end = start;
+      while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || std::strchr("+-.eE", text[end]))) ++end;
+      text.replace(start, end - start, fmt::format("{:.5g}", value));
+    }
+  }
+  fs::create_directories(out_);
+  const std::string path = (fs::path(out_) / "synthetic_measurements.yaml").string();
+  std::ofstream file(path);
+  file << fmt::format("# SYNTHETIC: values simulated with {} (seed {}, size factor {:g}, stiffness scaling {:g}) plus Gaussian noise of each sigma "
+                      "(noise seed {}), written by `demdesign compare {} {} --synthetic-from {} ...`\n",
+                      synthetic_from_, seed_, size_factor_, stiffness_scaling_, noise_seed_, material_, measurements_, synthetic_from_);
+  for (const std::string& line : lines) file << line << "\n";
+  std::cout << "wrote " << path << "\n";
   return 0;
 }
 

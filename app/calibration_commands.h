@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration.h"
 #include "model.h"
 #include "state.h"
 
@@ -37,10 +38,15 @@ class CalibrationCommands {
   CLI::App* compare_ = nullptr;
   CLI::App* calibrate_ = nullptr;
   CLI::App* diagnose_ = nullptr;
-  std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_;
+  std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_, effects_, synthetic_from_;
   std::vector<std::string> set_;
-  double size_factor_ = 1.0;
-  int replicas_ = 3, threads_ = 0;
+  double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
+  int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2;
+  long long noise_seed_ = 1;
+  int write_synthetic();
+  /// One render of the final state per test type of the measurement file, with `model`.
+  std::vector<std::string> render_tests(const materials::MaterialModel& model, const materials::MeasurementSet& measured,
+                                        const materials::CalibrationOptions& options);
   long long seed_ = 1;
   bool quiet_ = false;
 };

@@ -149,7 +149,7 @@ bool draw_contour_plot(const ContourPlot& plot, const std::string& png_path, std
     }
     s += "unset contour\nset surface\n";
     s += terminal(plot.width, plot.height, fs::path(png_path).filename().string());
-    s += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\nset cblabel {}\nset key below noenhanced\nset palette defined (0 '#f7fbff', 1 '#c6dbef', 2 '#6baed6', 3 '#2171b5')\n",
+    s += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\nset cblabel {}\nset key tmargin center horizontal noenhanced\nset palette defined (0 '#f7fbff', 1 '#c6dbef', 2 '#6baed6', 3 '#2171b5')\n",
                      gnuplot_string(plot.title), gnuplot_string(plot.x_label), gnuplot_string(plot.y_label), gnuplot_string(plot.background_label));
     s += fmt::format("set xrange [{}:{}]\nset yrange [{}:{}]\n", number(plot.x.front()), number(plot.x.back()), number(plot.y.front()), number(plot.y.back()));
     s += fmt::format("plot {} using 1:2:3 with image notitle", gnuplot_string(stem + "_background.dat"));

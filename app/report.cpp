@@ -340,10 +340,11 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
     const double change = fill.slope * duration, passed = primary.own.mean / kTonnesPerHourPerKgPerSecond * duration;
     if (std::abs(fill.t_stat) > 3 && std::abs(change) > 0.05 * std::max(passed, 1e-12)) {
       primary.own.found = false;
-      primary.own.why = fmt::format("still {}: the hold-up {} by {} kg from {} s to {} s, {} % of the {} kg that left; run longer",
+      const std::string share = passed > 1e-9 ? fmt::format("{} % of the {} kg that left", num(100 * std::abs(change) / passed), num(passed))
+                                              : std::string("while nothing has left yet");
+      primary.own.why = fmt::format("still {}: the hold-up {} by {} kg from {} s to {} s, {}; run longer",
                                     change > 0 ? "filling" : "emptying", change > 0 ? "rose" : "fell", num(std::abs(change)),
-                                    num(primary.own.t_start, 3), num(t_end, 3), num(100 * std::abs(change) / std::max(passed, 1e-12)),
-                                    num(passed));
+                                    num(primary.own.t_start, 3), num(t_end, 3), share);
     }
   }
   const bool steady = primary.own.found;

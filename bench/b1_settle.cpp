@@ -36,6 +36,7 @@
 //     the dense bed, bed about 0.078 m high for 20k.
 //
 // Usage: bench_b1_settle [--n 20000|100000] [--threads T] [--phase1-steps S1] [--phase2-steps S2]
+//        bench_b1_settle --n N --liggghts-data FILE   (writes the same lattice for LIGGGHTS; --n first)
 //   Without --n it runs 20,000 and then 100,000. Each run prints a table row per phase and one
 //   line per phase starting with "csv," (header line "csv,N,...") for committing results.
 //   The peak memory is reset before each size (/proc/self/clear_refs); where that is not
@@ -131,6 +132,20 @@ std::vector<dem::Vec3> lattice(const Size& b) {
         out.emplace_back((i + 0.5) * kSpacing + jx, (j + 0.5) * kSpacing + jy, (k + 0.5) * kSpacing);
       }
   return out;
+}
+
+/// Writes the lattice of size `b` as a LIGGGHTS data file (atom_style granular: id type diameter
+/// density x y z), so that the LIGGGHTS run of bench/b1_side_by_side.sh starts from exactly the
+/// same positions as this program.
+void write_liggghts_data(const Size& b, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path));
+  const std::vector<dem::Vec3> centres = lattice(b);
+  out << fmt::format("LIGGGHTS data file: B1 box settle lattice {} x {} x {} (bench_b1_settle)\n\n{} atoms\n1 atom types\n\n", b.nx,
+                     b.ny, b.nz, centres.size());
+  out << fmt::format("0 {:.17g} xlo xhi\n0 {:.17g} ylo yhi\n0 {:.17g} zlo zhi\n\nAtoms\n\n", b.lx, b.ly, (b.nz + 1) * kSpacing + 0.01);
+  for (size_t p = 0; p < centres.size(); ++p)
+    out << fmt::format("{} 1 0.004 2500 {:.17g} {:.17g} {:.17g}\n", p + 1, centres[p].x(), centres[p].y(), centres[p].z());
 }
 
 /// VmHWM in bytes (0 when unknown).
@@ -311,7 +326,7 @@ std::vector<Row> run_size(long n, std::optional<std::int64_t> phase1, std::optio
 
 [[noreturn]] void usage(const char* argv0, const std::string& problem) {
   std::fprintf(stderr,
-               "%s\nusage: %s [--n 20000|100000] [--threads T] [--phase1-steps S1] [--phase2-steps S2]\n"
+               "%s\nusage: %s [--n 20000|100000] [--threads T] [--phase1-steps S1] [--phase2-steps S2] [--liggghts-data FILE]\n"
                "  default: N = 20000 then 100000, all threads, the spec's step counts\n",
                problem.c_str(), argv0);
   std::exit(2);
@@ -328,6 +343,15 @@ int main(int argc, char** argv) {
     if (arg == "-h" || arg == "--help") usage(argv[0], "B1 box settle benchmark");
     if (a + 1 >= argc) usage(argv[0], "missing value after " + arg);
     const std::string value = argv[++a];
+    if (arg == "--liggghts-data") {  // write the lattice for LIGGGHTS and stop
+      try {
+        write_liggghts_data(size_for(sizes.size() == 1 ? sizes[0] : 20000), value);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_b1_settle: %s\n", e.what());
+        return 1;
+      }
+      return 0;
+    }
     char* end = nullptr;
     const long long v = std::strtoll(value.c_str(), &end, 10);
     if (end == value.c_str() || *end != '\0' || v < 0) usage(argv[0], arg + ": not a non-negative integer: " + value);

@@ -6,7 +6,8 @@
 // (length, 0, -R_p)). Idler stations every idler.spacing from the tail up to the transition:
 // a centre roll and two wing rolls of idler.roll_diameter under the belt (static meshes for the
 // renders; particles do not reach them). Skirts at y = +-skirt.width/2 from skirt.start for
-// skirt.length with a back plate across at the start; the loading port is between them.
+// skirt.length with a back plate across at the start; the loading port is between them, above
+// the wing tops (no particle is inserted into the belt), and feeds at belt speed.
 // CEMA discharge: r = R_p + belt_thickness + a1 with a1 = load_height / 2; with V^2 / (g r) >=
 // cos(inclination) the material leaves at the tangent point, otherwise at the angle from vertical
 // where cos(angle) = V^2 / (g r) (CEMA, Belt Conveyors for Bulk Materials, 7th ed., ch. 12).
@@ -121,12 +122,16 @@ Generated belt_conveyor(MapReader& reader, const EquipmentSpec& spec) {
     skirts.transform(tilt, Vec3::Zero());
     out.meshes.push_back(skirts.wall("skirts", materials.liner, where));
   }
-  // Loading port between the skirts near the tail, above the centre roll.
+  // Loading port between the skirts near the tail: 70 % of the belt width (inside the skirts),
+  // above the wing tops so that no particle is inserted into the belt, long enough to take a
+  // batch at the design rate; material arrives at belt speed, as from a loading chute.
   const double port_x = skirt_start + 0.1;
   {
-    const auto [lo, hi] = rotated_box(tilt, Vec3(port_x, -0.45 * centre, 0.02),
-                                      Vec3(port_x + std::min(0.5, 0.5 * skirt_length), 0.45 * centre, 0.02 + 0.15));
-    out.ports.push_back({"loading", lo, hi, Vec3::Zero()});
+    const double half = std::min(0.35 * width, 0.5 * skirt_width - 0.02);
+    const double bottom = trough_height(width, trough, half) + 0.01;
+    const auto [lo, hi] = rotated_box(tilt, Vec3(port_x, -half, bottom),
+                                      Vec3(port_x + std::min(1.0, skirt_length - 0.2), half, bottom + 0.25));
+    out.ports.push_back({"loading", lo, hi, speed * along});
   }
   // Outlet: below and beyond the head pulley where the stream lands.
   const Vec3 head = tilt * Vec3(length, 0, -pulley_radius);

@@ -136,7 +136,13 @@ class VertexWelder {
 
 /// Appends the triangles of `mesh`, placed by `placement`, to `out`; returns how many faces were
 /// points or lines (dropped). A mirroring placement reverses the winding to keep it outward.
-std::size_t append_mesh(const aiMesh& mesh, const Affine& placement, VertexWelder& welder, TriangleMesh& out) {
+/// Triangles (in file order) with a non-finite corner: how many, and up to 10 examples.
+struct NonFinite {
+  std::vector<std::size_t> examples;
+  std::size_t count = 0;
+};
+
+std::size_t append_mesh(const aiMesh& mesh, const Affine& placement, VertexWelder& welder, TriangleMesh& out, NonFinite& bad) {
   std::size_t dropped = 0;
   const bool mirrored = placement.determinant() < 0;
   for (unsigned int f = 0; f < mesh.mNumFaces; ++f) {
@@ -148,6 +154,13 @@ std::size_t append_mesh(const aiMesh& mesh, const Affine& placement, VertexWelde
     std::array<std::int32_t, 3> triangle{};
     for (int corner = 0; corner < 3; ++corner) {
       const aiVector3D& v = mesh.mVertices[face.mIndices[corner]];
+      // NaN or infinite coordinates: welding and repair would hide them (a NaN vertex makes a
+      // "degenerate" triangle that is silently removed); refused with the triangles named.
+      if (!(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))) {
+        if (bad.examples.size() < 10 && (bad.examples.empty() || bad.examples.back() != out.triangles.size()))
+          bad.examples.push_back(out.triangles.size());
+        ++bad.count;
+      }
       triangle[corner] = welder.index_of(placement.apply({double(v.x), double(v.y), double(v.z)}));
     }
     if (mirrored) std::swap(triangle[1], triangle[2]);
@@ -260,6 +273,36 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
       path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " + kExportAdvice;
   if (!has_surface) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
 
+  // Non-finite coordinates, before post-processing hides them (joining identical vertices merges
+  // a NaN vertex into another, and the repair then drops the "degenerate" triangle silently).
+  {
+    NonFinite bad;
+    std::size_t face_index = 0;
+    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh* mesh = scene->mMeshes[m];
+      if (!mesh || !mesh->mVertices) continue;
+      for (unsigned int f = 0; f < mesh->mNumFaces; ++f, ++face_index) {
+        const aiFace& face = mesh->mFaces[f];
+        bool finite = true;
+        for (unsigned int c = 0; c < face.mNumIndices && face.mIndices; ++c) {
+          if (face.mIndices[c] >= mesh->mNumVertices) continue;  // ValidateDataStructure refuses it below
+          const aiVector3D& v = mesh->mVertices[face.mIndices[c]];
+          finite = finite && std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+        }
+        if (finite) continue;
+        if (bad.examples.size() < 10) bad.examples.push_back(face_index);
+        ++bad.count;
+      }
+    }
+    if (bad.count > 0) {
+      std::string which;
+      for (std::size_t t : bad.examples) which += (which.empty() ? "" : ", ") + std::to_string(t);
+      throw MeshError(MeshError::Kind::unreadable,
+                      path + ": " + std::to_string(bad.count) + " faces have a corner with non-finite coordinates (NaN or "
+                          "infinity), e.g. triangles " + which + " (0-based, in file order); the file is damaged: re-export it");
+    }
+  }
+
   // Validate first (so broken files are refused, not crashed on), then triangulate and join.
   try {
     scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
@@ -277,6 +320,7 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   TriangleMesh out;
   out.source = path;
   VertexWelder welder(out.vertices);
+  NonFinite bad;
   const Affine placement = from_options(options);
   std::size_t points_and_lines = 0;
   std::vector<std::pair<const aiNode*, Affine>> stack;
@@ -287,13 +331,20 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
     const Affine global = compose(parent, from_assimp(node->mTransformation));
     for (unsigned int k = 0; k < node->mNumMeshes; ++k)
       if (node->mMeshes[k] < scene->mNumMeshes)
-        points_and_lines += append_mesh(*scene->mMeshes[node->mMeshes[k]], global, welder, out);
+        points_and_lines += append_mesh(*scene->mMeshes[node->mMeshes[k]], global, welder, out, bad);
     for (unsigned int child = 0; child < node->mNumChildren; ++child)
       if (node->mChildren[child]) stack.emplace_back(node->mChildren[child], global);
   }
   // A scene whose nodes reference no mesh at all: take the meshes as they are.
   if (out.triangles.empty() && points_and_lines == 0)
-    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) append_mesh(*scene->mMeshes[m], placement, welder, out);
+    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) append_mesh(*scene->mMeshes[m], placement, welder, out, bad);
+  if (bad.count > 0) {
+    std::string which;
+    for (std::size_t t : bad.examples) which += (which.empty() ? "" : ", ") + std::to_string(t);
+    throw MeshError(MeshError::Kind::unreadable,
+                    path + ": " + std::to_string(bad.count) + " triangle corners have non-finite coordinates (NaN or infinity), "
+                        "e.g. in triangles " + which + " (0-based, in file order); the file is damaged: re-export it");
+  }
   if (out.triangles.empty()) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
   if (out.vertices.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
     throw MeshError(MeshError::Kind::unreadable, path + ": more than 2^31 vertices; decimate the mesh before import");

@@ -489,12 +489,15 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
   std::map<std::string, int> index;
   for (size_t i = 0; i < names.size(); ++i) index[names[i]] = static_cast<int>(i);
 
-  const int points = options.design_points > 0 ? options.design_points : 2 * basis_size(p) + 2;
+  const int points = options.design_points > 0
+                         ? options.design_points
+                         : std::max(basis_size(p) + 1, static_cast<int>(std::ceil(options.design_factor * basis_size(p))) + 2);
   const int rounds = std::max(1, options.rounds);
   Progress progress{options, "design", rounds * points * static_cast<int>(measured.experiments.size()) + options.replicas * static_cast<int>(measured.experiments.size())};
   std::vector<FitParameter> box = parameters;
   Eigen::VectorXd x_best(p);
   for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].min, parameters[i].max);
+  Surrogate full_range;  // of round 1, over the whole parameter box: drawn in the contour maps
   Eigen::MatrixXd all_points(0, p), all_values(0, static_cast<Eigen::Index>(names.size()));
   for (int round = 0; round < rounds; ++round) {
     if (round > 0) {
@@ -552,6 +555,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
     Eigen::MatrixXd P(inside.size(), p), V(inside.size(), all_values.cols());
     for (size_t r = 0; r < inside.size(); ++r) P.row(r) = all_points.row(inside[r]), V.row(r) = all_values.row(inside[r]);
     result.surrogate = fit_surrogate(box, names, P, V, sigma);
+    if (round == 0) full_range = result.surrogate;
     // Starts: the best design points and the centre of the box.
     SurrogateObjective objective{&result.surrogate, measured_values, sigma};
     std::vector<std::pair<double, int>> ranked;
@@ -645,7 +649,13 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
     if (result.surrogate.fit_rms[t] > 1.0)
       result.words.push_back(fmt::format("The surrogate of {} misses its design points by {:.1f} sigma RMS: it is not quadratic over the box.", names[t],
                                          result.surrogate.fit_rms[t]));
-  if (p >= 2) result.contours.push_back(contour_map(result, 0, 1));
+  if (p >= 2) {
+    // The maps span the full range (round 1's surrogate), so every measured contour appears;
+    // the result keeps the last round's surrogate.
+    CalibrationResult wide = result;
+    wide.surrogate = full_range;
+    result.contours.push_back(contour_map(wide, 0, 1));
+  }
   return result;
 }
 
@@ -751,8 +761,16 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     }
     for (size_t j = 0; j < parameters.size(); ++j) A.col(static_cast<Eigen::Index>(j)) *= (parameters[j].max - parameters[j].min);
   }
-  Progress progress{options, "signature", static_cast<int>(missing_effects(d.base.fitted).size() * measured.experiments.size())};
-  for (const EffectCandidate& c : missing_effects(d.base.fitted)) {
+  // The candidates: every effect the model lacks, or those options.effects names.
+  std::vector<EffectCandidate> effects;
+  for (EffectCandidate& c : missing_effects(d.base.fitted))
+    if (options.effects.empty() || std::find(options.effects.begin(), options.effects.end(), c.name) != options.effects.end())
+      effects.push_back(std::move(c));
+  // The signature run of each candidate is the candidate model at its start: it serves as the
+  // "before" of its confirmation (same packing seed, the base's simulation noise).
+  std::map<std::string, Comparison> at_start;
+  Progress progress{options, "signature", static_cast<int>(effects.size() * measured.experiments.size())};
+  for (const EffectCandidate& c : effects) {
     CandidateResult cr;
     cr.name = c.name, cr.description = c.description;
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
@@ -770,7 +788,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     }
     std::map<std::string, double> floor;
     for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
-    const Comparison changed = compare_runs(measured, runs, options, floor);
+    const Comparison& changed = at_start[c.name] = compare_runs(measured, runs, options, floor);
     Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
     for (int i = 0; i < nt; ++i) {
       const Term& t = base.terms[i];
@@ -798,15 +816,14 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     int confirmed = 0;
     for (CandidateResult& cr : d.candidates) {
       if (confirmed >= options.confirm_candidates || cr.explained < 0.05) break;
-      const auto all = missing_effects(d.base.fitted);
-      const auto it = std::find_if(all.begin(), all.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
+      const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
       MaterialModel with = d.base.fitted;
       it->add(with);
       for (const auto& [key, v] : it->start) set_parameter(with, key, v);
       std::vector<FitParameter> params = parameters;
       params.insert(params.end(), cr.adds.begin(), cr.adds.end());
       if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
-      cr.fit = calibrate(with, measured, params, options);
+      cr.fit = calibrate(with, measured, params, options, &at_start.at(cr.name));
       cr.confirmed = true;
       cr.chi2 = cr.fit.after.chi2;
       cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);

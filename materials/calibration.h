@@ -51,13 +51,18 @@ struct CalibrationOptions {
   double size_factor = 1.0;     ///< passed to the virtual tests
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default
   std::uint64_t seed = 1;       ///< first packing seed; the design uses this one
-  int design_points = 0;        ///< per round; 0: 2 x (quadratic coefficients) + 2
+  int design_points = 0;        ///< per round; 0: from design_factor
+  /// Design points per round when design_points is 0: max(b + 1, ceil(design_factor x b) + 2),
+  /// b the quadratic coefficients (3 for one parameter, 6 for two). Below 2 for fast screening.
+  double design_factor = 2.0;
   int rounds = 2;               ///< surrogate rounds; round 2 spans a quarter of each range around round 1's optimum
   int starts = 8;               ///< NLopt starts (best design points and the centre)
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise
   double bic_margin = 10.0;         ///< an effect is recommended when it lowers BIC by more than this
   int confirm_candidates = 2;       ///< leading candidates confirmed by recalibration
+  /// Effects diagnose considers (names of missing_effects); empty: every effect the model lacks.
+  std::vector<std::string> effects;
   /// Progress lines (with time left); empty: quiet.
   std::function<void(const std::string&)> progress;
   /// Final state of every simulation (the app renders the last); may be empty.

@@ -45,7 +45,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   const double area = std::numbers::pi * radius * radius;
   const auto count = static_cast<std::int64_t>(std::ceil(area * fill * 0.6 / size.mean_volume));
   const double half = (radius - reach) / std::sqrt(2.0);
-  const double column = count * size.mean_volume / (0.25 * 4 * half * half);
+  const double column = count * size.mean_volume / (0.15 * 4 * half * half);
   const double z0 = reach + 0.002, z1 = z0 + column;
   auto make_spec = [&](double open_at) {
     CaseSpec spec = base_case(model, options, {wall_material}, "hopper_discharge");

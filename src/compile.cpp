@@ -15,6 +15,9 @@
 
 namespace dem {
 
+/// Most particles a case may create at the start (a bound on memory, see compile).
+constexpr std::int64_t kMaxParticles = 20'000'000;
+
 namespace {
 
 double mix(Mixing rule, double a, double b) {
@@ -46,7 +49,10 @@ void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, in
   if (choice.model == "none") return;
   const EffectSpec* spec = find_effect(stage, choice.model);
   ActiveEffect active{spec, param_cursor, model.history_width, {}};
-  for (const auto& [key, value] : choice.options) {
+  for (const auto& option_value : choice.options) {
+    // Named copies, not structured bindings: clang 14 (the fuzz build) cannot capture those.
+    const std::string& key = option_value.first;
+    const std::string& value = option_value.second;
     const auto option = std::find_if(spec->options.begin(), spec->options.end(),
                                      [&](const OptionSpec& o) { return o.key == key; });
     if (option == spec->options.end()) {
@@ -318,6 +324,31 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     }
     model.sources.push_back(std::move(source));
   }
+  // Particle counts are bounded before anything is allocated for them: a mistyped `count`
+  // (an extra zero or three) must be an error, not an out-of-memory kill minutes later.
+  {
+    std::int64_t total = 0;
+    for (size_t k = 0; k < spec.particles.size(); ++k) {
+      const ParticleSetSpec& p = spec.particles[k];
+      total += p.count;
+      if (total > kMaxParticles)
+        throw CaseError(fmt::format("{}: particles[{}].count: {} particles in all exceeds the limit of {} (about {:.0f} GB at "
+                                    "~1 kB per particle with its contacts); lower `count`",
+                                    p.location.str(), k, total, kMaxParticles, kMaxParticles * 1e3 / 1e9));
+      if (!p.positions.empty()) continue;
+      // Random placement without overlap stops near 30-35 % solid: refuse what cannot fit
+      // before drawing any diameter.
+      const double region = (p.region_max - p.region_min).prod();
+      const double d = p.diameter.smallest();
+      const double scale = p.clump.empty() ? 1.0 : 0.5;  // a clump's spheres may overlap
+      const double solid = static_cast<double>(p.count) * std::numbers::pi / 6.0 * d * d * d * scale;
+      if (!(solid <= 0.6 * region))
+        throw CaseError(fmt::format("{}: particles[{}].count: {} particles of at least {:g} m hold {:.3g} m^3 of solid, "
+                                    "{:.0f} % of the region's {:.3g} m^3; random placement stops near 30-35 %. Enlarge "
+                                    "`region` or lower `count`",
+                                    p.location.str(), k, p.count, d, solid, 100.0 * solid / region, region));
+    }
+  }
   const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());
   for (size_t k = 0; k < spec.inlets.size(); ++k) {
     const InletSpec& in = spec.inlets[k];
@@ -351,6 +382,9 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   model.duration = s.duration;
   model.gravity = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
   model.seed = s.seed;
+  model.stop_on_trouble = s.stop_on_trouble;
+  model.max_overlap_ratio = s.max_overlap_ratio;
+  model.energy_rise_limit = s.energy_rise_limit;
   model.threads = s.threads;
   model.skin = s.skin > 0 ? s.skin : 0.5 * model.radius_min;
   model.has_domain = s.has_domain;

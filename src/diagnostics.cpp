@@ -191,4 +191,88 @@ void check_numerics(const Model& model, const State& s, const Workspace& work, d
   }
 }
 
+double mechanical_energy(const Model& model, const State& s) {
+  const double g[3] = {model.gravity[0], model.gravity[1], model.gravity[2]};
+  double energy = 0;
+  for (size_t p = 0; p < s.size(); ++p) {
+    if (s.body[p] >= 0 || (!s.attached.empty() && s.attached[p] >= 0)) continue;
+    const double m = 1.0 / s.inv_mass[p], inertia = 1.0 / s.inv_inertia[p];
+    energy += 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
+    energy += 0.5 * inertia * (s.wx[p] * s.wx[p] + s.wy[p] * s.wy[p] + s.wz[p] * s.wz[p]);
+    energy -= m * (g[0] * s.x[p] + g[1] * s.y[p] + g[2] * s.z[p]);
+  }
+  const Bodies& b = s.bodies;
+  for (size_t k = 0; k < b.size(); ++k) {
+    energy += 0.5 * b.mass[k] * (b.vx[k] * b.vx[k] + b.vy[k] * b.vy[k] + b.vz[k] * b.vz[k]) + body_rotational_energy(s, k);
+    energy -= b.mass[k] * (g[0] * b.x[k] + g[1] * b.y[k] + g[2] * b.z[k]);
+  }
+  return energy;
+}
+
+std::string energy_source(const Model& model) {
+  if (!model.inlets.empty()) return "inlets insert energy";
+  for (const PlaneWall& w : model.planes) {
+    if (w.servo) return fmt::format("wall '{}' is servo-controlled", w.name);
+    if (w.velocity[0] != 0 || w.velocity[1] != 0 || w.velocity[2] != 0) return fmt::format("wall '{}' moves", w.name);
+  }
+  for (const MeshWall& m : model.meshes) {
+    if (!m.motion.is_static()) return fmt::format("mesh '{}' moves", m.name);
+    if (m.surface_velocity.kind != SurfaceVelocitySpec::Kind::none) return fmt::format("mesh '{}' has a moving surface", m.name);
+  }
+  for (const ActiveEffect& e : model.effects)
+    if (e.spec->stage == Stage::adhesion || e.spec->stage == Stage::extra)
+      return fmt::format("'{}' attracts particles (surface energy becomes motion)", e.spec->name);
+  if (model.has_attached) return "particles are glued to a wall";
+  return "";
+}
+
+namespace {
+
+/// The energy a source-free run may not gain: each particle's weight over its own diameter
+/// (settling, elastic rebound of a packing) plus the initial kinetic energy; at least 1e-12 J.
+double energy_scale(const Model& model, const State& s) {
+  const double g = std::sqrt(model.gravity[0] * model.gravity[0] + model.gravity[1] * model.gravity[1] +
+                             model.gravity[2] * model.gravity[2]);
+  double scale = 0;
+  for (size_t p = 0; p < s.size(); ++p) {
+    const double m = 1.0 / s.inv_mass[p];
+    scale += m * g * 2.0 * s.radius[p] + 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
+  }
+  return std::max(scale, 1e-12);
+}
+
+}  // namespace
+
+EnergyWatch::EnergyWatch(const Model& model, const State& state, double fraction)
+    : source_(energy_source(model)), fraction_(fraction) {
+  lowest_ = mechanical_energy(model, state);
+  scale_ = energy_scale(model, state);
+}
+
+void EnergyWatch::check(const Model& model, const State& s) {
+  if (!active()) return;
+  const double energy = mechanical_energy(model, s);
+  if (!std::isfinite(energy)) return;  // check_numerics names the particle
+  // Against the energy at the start, not the lowest so far: a contact stores elastic energy
+  // (not counted here) and gives it back on rebound.
+  if (energy - lowest_ > fraction_ * scale_) {
+    size_t fastest = 0;
+    double v2 = -1;
+    for (size_t p = 0; p < s.size(); ++p) {
+      const double w = s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p];
+      if (w > v2) v2 = w, fastest = p;
+    }
+    const double rise = energy - lowest_;
+    lowest_ = energy;  // report each rise once when the run only warns (numerical_trouble: warn)
+    throw NumericalError(fmt::format(
+        "t = {:.6g} s, step {}: the energy (kinetic + gravitational) rose by {:.3g} J above its value at the start ({:.0f} % of the energy scale "
+        "{:.3g} J, limit {:.0f} %) although nothing in this case supplies energy; the fastest particle is {} at "
+        "[{:.4g}, {:.4g}, {:.4g}] m moving at {:.3g} m/s.\nLikely causes: a time step too large against the Rayleigh time "
+        "or the contact time ({}); a stiffness too high for the step; particles created overlapping each other or a wall.",
+        s.time, s.step, rise, 100 * rise / scale_, scale_, 100 * fraction_, s.size() ? s.id[fastest] : -1,
+        s.size() ? s.x[fastest] : 0.0, s.size() ? s.y[fastest] : 0.0, s.size() ? s.z[fastest] : 0.0, std::sqrt(std::max(v2, 0.0)),
+        model.advice.report));
+  }
+}
+
 }  // namespace dem

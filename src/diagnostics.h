@@ -59,4 +59,31 @@ class NumericalError : public std::runtime_error {
 /// beyond `max_overlap_ratio` of its radius, naming the particle and the likely cause.
 void check_numerics(const Model& model, const State& state, const Workspace& work, double max_overlap_ratio = 0.5);
 
+/// Kinetic (translation and rotation) plus gravitational potential energy of the free
+/// particles and clumps [J] (glued particles move with their wall and are left out).
+double mechanical_energy(const Model& model, const State& state);
+
+/// Why the energy check cannot be used for this model ("" when it can): the model has an energy
+/// source (an inlet, a moving or servo wall, a moving mesh or belt surface, an attractive
+/// contact effect that converts surface energy into motion).
+std::string energy_source(const Model& model);
+
+/// Energy rise without a source: watches mechanical_energy() of a source-free model. A
+/// dissipative (or elastic, e = 1) system may not gain energy; the margin is `fraction` of the
+/// energy scale: the initial kinetic energy plus every particle's weight times its diameter.
+class EnergyWatch {
+ public:
+  EnergyWatch(const Model& model, const State& state, double fraction = 0.05);
+  /// Throws NumericalError when the energy exceeds its value at the start by more than the
+  /// margin, naming the fastest particle, where it is, and the likely cause.
+  void check(const Model& model, const State& state);
+  bool active() const { return source_.empty(); }
+  const std::string& source() const { return source_; }
+
+ private:
+  std::string source_;
+  double fraction_ = 0.05;
+  double lowest_ = 0, scale_ = 0;
+};
+
 }  // namespace dem

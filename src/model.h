@@ -144,6 +144,10 @@ struct Model {
   double radius_min = 0;          // [m]
   std::uint64_t seed = 1;
   int threads = 0;
+  // Numerical trouble (SimulationSpec): stop or warn; overlap and energy-rise limits.
+  bool stop_on_trouble = true;
+  double max_overlap_ratio = 0.5;
+  double energy_rise_limit = 0.05;
   bool has_domain = false;
   std::array<double, 3> domain_min{}, domain_max{};  // [m]
   std::array<double, 3> period{};  ///< [m] length of each periodic axis, 0 when not periodic

@@ -74,6 +74,9 @@ void remove_lost(const Model& model, State& state) {
         state.lost_mass += 1.0 / state.inv_mass[p];
       }
     }
+    if (verdict == -1) {
+      state.last_lost = {state.id[p], state.x[p], state.y[p], state.z[p], state.vx[p], state.vy[p], state.vz[p]};
+    }
   }
   if (!any) return;
   for (size_t b = 0; b < body_outlet.size(); ++b) {

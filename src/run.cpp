@@ -200,9 +200,21 @@ void write_file_atomically(const std::string& path, const std::string& content) 
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     out << content;
     out.flush();
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write (disk full or no permission?)", temporary));
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw std::runtime_error(fmt::format("{}: cannot write {} bytes (disk full, file size limit or no permission?); "
+                                           "the previous {} is kept unchanged",
+                                           path, content.size(), target.filename().string()));
+    }
   }
-  std::filesystem::rename(temporary, target);
+  std::error_code error;
+  std::filesystem::rename(temporary, target, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    throw std::runtime_error(fmt::format("{}: cannot replace it ({}); the previous version is kept", path, error.message()));
+  }
 }
 
 void print_setup(const Model& model, const State& state, std::ostream& log) {
@@ -264,9 +276,39 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     if (options.resume) frames->adopt_existing();
     else write_frame(*frames, state);
   }
+  // Trouble present from the start (particles created overlapping): told before the first step.
+  if (!options.resume) {
+    try {
+      check_numerics(model, state, work, model.max_overlap_ratio);
+    } catch (const NumericalError& e) {
+      if (model.stop_on_trouble) throw;
+      fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+    }
+  }
   stop_signal = 0;
   auto previous_int = std::signal(SIGINT, on_stop_signal);
   auto previous_term = std::signal(SIGTERM, on_stop_signal);
+  // Numerical trouble: checked every few steps (cheap next to a step), so it is caught within
+  // a few steps of its start, not at the next row of scalars.
+  const std::int64_t check_every = std::min<std::int64_t>(every, 10);
+  EnergyWatch energy(model, state, model.energy_rise_limit);
+  if (!energy.active()) fmt::print(log, "  energy check: off ({})\n", energy.source());
+  std::int64_t lost_reported = state.lost, warnings = 0;
+  auto trouble = [&](const NumericalError& e) {
+    if (model.stop_on_trouble) {
+      // Keep what was computed: the rows so far (the last checkpoint stays as it was).
+      if (options.write_files) {
+        try {
+          write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+        } catch (const std::exception&) {
+        }
+      }
+      std::signal(SIGINT, previous_int);
+      std::signal(SIGTERM, previous_term);
+      throw e;
+    }
+    if (warnings++ < 20) fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+  };
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -276,10 +318,26 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     step(model, state, work);
     particle_steps += static_cast<std::int64_t>(state.size());
     const bool last = state.step == last_step;
-    if (state.step % every == 0 || last) {
-      check_numerics(model, state, work);
-      summary.scalars.push_back(measure(model, state, work));
+    if (state.step % check_every == 0 || last) {
+      try {
+        check_numerics(model, state, work, model.max_overlap_ratio);
+        energy.check(model, state);
+      } catch (const NumericalError& e) {
+        trouble(e);
+      }
+      if (state.lost > lost_reported) {
+        const auto& p = state.last_lost;
+        // The first loss, then each tenfold: a leak is told, not repeated every step.
+        if (lost_reported == 0 || state.lost >= 10 * lost_reported)
+          fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; "
+                          "the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. Likely "
+                          "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
+                          "large that particles pass through a wall\n",
+                     state.time, state.lost, p.id, p.x, p.y, p.z, p.vx, p.vy, p.vz);
+        if (lost_reported == 0 || state.lost >= 10 * lost_reported) lost_reported = state.lost;
+      }
     }
+    if (state.step % every == 0 || last) summary.scalars.push_back(measure(model, state, work));
     if (frames && (state.step % frame_every == 0 || last)) {
       write_frame(*frames, state);
       if (options.on_frame) options.on_frame(model, state, work, out, last);
@@ -327,6 +385,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   if (options.write_files && !model.meshes.empty()) write_mesh_records(model, state, out);
   if (options.write_files) {
     write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
+    write_file_atomically(out + "/run_info.yaml",
+                          run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
+                                                        "  state_hash: {:016x}\n",
+                                                        state.step >= last_step ? "true" : "false", state.time, state.step,
+                                                        state.size(), state_hash(state, model.history_width)));
     fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", out,
                frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
   }

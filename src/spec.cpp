@@ -127,7 +127,7 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
     for (const std::string& key : t.keys()) {
       const YAML::Node range = t.node(key);
       if (!range.IsSequence() || range.size() != 2) t.fail(key, "must be a range [min, max]");
-      const double lo = MapReader::scalar_number(range[0], t, key), hi = MapReader::scalar_number(range[1], t, key);
+      const double lo = MapReader::finite_number(range[0], t, key), hi = MapReader::finite_number(range[1], t, key);
       if (!(lo < hi)) t.fail(key, "needs min < max");
       lib.material.tunable[key] = {lo, hi};
     }
@@ -255,9 +255,9 @@ SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
       map.fail("mass_fractions", "must be a list as long as 'values'");
     double sum = 0;
     for (size_t k = 0; k < values.size(); ++k) {
-      d.values.push_back(MapReader::scalar_number(values[k], map, "values"));
-      d.mass_fractions.push_back(MapReader::scalar_number(fractions[k], map, "mass_fractions"));
-      if (!(d.values.back() > 0)) map.fail("values", "diameters must be positive");
+      d.values.push_back(MapReader::finite_number(values[k], map, "values"));
+      d.mass_fractions.push_back(MapReader::finite_number(fractions[k], map, "mass_fractions"));
+      if (!(d.values.back() > 0 && d.values.back() <= 10)) map.fail("values", "diameters must be in (0, 10] m");
       if (!(d.mass_fractions.back() >= 0)) map.fail("mass_fractions", "fractions must not be negative");
       sum += d.mass_fractions.back();
     }
@@ -402,14 +402,14 @@ MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t i
       map.fail("triangles", "inline meshes need `vertices: [[x,y,z], ...]` and `triangles: [[i,j,k], ...]`");
     for (const auto& v : vertices) {
       if (!v.IsSequence() || v.size() != 3) map.fail("vertices", "each vertex must be [x, y, z]");
-      m.vertices.push_back({MapReader::scalar_number(v[0], map, "vertices"), MapReader::scalar_number(v[1], map, "vertices"),
-                            MapReader::scalar_number(v[2], map, "vertices")});
+      m.vertices.push_back({MapReader::finite_number(v[0], map, "vertices"), MapReader::finite_number(v[1], map, "vertices"),
+                            MapReader::finite_number(v[2], map, "vertices")});
     }
     for (const auto& t : triangles) {
       if (!t.IsSequence() || t.size() != 3) map.fail("triangles", "each triangle must be three vertex indices [i, j, k]");
       std::array<std::int32_t, 3> tri;
       for (int k = 0; k < 3; ++k) {
-        const double v = MapReader::scalar_number(t[k], map, "triangles");
+        const double v = MapReader::finite_number(t[k], map, "triangles");
         if (v < 0 || v >= static_cast<double>(m.vertices.size()) || v != std::floor(v))
           map.fail("triangles", fmt::format("vertex index {:g} is not one of the {} vertices (0-based)", v, m.vertices.size()));
         tri[k] = static_cast<std::int32_t>(v);
@@ -459,9 +459,9 @@ ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, 
     if (!positions.IsSequence() || positions.size() == 0) map.fail("positions", "must be a list of [x, y, z] centres");
     for (const auto& item : positions) {
       if (!item.IsSequence() || item.size() != 3) map.fail("positions", "each entry must be [x, y, z]");
-      p.positions.emplace_back(MapReader::scalar_number(item[0], map, "positions"),
-                               MapReader::scalar_number(item[1], map, "positions"),
-                               MapReader::scalar_number(item[2], map, "positions"));
+      p.positions.emplace_back(MapReader::finite_number(item[0], map, "positions"),
+                               MapReader::finite_number(item[1], map, "positions"),
+                               MapReader::finite_number(item[2], map, "positions"));
     }
     p.count = static_cast<int64_t>(p.positions.size());
   } else {
@@ -548,6 +548,9 @@ SimulationSpec read_simulation(const YAML::Node& node, const std::string& file) 
   }
   s.mass_scaling = map.number("mass_scaling", 1.0, 1e-6, 1e12);
   s.stiffness_scaling = map.number("stiffness_scaling", 1.0, 1e-9, 1e3);
+  s.stop_on_trouble = map.string("numerical_trouble", "stop", {"stop", "warn"}) == "stop";
+  s.max_overlap_ratio = map.number("max_overlap", s.max_overlap_ratio, 0.01, 1.0, "of the radius");
+  s.energy_rise_limit = map.number("energy_rise_limit", s.energy_rise_limit, 1e-4, 100.0, "of the energy scale");
   map.finish();
   return s;
 }
@@ -558,6 +561,17 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   if (!node) return o;
   MapReader map(node, file, "output");
   o.directory = map.string("directory", o.directory);
+  // Results stay inside the working directory: a case file (perhaps from someone else) may not
+  // write to an absolute path or climb out with `..`. `--out` on the command line may.
+  {
+    const std::filesystem::path dir(o.directory);
+    const std::filesystem::path normal = dir.lexically_normal();
+    if (o.directory.empty() || dir.is_absolute() || dir.has_root_name() || dir.has_root_directory() || normal.empty() ||
+        normal == "." || *normal.begin() == "..")
+      map.fail("directory", fmt::format("'{}' is not allowed: give a folder inside the working directory, e.g. "
+                                        "out/my_case (no absolute path, no `..`); use `--out DIR` to write elsewhere",
+                                        o.directory));
+  }
   o.scalars_every = map.integer("scalars_every", 0, 0, std::numeric_limits<int32_t>::max());
   o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
   o.frames_every = map.number("frames_every", 0.0, 0.0, 1e9, "s");

@@ -218,6 +218,11 @@ struct SimulationSpec {
   bool periodic[3] = {false, false, false};  // along x, y, z: the domain wraps around
   double mass_scaling = 1.0;      // [-] particle densities multiplied by this (quasi-static tests)
   double stiffness_scaling = 1.0; // [-] Young's moduli of particle materials multiplied by this
+  /// Numerical trouble (NaN, overlap beyond max_overlap_ratio of a radius, energy rising by more
+  /// than energy_rise_limit of the energy scale without a source): stop the run, or warn and go on.
+  bool stop_on_trouble = true;     // YAML: numerical_trouble: stop | warn
+  double max_overlap_ratio = 0.5;  // [-] of the smaller radius
+  double energy_rise_limit = 0.05; // [-]
 };
 
 struct OutputSpec {

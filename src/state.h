@@ -90,6 +90,11 @@ struct State {
   std::int64_t next_id = 0;
   std::int64_t lost = 0;  ///< particles removed because they left the domain
   double lost_mass = 0;   // [kg] of those particles (spillage)
+  /// The last particle that left the domain, for the run's warning (not checkpointed).
+  struct LostParticle {
+    std::int64_t id = -1;
+    double x = 0, y = 0, z = 0, vx = 0, vy = 0, vz = 0;
+  } last_lost;
 
   // Particles (n): hot columns. 18 doubles + 16 bytes = 160 bytes a particle.
   std::vector<double> x, y, z;     // [m] centre

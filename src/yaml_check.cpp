@@ -93,10 +93,17 @@ double MapReader::scalar_number(const YAML::Node& n, const MapReader& ctx, const
     size_t used = 0;
     const double value = std::stod(text, &used);
     if (used != text.size()) throw std::invalid_argument(text);
+    if (std::isnan(value)) throw std::invalid_argument(text);  // NaN is never a valid input
     return value;
   } catch (const std::exception&) {
     ctx.fail(key, fmt::format("'{}' is not a number", text));
   }
+}
+
+double MapReader::finite_number(const YAML::Node& n, const MapReader& ctx, const std::string& key) {
+  const double value = scalar_number(n, ctx, key);
+  if (!std::isfinite(value)) ctx.fail(key, fmt::format("'{}' must be a finite number", n.Scalar()));
+  return value;
 }
 
 double MapReader::number(const std::string& key, double fallback, double min, double max, std::string_view unit) {

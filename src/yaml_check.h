@@ -52,7 +52,10 @@ class MapReader {
   const std::string& file() const { return file_; }
 
   SourceLocation at(const YAML::Node& n) const;
+  /// A number (NaN refused; "inf", ".inf" and "rigid" give +infinity).
   static double scalar_number(const YAML::Node& n, const MapReader& ctx, const std::string& key);
+  /// A finite number (coordinates, indices, list entries).
+  static double finite_number(const YAML::Node& n, const MapReader& ctx, const std::string& key);
 
  private:
   YAML::Node node_;

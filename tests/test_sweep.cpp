@@ -66,3 +66,29 @@ TEST(Sweep, ZipNeedsEqualListsAndBadPathsAreNamed) {
 
 }  // namespace
 }  // namespace dem::test
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "video.h"
+
+namespace dem::test {
+namespace {
+
+// Videos are optional: without ffmpeg on the PATH the call says so (and what to install) instead
+// of failing the run; the frames stay where they are.
+TEST(Video, MissingFfmpegIsSaidClearly) {
+  const std::filesystem::path empty = std::filesystem::temp_directory_path() / "demdesign_video_test_path";
+  std::filesystem::create_directories(empty);
+  const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", empty.c_str(), 1);
+  std::string message;
+  const bool made = app::make_video(empty.string(), "frame_", (empty / "flow.mp4").string(), 10, &message);
+  setenv("PATH", saved.c_str(), 1);
+  EXPECT_FALSE(made);
+  EXPECT_NE(message.find("ffmpeg not found: install the Debian package ffmpeg"), std::string::npos) << message;
+  EXPECT_FALSE(std::filesystem::exists(empty / "flow.mp4"));
+}
+
+}  // namespace
+}  // namespace dem::test

@@ -1,0 +1,274 @@
+// A run loses nothing and explains itself: a real `demdesign` process killed with SIGKILL at
+// seeded random moments resumes with --resume to the same final state (state_hash in
+// run_info.yaml) as an uninterrupted run; SIGTERM writes a checkpoint and exits cleanly; a write
+// that fails (file size limit standing in for a full disk) gives a clear error and keeps the
+// earlier results readable. Numerical trouble (NaN, overlap, energy rising without a source,
+// particles leaving the domain) is reported with the particle and the likely cause. A soak run
+// with continuous insertion and removal keeps its memory flat.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "diagnostics.h"
+#include "model.h"
+#include "particles.h"
+#include "run.h"
+#include "spec.h"
+#include "step.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const fs::path kScratch = fs::temp_directory_path() / ("demdesign_crash_" + std::to_string(::getpid()));
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// inlet_outlet.yaml with a checkpoint every 0.02 s of simulated time.
+fs::path checkpoint_case() {
+  fs::create_directories(kScratch);
+  std::string text = read_text(fs::path(DEMDESIGN_SOURCE_DIR) / "cases/inlet_outlet.yaml");
+  const std::string from = "output: {directory: out/inlet_outlet}";
+  text.replace(text.find(from), from.size(), "output: {directory: out/crash_test, checkpoint_every: 0.02}");
+  const fs::path path = kScratch / "case.yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+/// Starts the demdesign binary with `args`, output to `log`; optional file size limit [bytes].
+pid_t start(const std::vector<std::string>& args, const fs::path& log, rlim_t file_limit = 0) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDOUT_FILENO), ::dup2(fd, STDERR_FILENO);
+    if (file_limit) {
+      ::signal(SIGXFSZ, SIG_IGN);  // writes past the limit fail with EFBIG, as on a full disk
+      const rlimit limit{file_limit, file_limit};
+      ::setrlimit(RLIMIT_FSIZE, &limit);
+    }
+    std::vector<char*> argv{const_cast<char*>(DEMDESIGN_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(DEMDESIGN_BINARY, argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string end_hash(const fs::path& out) {
+  const std::string info = read_text(out / "run_info.yaml");
+  const auto at = info.find("state_hash: ");
+  return at == std::string::npos ? "" : info.substr(at + 12, 16);
+}
+
+std::vector<std::string> run_args(const fs::path& c, const fs::path& out) {
+  return {c.string(), "--out", out.string(), "--threads", "1", "--quiet", "--no-report"};
+}
+
+TEST(KillAndResume, SigkillAtRandomMomentsThenResumeReachesTheSameState) {
+  const fs::path c = checkpoint_case();
+  const fs::path reference = kScratch / "reference";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start(run_args(c, reference), kScratch / "reference.log")), 0) << read_text(kScratch / "reference.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string expected = end_hash(reference);
+  ASSERT_EQ(expected.size(), 16u);
+  std::mt19937 random(20240901);
+  int trials = 0, killed_mid_run = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const fs::path out = kScratch / ("trial" + std::to_string(trial));
+    const pid_t pid = start(run_args(c, out), kScratch / "trial.log");
+    while (!fs::exists(out / "checkpoint.bin") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(2ms);
+    // A seeded random moment in the rest of the run.
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::uniform_real_distribution<double>(0.0, 0.7)(random) * seconds));
+    const bool running = ::kill(pid, SIGKILL) == 0;
+    const int status = wait_exit(pid);
+    killed_mid_run += running && status == 128 + SIGKILL;
+    auto args = run_args(c, out);
+    args.push_back("--resume");
+    ASSERT_EQ(wait_exit(start(args, kScratch / "resume.log")), 0) << read_text(kScratch / "resume.log");
+    EXPECT_EQ(end_hash(out), expected) << "trial " << trial << ": " << read_text(kScratch / "resume.log");
+    ++trials;
+  }
+  std::cout << trials << " kill-and-resume trials (" << killed_mid_run << " killed mid-run), uninterrupted run " << seconds
+            << " s; every resumed run ended with state_hash " << expected << "\n";
+  EXPECT_GE(killed_mid_run, 2);
+}
+
+TEST(KillAndResume, SigtermWritesACheckpointAndExitsCleanly) {
+  const fs::path c = checkpoint_case();
+  const fs::path out = kScratch / "sigterm";
+  const pid_t pid = start(run_args(c, out), kScratch / "sigterm.log");
+  while (!fs::exists(out / "checkpoint.bin") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(2ms);
+  std::this_thread::sleep_for(100ms);
+  ::kill(pid, SIGTERM);
+  EXPECT_EQ(wait_exit(pid), 0);
+  const std::string log = read_text(kScratch / "sigterm.log");
+  if (log.find("stopped by signal 15") == std::string::npos) GTEST_SKIP() << "the run ended before the signal";
+  EXPECT_NE(read_text(out / "run_info.yaml").find("completed: false"), std::string::npos);
+  EXPECT_NE(read_text(out / "scalars.csv").find("time_s,step"), std::string::npos);
+  auto args = run_args(c, out);
+  args.push_back("--resume");
+  ASSERT_EQ(wait_exit(start(args, kScratch / "sigterm_resume.log")), 0) << read_text(kScratch / "sigterm_resume.log");
+  EXPECT_NE(read_text(out / "run_info.yaml").find("completed: true"), std::string::npos);
+}
+
+TEST(FullDisk, AFailedWriteIsAClearErrorAndEarlierResultsStayReadable) {
+  // Every row of scalars (about 9000 steps a second); scalars.csv outgrows 256 kB mid-run, like a disk filling up.
+  std::string text = read_text(checkpoint_case());
+  text.replace(text.find("checkpoint_every: 0.02}"), 23, "checkpoint_every: 0.02, scalars_every: 1}");
+  const fs::path c = kScratch / "full_disk.yaml";
+  std::ofstream(c) << text;
+  const fs::path out = kScratch / "full_disk";
+  const int status = wait_exit(start(run_args(c, out), kScratch / "full_disk.log", 256 * 1024));
+  const std::string log = read_text(kScratch / "full_disk.log");
+  EXPECT_EQ(status, 1) << log;
+  EXPECT_NE(log.find("cannot write"), std::string::npos) << log;
+  EXPECT_NE(log.find("is kept"), std::string::npos) << log;
+  // What was written before is whole: the last scalars.csv and checkpoint, no half-written files.
+  const std::string csv = read_text(out / "scalars.csv");
+  EXPECT_EQ(csv.rfind("time_s,step", 0), 0u);
+  EXPECT_EQ(csv.back(), '\n');
+  EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
+  for (const auto& entry : fs::recursive_directory_iterator(out)) EXPECT_NE(entry.path().extension(), ".part") << entry.path();
+}
+
+// ---- numerical trouble, in process ----
+
+std::string base_case(const std::string& particles, const std::string& simulation_extra = "") {
+  return "simulation: {duration: 0.02, gravity: [0, 0, 0]" + simulation_extra + "}\n"
+         "materials:\n  glass: {density: 2500, youngs_modulus: 5.0e7, restitution: 0.9, friction: 0.3}\n"
+         "particles:\n" + particles;
+}
+
+std::string run_and_catch(const std::string& text, std::string* log_out = nullptr) {
+  const dem::Model model = dem::compile(dem::parse_case_text(text));
+  dem::State state = dem::initial_state(model);
+  dem::Workspace work;
+  dem::RunOptions options;
+  options.write_files = false;
+  options.progress = false;
+  std::ostringstream log;
+  try {
+    dem::run(model, state, work, options, log);
+  } catch (const dem::NumericalError& e) {
+    if (log_out) *log_out = log.str();
+    return e.what();
+  }
+  if (log_out) *log_out = log.str();
+  return "";
+}
+
+TEST(NumericalTrouble, OverlapBeyondTheLimitNamesBothParticles) {
+  // 60 % of the radius at the start: beyond the 50 % limit.
+  const std::string e = run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0], [0.007, 0, 0]]}\n"));
+  EXPECT_NE(e.find("particles 0 and 1 overlap by 60 %"), std::string::npos) << e;
+  EXPECT_NE(e.find("Likely causes"), std::string::npos) << e;
+}
+
+TEST(NumericalTrouble, EnergyRisingWithoutASourceIsCaught) {
+  // 30 % overlap (within the overlap limit) at rest: the contact pushes them apart, from nothing.
+  const std::string e = run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0], [0.0085, 0, 0]]}\n"));
+  EXPECT_NE(e.find("the energy (kinetic + gravitational) rose"), std::string::npos) << e;
+  EXPECT_NE(e.find("fastest particle is"), std::string::npos) << e;
+  EXPECT_NE(e.find("time step"), std::string::npos) << e;
+  // With `numerical_trouble: warn` the run goes on and says so.
+  std::string log;
+  EXPECT_EQ(run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0], [0.0085, 0, 0]]}\n",
+                                    ", numerical_trouble: warn"),
+                          &log),
+            "");
+  EXPECT_NE(log.find("WARNING (numerical_trouble: warn"), std::string::npos) << log;
+  // A clean elastic collision is not flagged (elastic energy is given back on rebound).
+  EXPECT_EQ(run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0]], velocity: [1, 0, 0]}\n"
+                                    "  - {material: glass, diameter: 0.01, positions: [[0.0105, 0, 0]], velocity: [-1, 0, 0]}\n")),
+            "");
+}
+
+TEST(NumericalTrouble, BlowUpFromATooLargeTimeStepIsCaughtWithTheCause) {
+  const std::string e = run_and_catch(
+      base_case("  - {material: glass, diameter: 0.01, count: 100, region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}, velocity: [0, 0, -2]}\n",
+                ", time_step: 1.0e-3, unsafe_time_step: warn, domain: {min: [-1, -1, -1], max: [1, 1, 1]}") +
+      "walls:\n  - {name: floor, material: glass, plane: {point: [0, 0, -0.001], normal: [0, 0, 1]}}\n");
+  EXPECT_FALSE(e.empty());
+  EXPECT_NE(e.find("Likely cause"), std::string::npos) << e;
+  EXPECT_NE(e.find("time step"), std::string::npos) << e;
+}
+
+TEST(NumericalTrouble, ParticlesLeavingTheDomainAreNamed) {
+  std::string log;
+  EXPECT_EQ(run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0]], velocity: [10, 0, 0]}\n",
+                                    ", domain: {min: [-0.1, -0.1, -0.1], max: [0.1, 0.1, 0.1]}"),
+                          &log),
+            "");
+  EXPECT_NE(log.find("1 particles have left the domain"), std::string::npos) << log;
+  EXPECT_NE(log.find("particle 0, at [0.1"), std::string::npos) << log;
+}
+
+// ---- soak: continuous insertion and removal, memory flat ----
+
+long rss_kb() {
+  std::ifstream statm("/proc/self/statm");
+  long size = 0, resident = 0;
+  statm >> size >> resident;
+  return resident * (::sysconf(_SC_PAGESIZE) / 1024);
+}
+
+TEST(Soak, InletAndOutletForManyStepsKeepMemoryFlat) {
+  // The inlet_outlet case with a wider outlet: feeds at 1.8 t/h and removes what reaches x > 0.12.
+  std::string text = read_text(fs::path(DEMDESIGN_SOURCE_DIR) / "cases/inlet_outlet.yaml");
+  text.replace(text.find("{min: [0.3, -0.1, -0.3]"), 23, "{min: [0.12, -0.1, -0.3]");
+  const dem::Model model = dem::compile(dem::parse_case_text(text, (fs::path(DEMDESIGN_SOURCE_DIR) / "cases/x.yaml").string()));
+  dem::State state = dem::initial_state(model);
+  dem::Workspace work;
+  dem::prepare(model, state, work);
+  const double seconds = std::getenv("DEMDESIGN_SOAK_SECONDS") ? std::atof(std::getenv("DEMDESIGN_SOAK_SECONDS")) : 4.0;
+  const std::int64_t steps = static_cast<std::int64_t>(seconds / model.dt);
+  long warm = 0, peak = 0;
+  size_t particles_min = SIZE_MAX, particles_max = 0;
+  for (std::int64_t k = 1; k <= steps; ++k) {
+    dem::step(model, state, work);
+    if (k % 2000 == 0) {
+      const long rss = rss_kb();
+      if (k >= steps / 4) {
+        if (!warm) warm = rss;
+        peak = std::max(peak, rss);
+        particles_min = std::min(particles_min, state.size()), particles_max = std::max(particles_max, state.size());
+      }
+    }
+  }
+  const auto& in = state.inlets[0];
+  const auto& out = state.outlets[0];
+  std::cout << "soak: " << steps << " steps (" << seconds << " s simulated), " << in.inserted << " particles inserted, "
+            << out.removed << " removed, " << particles_min << "-" << particles_max << " alive after the first quarter; RSS "
+            << warm << " kB after the first quarter, peak " << peak << " kB later (drift " << peak - warm << " kB)\n";
+  EXPECT_GT(out.removed, 1000);
+  EXPECT_LT(peak - warm, 4096) << "memory grows with insertions and removals";
+}
+
+}  // namespace
