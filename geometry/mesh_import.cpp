@@ -185,10 +185,27 @@ void refuse_impossible_counts(const std::string& path) {
   std::vector<std::string> counts;  // declared element counts, as written
   std::string line;
   bool off_header_seen = false;
-  while (std::getline(lines, line) && line.find("end_header") != 0) {
+  int line_number = 0;
+  bool end_seen = false;
+  while (std::getline(lines, line)) {
+    ++line_number;
+    if (line.find("end_header") == 0) {
+      end_seen = true;
+      break;
+    }
     std::istringstream words(line.substr(0, line.find('#')));
     std::string word;
     if (extension == ".ply") {
+      // assimp 5.2's PLY reader loops forever on a header line with an unknown keyword (found by
+      // the mesh fuzzer, tests/fuzz/regressions/mesh/): refuse those first.
+      std::istringstream keyword_words(line);
+      std::string keyword;
+      keyword_words >> keyword;
+      static const char* const kKeywords[] = {"ply", "format", "comment", "obj_info", "element", "property"};
+      if (!keyword.empty() && std::none_of(std::begin(kKeywords), std::end(kKeywords), [&](const char* k) { return keyword == k; }))
+        throw MeshError(MeshError::Kind::unreadable,
+                        path + ": line " + std::to_string(line_number) + " of the PLY header starts with '" + keyword.substr(0, 40) +
+                            "'; valid: ply, format, comment, obj_info, element, property, end_header. The file is damaged: re-export it");
       if (words >> word && word == "element" && words >> word && words >> word) counts.push_back(word);
       continue;
     }
@@ -201,6 +218,8 @@ void refuse_impossible_counts(const std::string& path) {
     }
     if (counts.size() >= 2) break;
   }
+  if (extension == ".ply" && !end_seen && bytes >= header.size())
+    throw MeshError(MeshError::Kind::unreadable, path + ": the PLY header has no end_header in its first 4096 bytes; re-export it");
   for (const std::string& count : counts)
     if (std::strtoull(count.c_str(), nullptr, 10) > bytes)
       throw MeshError(MeshError::Kind::unreadable, path + ": the header declares " + count +

@@ -653,7 +653,10 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   else spec.contact = read_contact(library_contact, library_contact_file);
   // Pair parameters a library material gives against wall materials the case has, unless the
   // case gives that pair itself.
-  for (const auto& [material, wall] : library_walls) {
+  for (const auto& material_wall : library_walls) {
+    // Named references, not structured bindings: clang 14 (the fuzz build) cannot capture those.
+    const std::string& material = material_wall.first;
+    const auto& wall = material_wall.second;
     const auto has = [&](const std::string& n) { return std::any_of(spec.materials.begin(), spec.materials.end(), [&](const MaterialSpec& m) { return m.name == n; }); };
     if (!has(wall.first)) continue;
     const bool given = std::any_of(spec.interactions.begin(), spec.interactions.end(), [&](const InteractionSpec& in) {
