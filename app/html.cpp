@@ -86,7 +86,7 @@ std::string embed_image(const std::string& path, const std::string& alt) {
   bytes << in.rdbuf();
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  const char* mime = ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : "image/png";
+  const char* mime = ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : ext == ".svg" ? "image/svg+xml" : "image/png";
   return fmt::format("<img alt=\"{}\" src=\"data:{};base64,{}\">", esc(alt), mime, base64(bytes.str()));
 }
 

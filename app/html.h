@@ -1,5 +1,5 @@
 // Small helpers for self-contained HTML reports (escaped text, numbers, embedded images, the
-// house CSS), shared by the calibration report. Same conventions as app/report.cpp.
+// house CSS), shared by the run, sweep and calibration reports.
 #pragma once
 
 #include <initializer_list>
