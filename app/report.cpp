@@ -107,24 +107,7 @@ struct Hotspot {
   double area = 0, shear_rate = 0, impact_rate = 0, impacts_rate = 0, wear_mm_per_year = kNaN;
 };
 
-/// Cells that start with a number (or a dash for "none") are right-aligned.
-bool looks_numeric(const std::string& cell) {
-  if (cell.empty()) return false;
-  if (std::isdigit(static_cast<unsigned char>(cell[0])) || ((cell[0] == '-' || cell[0] == '+') && cell.size() > 1 && std::isdigit(static_cast<unsigned char>(cell[1]))))
-    return true;
-  return cell.rfind("&ndash;", 0) == 0 || cell.rfind("&minus;", 0) == 0 || cell.rfind("&infin;", 0) == 0;
-}
-
-std::string table_row(std::initializer_list<std::string> cells, bool header = false) {
-  std::string out = "<tr>";
-  bool first = true;
-  for (const std::string& c : cells) {
-    if (header) out += "<th>" + c + "</th>";
-    else out += (!first && looks_numeric(c) ? "<td class=\"n\">" : "<td>") + c + "</td>";
-    first = false;
-  }
-  return out + "</tr>\n";
-}
+std::string table_row(std::initializer_list<std::string> cells, bool header = false) { return html::row(cells, header); }
 
 /// Draws a plot into dir/plots and returns the HTML figure (or the reason there is none).
 std::string figure(const plot::Plot& p, const std::string& dir, const std::string& name, const std::string& caption) {

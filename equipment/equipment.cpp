@@ -46,6 +46,15 @@ std::pair<Vec3, Vec3> perpendicular_pair(const Vec3& axis) {
   return {u, n.cross(u)};
 }
 
+std::pair<Vec3, Vec3> rotated_box(const Eigen::Matrix3d& rotation, const Vec3& lo, const Vec3& hi) {
+  Vec3 a = Vec3::Constant(1e300), b = Vec3::Constant(-1e300);
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+    include(a, b, rotation * corner);
+  }
+  return {a, b};
+}
+
 MapReader sub_map(MapReader& parent, const std::string& key) {
   if (!parent.has(key)) {
     parent.node(key);  // marks it read

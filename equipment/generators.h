@@ -102,6 +102,10 @@ std::pair<Vec3, Vec3> perpendicular_pair(const Vec3& axis);
 /// The sub-map `key` of `parent` as a reader (an empty map when absent, so defaults apply).
 MapReader sub_map(MapReader& parent, const std::string& key);
 
+/// Axis-aligned box holding the corners of [lo, hi] moved by x -> rotation x (ports, outlets and
+/// sensor boxes of tilted equipment).
+std::pair<Vec3, Vec3> rotated_box(const Eigen::Matrix3d& rotation, const Vec3& lo, const Vec3& hi);
+
 /// Grows the box [lo, hi] to hold p.
 inline void include(Vec3& lo, Vec3& hi, const Vec3& p) {
   lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);

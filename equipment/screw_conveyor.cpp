@@ -18,20 +18,6 @@
 
 namespace dem::equipment::detail {
 
-namespace {
-
-/// Axis-aligned box of the corners of [lo, hi] moved by x -> rotation x.
-std::pair<Vec3, Vec3> rotated_box(const Eigen::Matrix3d& rotation, const Vec3& lo, const Vec3& hi) {
-  Vec3 a = Vec3::Constant(1e300), b = Vec3::Constant(-1e300);
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
-    include(a, b, rotation * corner);
-  }
-  return {a, b};
-}
-
-}  // namespace
-
 Generated screw_conveyor(MapReader& reader, const EquipmentSpec& spec) {
   const Materials materials = read_materials(reader);
   const double diameter = reader.number("diameter", 0.1, 0.02, 2.0, "m");
