@@ -192,7 +192,7 @@ std::size_t particle_bytes_held(const dem::State& s) {
 std::size_t contact_list_bytes(const dem::ContactList& c) { return bytes(c.i) + bytes(c.j) + bytes(c.history); }
 
 std::size_t contact_forces_bytes(const dem::ContactForces& f) {
-  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.tix) + bytes(f.tiy) + bytes(f.tiz) + bytes(f.tjx) +
+  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.tjx) +
          bytes(f.tjy) + bytes(f.tjz) + bytes(f.active);
 }
 

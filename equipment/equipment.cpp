@@ -21,7 +21,8 @@ namespace detail {
 
 void cylinder(MeshBuilder& mesh, const Vec3& a, const Vec3& b, double radius, int around, bool caps) {
   const Vec3 axis = (b - a).normalized();
-  const auto [u, v] = perpendicular_pair(axis);
+  const auto frame = perpendicular_pair(axis);  // not a structured binding: lambdas capture it (clang 14)
+  const Vec3 u = frame.first, v = frame.second;
   const int along = segments((b - a).norm(), kCell);
   // u runs along the axis, w around it: normals point outward.
   mesh.grid([&](double s, double w) {

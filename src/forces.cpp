@@ -1,7 +1,12 @@
-// Determinism: each listed contact writes its force into its own buffer slot and each particle
-// then sums its contacts in list order, so the result is bitwise the same for any thread count.
-// Rejected alternative: atomics or thread-private force arrays; both make the summation order
-// (and so the last bits of every trajectory) depend on the number of threads.
+// Determinism: a contact's force on body i is added to i's totals by the one thread that owns i,
+// in list order; what body j receives is written to the contact's own buffer slot and summed per
+// particle afterwards, again in list order. The result is bitwise the same for any thread count
+// and schedule. Rejected alternative: atomics or thread-private force arrays; both make the
+// summation order (and so the last bits of every trajectory) depend on the number of threads.
+//
+// Sum per particle, in this order: own pairs (as i), plane walls, meshes, incoming pairs (as j),
+// then gravity. The closing half kick of the step runs in the same pass (one sweep over the
+// particles instead of two).
 #include "parallel.h"
 #include "forces.h"
 
@@ -20,6 +25,8 @@ namespace {
 struct Batch {
   ContactBatch b;
   std::int32_t contact[kBatch];
+  std::int32_t owner[kBatch];  // slot of body i
+  bool pair[kBatch];           // particle pair (else plane wall)
   double lever_i[kBatch], lever_j[kBatch];  // [m] centre to contact point
 };
 
@@ -34,34 +41,44 @@ void set_load(ContactBatch& b) {
   for (int c = 0; c < b.count; ++c) b.load[c] = b.fn[c] > 0.0 ? b.fn[c] : 0.0;
 }
 
-/// Evaluates a full batch and writes each contact's force and torques to its buffer slot.
-void flush(const Model& model, Batch& batch, ContactForces& out) {
+/// Evaluates a full batch: adds each contact's force and torque to body i's totals and keeps
+/// the force (and, for particle pairs, the torque on j) in the contact's buffer slot. Particle
+/// and wall contacts share the batch, so each particle's contacts are added in the order they
+/// were listed whatever the batch boundaries.
+void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   ContactBatch& b = batch.b;
   evaluate_effects(model, b);
   for (int c = 0; c < b.count; ++c) {
-    const std::int32_t k = batch.contact[c];
+    const std::int32_t k = batch.contact[c], i = batch.owner[c];
+    ContactForces& out = batch.pair[c] ? work.pair_forces : work.wall_forces;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
-    out.fx[k] = b.fn[c] * nx + ftx;
-    out.fy[k] = b.fn[c] * ny + fty;
-    out.fz[k] = b.fn[c] * nz + ftz;
+    const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
+    out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
+    out.active[k] = 1;
     // Torque of the tangential force about each centre: (-lever n) x ft; plus rolling torque.
     const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
-    out.tix[k] = -batch.lever_i[c] * cx + b.mx[c];
-    out.tiy[k] = -batch.lever_i[c] * cy + b.my[c];
-    out.tiz[k] = -batch.lever_i[c] * cz + b.mz[c];
-    out.tjx[k] = -batch.lever_j[c] * cx - b.mx[c];
-    out.tjy[k] = -batch.lever_j[c] * cy - b.my[c];
-    out.tjz[k] = -batch.lever_j[c] * cz - b.mz[c];
-    out.active[k] = 1;
+    s.fx[i] += fx, s.fy[i] += fy, s.fz[i] += fz;
+    s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
+    s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
+    s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
+    if (batch.pair[c]) {
+      out.tjx[k] = -batch.lever_j[c] * cx - b.mx[c];
+      out.tjy[k] = -batch.lever_j[c] * cy - b.my[c];
+      out.tjz[k] = -batch.lever_j[c] * cz - b.mz[c];
+    }
   }
   b.count = 0;
 }
 
+/// A listed contact that is not acting: inactive, history cleared (written only when it is
+/// not already clear, so idle pairs of the skin cost reads, not writes).
 void forget(ContactList& list, ContactForces& out, size_t k, int width) {
-  out.active[k] = 0;
+  if (out.active[k]) out.active[k] = 0;
   double* row = &list.history[k * width];
-  for (int q = 0; q < width; ++q) row[q] = 0.0;
+  bool clear = true;
+  for (int q = 0; q < width; ++q) clear &= row[q] == 0.0;
+  if (!clear) std::fill_n(row, width, 0.0);
 }
 
 /// Relative-motion columns common to particle and wall contacts.
@@ -84,13 +101,14 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
   const bool periodic = model.periodic();
   const double range = model.interaction_range;
   ContactBatch& b = batch.b;
+  const double xi = s.x[i], yi = s.y[i], zi = s.z[i], ri = s.radius[i];
   for (std::int32_t k = work.pair_begin[i]; k < work.pair_begin[i + 1]; ++k) {
     const std::int32_t j = s.pairs.j[k];
-    double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
+    double d[3] = {xi - s.x[j], yi - s.y[j], zi - s.z[j]};
     if (periodic) minimum_image(model, d);
     const double dx = d[0], dy = d[1], dz = d[2];
     const double dist2 = dx * dx + dy * dy + dz * dz;
-    const double reach = s.radius[i] + s.radius[j] + range;
+    const double reach = ri + s.radius[j] + range;
     if (dist2 >= reach * reach) {
       forget(s.pairs, work.pair_forces, k, width);
       continue;
@@ -98,8 +116,8 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     const int c = b.count;
     const double dist = std::sqrt(dist2);
     const double nx = dx / dist, ny = dy / dist, nz = dz / dist;
-    const double overlap = s.radius[i] + s.radius[j] - dist;
-    const double lever_i = s.radius[i] - 0.5 * overlap, lever_j = s.radius[j] - 0.5 * overlap;
+    const double overlap = ri + s.radius[j] - dist;
+    const double lever_i = ri - 0.5 * overlap, lever_j = s.radius[j] - 0.5 * overlap;
     // Contact-point velocity of j: v_j + w_j x (lever_j n).
     const double vjx = s.vx[j] + lever_j * (s.wy[j] * nz - s.wz[j] * ny);
     const double vjy = s.vy[j] + lever_j * (s.wz[j] * nx - s.wx[j] * nz);
@@ -107,18 +125,19 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     fill_motion(b, c, s, i, nx, ny, nz, lever_i, vjx, vjy, vjz, s.wx[j], s.wy[j], s.wz[j]);
     b.pair_type[c] = model.pair_type(s.material[i], s.material[j]);
     b.overlap[c] = overlap;
-    b.radius_i[c] = s.radius[i];
+    b.radius_i[c] = ri;
     b.radius_j[c] = s.radius[j];
-    b.r_eff[c] = s.radius[i] * s.radius[j] / (s.radius[i] + s.radius[j]);
+    b.r_eff[c] = ri * s.radius[j] / (ri + s.radius[j]);
     b.m_eff[c] = 1.0 / (s.inv_mass[i] + s.inv_mass[j]);
     // Moments of inertia about the contact point, 7/5 m R^2 for a sphere.
-    b.inertia_eff[c] = 1.0 / (s.inv_mass[i] / (1.4 * s.radius[i] * s.radius[i]) +
-                              s.inv_mass[j] / (1.4 * s.radius[j] * s.radius[j]));
+    b.inertia_eff[c] = 1.0 / (s.inv_mass[i] / (1.4 * ri * ri) + s.inv_mass[j] / (1.4 * s.radius[j] * s.radius[j]));
     b.history[c] = s.pairs.history.data() + static_cast<size_t>(k) * width;
     batch.contact[c] = k;
+    batch.owner[c] = static_cast<std::int32_t>(i);
+    batch.pair[c] = true;
     batch.lever_i[c] = lever_i;
     batch.lever_j[c] = lever_j;
-    if (++b.count == kBatch) flush(model, batch, work.pair_forces);
+    if (++b.count == kBatch) flush(model, batch, s, work);
   }
 }
 
@@ -149,9 +168,11 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     b.inertia_eff[c] = 1.4 * s.radius[i] * s.radius[i] / s.inv_mass[i];
     b.history[c] = s.wall_pairs.history.data() + static_cast<size_t>(k) * width;
     batch.contact[c] = k;
+    batch.owner[c] = static_cast<std::int32_t>(i);
+    batch.pair[c] = false;
     batch.lever_i[c] = dist;
     batch.lever_j[c] = 0.0;
-    if (++b.count == kBatch) flush(model, batch, work.wall_forces);
+    if (++b.count == kBatch) flush(model, batch, s, work);
   }
 }
 
@@ -169,59 +190,49 @@ void evaluate_effects(const Model& model, ContactBatch& b) {
   if (!load_set) set_load(b);
 }
 
-void compute_forces(const Model& model, State& s, Workspace& work) {
+void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
   const long n = static_cast<long>(s.size());
+  // Own contacts. Dynamic chunks: the work per particle varies (a settling bed has all its
+  // contacts at the bottom), and the sums do not depend on which thread takes which chunk.
 #pragma omp parallel if (n >= kParallelMin)
   {
     Batch batch;
     batch.b.count = 0;
-#pragma omp for schedule(static) nowait
-    for (long i = 0; i < n; ++i) particle_contacts(model, s, work, batch, i);
-    if (batch.b.count) flush(model, batch, work.pair_forces);
-#pragma omp for schedule(static)
-    for (long i = 0; i < n; ++i) wall_contacts(model, s, work, batch, i);
-    if (batch.b.count) flush(model, batch, work.wall_forces);
+#pragma omp for schedule(dynamic, 256) nowait
+    for (long i = 0; i < n; ++i) {
+      s.fx[i] = s.fy[i] = s.fz[i] = 0.0;
+      s.tx[i] = s.ty[i] = s.tz[i] = 0.0;
+      particle_contacts(model, s, work, batch, i);
+      wall_contacts(model, s, work, batch, i);
+    }
+    if (batch.b.count) flush(model, batch, s, work);
   }
 
   mesh_contact_forces(model, s, work);
 
-  // Sum per particle in list order: own pairs, incoming pairs, walls, meshes; then gravity.
-  const ContactForces& mf = work.mesh_forces;
-  const bool meshes = !model.meshes.empty();
+  // Incoming pairs (as j), gravity, and the closing half kick of free spheres.
   const ContactForces& pf = work.pair_forces;
-  const ContactForces& wf = work.wall_forces;
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-    for (std::int32_t k = work.pair_begin[p]; k < work.pair_begin[p + 1]; ++k) {
-      if (!pf.active[k]) continue;
-      fx += pf.fx[k], fy += pf.fy[k], fz += pf.fz[k];
-      tx += pf.tix[k], ty += pf.tiy[k], tz += pf.tiz[k];
-    }
+    double fx = s.fx[p], fy = s.fy[p], fz = s.fz[p], tx = s.tx[p], ty = s.ty[p], tz = s.tz[p];
     for (std::int32_t q = work.incoming_begin[p]; q < work.incoming_begin[p + 1]; ++q) {
       const std::int32_t k = work.incoming[q];
       if (!pf.active[k]) continue;
       fx -= pf.fx[k], fy -= pf.fy[k], fz -= pf.fz[k];
       tx += pf.tjx[k], ty += pf.tjy[k], tz += pf.tjz[k];
     }
-    for (std::int32_t k = work.wall_begin[p]; k < work.wall_begin[p + 1]; ++k) {
-      if (!wf.active[k]) continue;
-      fx += wf.fx[k], fy += wf.fy[k], fz += wf.fz[k];
-      tx += wf.tix[k], ty += wf.tiy[k], tz += wf.tiz[k];
-    }
-    if (meshes) {
-      for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
-        const size_t slot = static_cast<size_t>(p) * MeshContacts::kSlots + k;
-        if (!mf.active[slot]) continue;
-        fx += mf.fx[slot], fy += mf.fy[slot], fz += mf.fz[slot];
-        tx += mf.tix[slot], ty += mf.tiy[slot], tz += mf.tiz[slot];
-      }
-    }
     // A body carries its own weight; a glued sphere is part of its wall, which has none.
-    const double mass = s.body[p] >= 0 || s.attached[p] >= 0 ? 0.0 : 1.0 / s.inv_mass[p];
-    s.fx[p] = fx + mass * gx, s.fy[p] = fy + mass * gy, s.fz[p] = fz + mass * gz;
+    const bool free = s.body[p] < 0 && s.attached[p] < 0;
+    const double mass = free ? 1.0 / s.inv_mass[p] : 0.0;
+    fx += mass * gx, fy += mass * gy, fz += mass * gz;
+    s.fx[p] = fx, s.fy[p] = fy, s.fz[p] = fz;
     s.tx[p] = tx, s.ty[p] = ty, s.tz[p] = tz;
+    if (free && kick != 0.0) {
+      const double a = kick * s.inv_mass[p], b = kick * s.inv_inertia[p];
+      s.vx[p] += a * fx, s.vy[p] += a * fy, s.vz[p] += a * fz;
+      s.wx[p] += b * tx, s.wy[p] += b * ty, s.wz[p] += b * tz;
+    }
   }
 
   // Bodies: force and torque about the centre of mass from their spheres, plus weight.
@@ -240,14 +251,27 @@ void compute_forces(const Model& model, State& s, Workspace& work) {
     }
     bodies.fx[b] = fx, bodies.fy[b] = fy, bodies.fz[b] = fz;
     bodies.tx[b] = tx, bodies.ty[b] = ty, bodies.tz[b] = tz;
+    if (kick != 0.0) {
+      const double a = kick / bodies.mass[b];
+      bodies.vx[b] += a * fx, bodies.vy[b] += a * fy, bodies.vz[b] += a * fz;
+      bodies.lx[b] += kick * tx, bodies.ly[b] += kick * ty, bodies.lz[b] += kick * tz;
+    }
   }
 
   // Force on each wall (reaction of its contacts), summed in list order.
+  const ContactForces& wf = work.wall_forces;
   for (auto* column : {&s.walls.fx, &s.walls.fy, &s.walls.fz}) std::fill(column->begin(), column->end(), 0.0);
-  for (size_t k = 0; k < s.wall_pairs.size(); ++k) {
-    if (!wf.active[k]) continue;
-    const std::int32_t w = s.wall_pairs.j[k];
-    s.walls.fx[w] -= wf.fx[k], s.walls.fy[w] -= wf.fy[k], s.walls.fz[w] -= wf.fz[k];
+  if (!model.planes.empty()) {
+    double* wfx = s.walls.fx.data();
+    double* wfy = s.walls.fy.data();
+    double* wfz = s.walls.fz.data();
+    const std::int32_t* wall = s.wall_pairs.j.data();
+    const size_t count = s.wall_pairs.size();
+    for (size_t k = 0; k < count; ++k) {
+      if (!wf.active[k]) continue;
+      const std::int32_t w = wall[k];
+      wfx[w] -= wf.fx[k], wfy[w] -= wf.fy[k], wfz[w] -= wf.fz[k];
+    }
   }
   // Glued spheres pass their contact forces to their wall, summed in slot order.
   if (!model.has_attached) return;

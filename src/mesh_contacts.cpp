@@ -98,19 +98,22 @@ struct MeshBatch {
   double point[kBatch][3];     // [m] contact point, world
 };
 
-void flush(const Model& model, MeshBatch& mb, ContactForces& out, MeshSlotResults& slot_results) {
+/// Evaluates a batch of mesh contacts: each force and torque is added to its particle's totals
+/// (the particle's own thread, slot order) and kept per slot for the records and mesh loads.
+void flush(const Model& model, MeshBatch& mb, State& s, ContactForces& out, MeshSlotResults& slot_results) {
   ContactBatch& b = mb.b;
   evaluate_effects(model, b);
   for (int c = 0; c < b.count; ++c) {
     const std::int32_t k = mb.slot[c];
+    const std::size_t p = static_cast<std::size_t>(k) / kSlots;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
-    out.fx[k] = b.fn[c] * nx + b.ftx[c];
-    out.fy[k] = b.fn[c] * ny + b.fty[c];
-    out.fz[k] = b.fn[c] * nz + b.ftz[c];
+    const double fx = b.fn[c] * nx + b.ftx[c], fy = b.fn[c] * ny + b.fty[c], fz = b.fn[c] * nz + b.ftz[c];
+    out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
     const double cx = ny * b.ftz[c] - nz * b.fty[c], cy = nz * b.ftx[c] - nx * b.ftz[c], cz = nx * b.fty[c] - ny * b.ftx[c];
-    out.tix[k] = -mb.lever[c] * cx + b.mx[c];
-    out.tiy[k] = -mb.lever[c] * cy + b.my[c];
-    out.tiz[k] = -mb.lever[c] * cz + b.mz[c];
+    s.fx[p] += fx, s.fy[p] += fy, s.fz[p] += fz;
+    s.tx[p] += -mb.lever[c] * cx + b.mx[c];
+    s.ty[p] += -mb.lever[c] * cy + b.my[c];
+    s.tz[p] += -mb.lever[c] * cz + b.mz[c];
     out.active[k] = 1;
     slot_results.fn[k] = b.fn[c];
     slot_results.shear_power[k] = std::abs(b.ftx[c] * b.vtx[c] + b.fty[c] * b.vty[c] + b.ftz[c] * b.vtz[c]);
@@ -187,7 +190,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   if (model.meshes.empty()) return;
   MeshSlotResults& slot_results = work.mesh_slots;
   if (work.mesh_forces.fx.size() != n * kSlots) {  // slots beyond a particle's count are never read
-    work.mesh_forces.resize(n * kSlots);
+    work.mesh_forces.resize(n * kSlots, false);
     slot_results.resize(n * kSlots);
   }
   const double range = model.interaction_range;
@@ -213,7 +216,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
         old_point[k][0] = mc.px[slot], old_point[k][1] = mc.py[slot], old_point[k][2] = mc.pz[slot];
         if (width) std::memcpy(&old_history[k * width], &mc.history[slot * width], width * sizeof(double));
       }
-      if (mb.b.count + kSlots > kBatch) flush(model, mb, work.mesh_forces, work.mesh_slots);
+      if (mb.b.count + kSlots > kBatch) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
       const double radius = s.radius[p];
       int count = 0;
       for (std::int32_t q = first; q < last;) {
@@ -325,7 +328,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
       mc.count[p] = static_cast<std::uint8_t>(count);
       for (int k = count; k < kSlots; ++k) work.mesh_forces.active[static_cast<size_t>(p) * kSlots + k] = 0;
     }
-    if (mb.b.count) flush(model, mb, work.mesh_forces, work.mesh_slots);
+    if (mb.b.count) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
   }
 
   // Records per triangle and loads per mesh, summed in slot order.

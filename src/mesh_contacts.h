@@ -17,7 +17,8 @@ void find_mesh_candidates(const Model& model, State& state, Workspace& work, dou
 /// Largest displacement of any mesh since the lists were built (for the skin criterion) [m].
 double mesh_displacement_since_build(const Model& model, const State& state, double time);
 /// Resolves and evaluates the mesh contacts of every particle at the meshes' current pose;
-/// forces go to Workspace::mesh_forces (per slot), records and loads to the state.
+/// forces and torques are added to the particles' totals (state.fx.., tx..) and kept per slot
+/// in Workspace::mesh_forces; records and loads go to the state.
 void mesh_contact_forces(const Model& model, State& state, Workspace& work);
 
 }  // namespace dem

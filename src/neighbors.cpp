@@ -179,8 +179,9 @@ void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>
 
 }  // namespace
 
-void ContactForces::resize(std::size_t n) {
-  for (auto* c : {&fx, &fy, &fz, &tix, &tiy, &tiz, &tjx, &tjy, &tjz}) c->assign(n, 0.0);
+void ContactForces::resize(std::size_t n, bool reaction_torques) {
+  for (auto* c : {&fx, &fy, &fz}) c->assign(n, 0.0);
+  for (auto* c : {&tjx, &tjy, &tjz}) c->assign(reaction_torques ? n : 0, 0.0);
   active.assign(n, 0);
 }
 
@@ -211,20 +212,25 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
     for (size_t p = 0; p < n; ++p)
       if (s.body[p] >= 0) work.body_members[cursor[s.body[p]]++] = static_cast<std::int32_t>(p);
   }
-  work.pair_forces.resize(s.pairs.size());
-  work.wall_forces.resize(s.wall_pairs.size());
+  work.pair_forces.resize(s.pairs.size(), true);
+  work.wall_forces.resize(s.wall_pairs.size(), false);
   work.valid = true;
 }
 
-bool needs_rebuild(const Model& model, const State& s, const Workspace& work) {
+bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bool free_spheres_checked) {
   if (!work.valid || s.x_built.size() != s.size()) return true;
   const double limit2 = 0.25 * model.skin * model.skin;
   const long n = static_cast<long>(s.size());
+  const bool all = !free_spheres_checked;
+  const bool others = s.bodies.size() > 0 || model.has_attached;
   int moved = 0;
+  if (all || others) {
 #pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
-  for (long p = 0; p < n; ++p) {
-    const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
-    moved |= (dx * dx + dy * dy + dz * dz > limit2);
+    for (long p = 0; p < n; ++p) {
+      if (!all && s.body[p] < 0 && s.attached[p] < 0) continue;
+      const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
+      moved |= (dx * dx + dy * dy + dz * dz > limit2);
+    }
   }
   if (moved) return true;
   // Meshes move too: each side may use half the skin.

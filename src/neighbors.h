@@ -10,8 +10,10 @@
 
 namespace dem {
 
-/// True when the lists no longer cover every contact that could form.
-bool needs_rebuild(const Model& model, const State& state, const Workspace& work);
+/// True when the lists no longer cover every contact that could form. With
+/// free_spheres_checked the caller has already tested the free spheres (step's fused kick and
+/// drift) and only spheres of bodies, glued spheres and meshes are tested here.
+bool needs_rebuild(const Model& model, const State& state, const Workspace& work, bool free_spheres_checked = false);
 /// Rebuilds the contact lists (see above).
 void rebuild_contacts(const Model& model, State& state, Workspace& work);
 /// Rebuilds the workspace's indexing of the state's contact lists without changing them (after

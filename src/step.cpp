@@ -14,41 +14,42 @@ namespace dem {
 
 namespace {
 
-/// v += h F / m, w += h T / I for free spheres; V += h F / M, L += h T for bodies.
-void kick(State& s, double h) {
+/// The opening half kick and the drift in one pass: v += h F/m, w += h T/I, x += dt v for free
+/// spheres; bodies take the same kick and move freely, then place their spheres. Returns whether
+/// a free sphere has moved more than half the skin since the lists were built (the same test
+/// as needs_rebuild, made while the positions are in cache).
+bool kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
   const long n = static_cast<long>(s.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  const bool check = s.x_built.size() == s.size();
+  const double limit2 = 0.25 * model.skin * model.skin;
+  int moved = 0;
+#pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
     if (s.body[p] >= 0 || s.attached[p] >= 0) continue;  // moved by its body or its wall
     const double a = h * s.inv_mass[p], b = h * s.inv_inertia[p];
-    s.vx[p] += a * s.fx[p], s.vy[p] += a * s.fy[p], s.vz[p] += a * s.fz[p];
+    const double vx = s.vx[p] + a * s.fx[p], vy = s.vy[p] + a * s.fy[p], vz = s.vz[p] + a * s.fz[p];
+    s.vx[p] = vx, s.vy[p] = vy, s.vz[p] = vz;
     s.wx[p] += b * s.tx[p], s.wy[p] += b * s.ty[p], s.wz[p] += b * s.tz[p];
+    const double x = s.x[p] + dt * vx, y = s.y[p] + dt * vy, z = s.z[p] + dt * vz;
+    s.x[p] = x, s.y[p] = y, s.z[p] = z;
+    if (check) {
+      const double dx = x - s.x_built[p], dy = y - s.y_built[p], dz = z - s.z_built[p];
+      moved |= (dx * dx + dy * dy + dz * dz > limit2);
+    }
   }
   Bodies& b = s.bodies;
+  if (b.size() == 0) return moved != 0;
   for (size_t k = 0; k < b.size(); ++k) {
     const double a = h / b.mass[k];
     b.vx[k] += a * b.fx[k], b.vy[k] += a * b.fy[k], b.vz[k] += a * b.fz[k];
     b.lx[k] += h * b.tx[k], b.ly[k] += h * b.ty[k], b.lz[k] += h * b.tz[k];
-  }
-}
-
-/// x += h v for free spheres; bodies translate and rotate freely, then place their spheres.
-void drift(State& s, const Workspace& work, const Model& model, double h) {
-  const long n = static_cast<long>(s.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (long p = 0; p < n; ++p) {
-    if (s.attached[p] >= 0) continue;  // moved by its wall
-    s.x[p] += h * s.vx[p], s.y[p] += h * s.vy[p], s.z[p] += h * s.vz[p];
-  }
-  Bodies& b = s.bodies;
-  if (b.size() == 0) return;
-  for (size_t k = 0; k < b.size(); ++k) {
-    b.x[k] += h * b.vx[k], b.y[k] += h * b.vy[k], b.z[k] += h * b.vz[k];
+    b.x[k] += dt * b.vx[k], b.y[k] += dt * b.vy[k], b.z[k] += dt * b.vz[k];
     const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inertia[3] = {b.ix[k], b.iy[k], b.iz[k]};
-    const Quaternion q = free_rotation({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, inertia, h);
+    const Quaternion q = free_rotation({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, inertia, dt);
     b.qw[k] = q.w, b.qx[k] = q.x, b.qy[k] = q.y, b.qz[k] = q.z;
   }
   place_body_spheres(model, s, work.body_begin, work.body_members);
+  return moved != 0;
 }
 
 /// Walls move at their set velocity; servo walls add the normal speed that drives their
@@ -103,15 +104,13 @@ void prepare(const Model& model, State& state, Workspace& work) {
 
 void step(const Model& model, State& state, Workspace& work) {
   const double dt = model.dt;
-  kick(state, 0.5 * dt);
-  drift(state, work, model, dt);
+  const bool free_moved = kick_drift(state, work, model, 0.5 * dt, dt);
   move_walls(model, state, dt);
   place_meshes(model, state.time + dt, work);
   for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
     if (run_inlet(model, state, k) > 0) work.valid = false;
-  if (needs_rebuild(model, state, work)) rebuild_contacts(model, state, work);
-  compute_forces(model, state, work);
-  kick(state, 0.5 * dt);
+  if (free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)) rebuild_contacts(model, state, work);
+  compute_forces(model, state, work, 0.5 * dt);
   refresh_body_spheres(model, state, work);
   state.time += dt;
   ++state.step;

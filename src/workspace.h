@@ -8,15 +8,16 @@
 
 namespace dem {
 
-/// Forces of each listed contact from the last evaluation, written by the contact loop and
-/// summed per particle in a fixed order (so results do not depend on the thread count).
-/// Per contact: 9 doubles + 1 byte = 73 bytes.
+/// Forces of each listed contact from the last evaluation. The force and torque on body i are
+/// added to i's totals as the contact is evaluated (by the thread that owns i); what body j
+/// receives is kept here and summed per particle afterwards, in list order, so results do not
+/// depend on the thread count. Per contact: 6 doubles + 1 byte = 49 bytes (3 + 1 = 25 without
+/// reaction torques: wall and mesh contacts).
 struct ContactForces {
   std::vector<double> fx, fy, fz;     // [N] on body i
-  std::vector<double> tix, tiy, tiz;  // [N m] on body i
-  std::vector<double> tjx, tjy, tjz;  // [N m] on body j (particle pairs only)
+  std::vector<double> tjx, tjy, tjz;  // [N m] on body j (particle pairs only, else empty)
   std::vector<std::uint8_t> active;   // 1 when the contact exerted a force this step
-  void resize(std::size_t n);
+  void resize(std::size_t n, bool reaction_torques);
 };
 
 /// Per mesh-contact slot, what the records of triangles and meshes need from the evaluation.

@@ -71,16 +71,23 @@ std::uint64_t settle_hash(int threads, int steps) {
   omp_set_num_threads(threads);
   CaseSpec spec = load_case("settling_bed.yaml");
   spec.particles[0].count = 3000;  // above kParallelMin, so 2 threads really split the loops
+  spec.particles[0].region_min.z() = 0.0;  // from the floor up: loose enough to place,
+  spec.particles[0].region_max.z() = 0.06;  // dense enough to touch soon
   Sim sim(spec);
   for (int k = 0; k < steps; ++k) sim.advance();
+  // The run must reach a bed: spheres touching each other and the walls at the same time.
+  EXPECT_GT(sim.work.wall_forces.active.size(), 100u);
+  EXPECT_GT(std::count(sim.work.wall_forces.active.begin(), sim.work.wall_forces.active.end(), 1), 100);
   return state_hash(sim.state, sim.model.history_width);
 }
 
 TEST(Determinism, SameHashOnRerunAndForOneAndTwoThreads) {
+  // Long enough for a bed with particle and wall contacts on the same spheres (the order in
+  // which a sphere's contacts are summed must not depend on how threads share the particles).
   const int saved = omp_get_max_threads();
-  const std::uint64_t one = settle_hash(1, 1200);
-  const std::uint64_t two = settle_hash(2, 1200);
-  const std::uint64_t again = settle_hash(2, 1200);
+  const std::uint64_t one = settle_hash(1, 3000);
+  const std::uint64_t two = settle_hash(2, 3000);
+  const std::uint64_t again = settle_hash(2, 3000);
   omp_set_num_threads(saved);
   EXPECT_EQ(two, again) << "rerun";
   EXPECT_EQ(one, two) << "1 versus 2 threads";
