@@ -214,6 +214,13 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   }
   work.pair_forces.resize(s.pairs.size(), true);
   work.wall_forces.resize(s.wall_pairs.size(), false);
+  // A contact with a history counts as active until it is next evaluated: the contact loop
+  // clears the history of an inactive contact only when it was active (idle pairs of the skin
+  // are then read, never written, and their history rows not touched at all).
+  const int width = model.history_width;
+  for (auto [list, forces] : {std::pair{&s.pairs, &work.pair_forces}, std::pair{&s.wall_pairs, &work.wall_forces}})
+    for (size_t k = 0; k < list->size() && width > 0; ++k)
+      forces->active[k] = !row_is_zero(&list->history[k * width], width);
   work.valid = true;
 }
 
