@@ -236,6 +236,64 @@ materials::BatchOutcome read_outcome(ByteReader& in) {
   return b;
 }
 
+// ---- sweep variants --------------------------------------------------------------------------
+
+namespace {
+constexpr int kAskTag = 701, kAnswerTag = 702;  // message tags of the work queue
+}
+
+WorkQueue::WorkQueue(size_t count) : count_(count) {}
+
+WorkQueue::~WorkQueue() {
+#ifdef DEMDESIGN_WITH_MPI
+  delete static_cast<MPI_Request*>(request_);
+#endif
+}
+
+long WorkQueue::next() {
+#ifdef DEMDESIGN_WITH_MPI
+  if (the_world.active() && the_world.rank != 0) {
+    // Ask rank 0 and wait for the answer without blocking (the rank looks after its variants meanwhile).
+    auto* request = static_cast<MPI_Request*>(request_);
+    if (!asked_) {
+      const int ask = 1;
+      check(MPI_Send(&ask, 1, MPI_INT, 0, kAskTag, MPI_COMM_WORLD), "MPI_Send");
+      if (!request) request_ = request = new MPI_Request;
+      check(MPI_Irecv(&answer_, 1, MPI_LONG, 0, kAnswerTag, MPI_COMM_WORLD, request), "MPI_Irecv");
+      asked_ = true;
+    }
+    int arrived = 0;
+    check(MPI_Test(request, &arrived, MPI_STATUS_IGNORE), "MPI_Test");
+    if (!arrived) return kWait;
+    asked_ = false;
+    return answer_;
+  }
+#endif
+  return next_ < count_ ? static_cast<long>(next_++) : kNone;
+}
+
+bool WorkQueue::serve() {
+  bool answered = false;
+#ifdef DEMDESIGN_WITH_MPI
+  if (!the_world.active() || the_world.rank != 0) return false;
+  for (;;) {
+    int waiting = 0;
+    MPI_Status status;
+    check(MPI_Iprobe(MPI_ANY_SOURCE, kAskTag, MPI_COMM_WORLD, &waiting, &status), "MPI_Iprobe");
+    if (!waiting) break;
+    int ask = 0;
+    check(MPI_Recv(&ask, 1, MPI_INT, status.MPI_SOURCE, kAskTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
+    const long item = next_ < count_ ? static_cast<long>(next_++) : kNone;
+    if (item == kNone) ++told_;
+    check(MPI_Send(&item, 1, MPI_LONG, status.MPI_SOURCE, kAnswerTag, MPI_COMM_WORLD), "MPI_Send");
+    answered = true;
+  }
+#endif
+  return answered;
+}
+
+bool WorkQueue::all_told() const { return the_world.rank != 0 || told_ >= the_world.size - 1; }
+
 // ---- calibration batches ----------------------------------------------------------------------
 
 materials::BatchRunner calibration_batch_runner() {

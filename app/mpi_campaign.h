@@ -8,11 +8,13 @@
 // rank 0 of 1. One simulation is not split over ranks (no domain decomposition): a case without a
 // sweep runs on rank 0 and the other ranks wait.
 //
-// Sharing is static and cyclic: rank r runs items r, r+N, r+2N, ... of a campaign. Rejected: a
-// dynamic queue served by rank 0 (MPI messages answered between waitpid calls, or an MPI window
-// with an atomic counter); it balances variants of very different cost better, but rank 0 would
-// have to poll MPI while its own simulations run, and a cyclic share already spreads the
-// neighbouring (similar) variants of a grid over the ranks.
+// Sweep variants are handed out one at a time by rank 0 (WorkQueue): a rank with a free slot
+// asks, rank 0 answers between looking after its own variants, so a variant that fails at once
+// or runs short frees its slot for the next. Rejected: a static share (rank r runs r, r+N, ...),
+// which left one rank idle while the other ran two long variants in the test campaign; and an
+// MPI window with an atomic counter, which needs the same polling of MPI on rank 0 for progress
+// across nodes and is harder to follow. Calibration batches are shared statically and cyclically:
+// every rank runs the calibration in lockstep, and a design round's simulations cost alike.
 #pragma once
 
 #include <cstdint>
@@ -67,6 +69,32 @@ std::vector<std::string> all_gather(const std::string& mine);
 /// The environment for a child process: this one's without the MPI launcher's variables, so a
 /// child demdesign (a sweep variant) runs as a plain process and never joins the MPI job.
 std::vector<std::string> child_environment();
+
+/// The items 0..count-1 of a campaign (sweep variants), handed out one at a time by rank 0 to
+/// whichever rank asks (rank 0 serves itself first). Without MPI, a counter. Every rank keeps
+/// asking until told there is nothing left, so no message is in flight afterwards.
+class WorkQueue {
+ public:
+  static constexpr long kNone = -1;  ///< nothing left
+  static constexpr long kWait = -2;  ///< asked rank 0; the answer is not here yet
+  explicit WorkQueue(size_t count);
+  ~WorkQueue();
+  WorkQueue(const WorkQueue&) = delete;
+  WorkQueue& operator=(const WorkQueue&) = delete;
+  /// The next item for this rank, kNone or kWait; never blocks.
+  long next();
+  /// Rank 0: answers the requests that have arrived; true when it answered any.
+  bool serve();
+  /// Rank 0: true when every other rank has been told there is nothing left (other ranks: true).
+  bool all_told() const;
+
+ private:
+  size_t count_, next_ = 0;
+  int told_ = 0;
+  bool asked_ = false;
+  long answer_ = kNone;
+  void* request_ = nullptr;  ///< the pending MPI_Request of the answer (MPI types stay out of this header)
+};
 
 /// Calibration batches shared among the ranks: rank r runs simulations r, r+N, ... (stopping
 /// at its first fatal one), and every rank receives every outcome, because every rank runs the

@@ -8,12 +8,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstring>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <regex>
+#include <thread>
 
 #include "mpi_campaign.h"
 #include "report.h"
@@ -170,10 +172,9 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
   namespace fs = std::filesystem;
   const mpi::World& world = mpi::world();
   const size_t n = plan.variants.size();
-  // This rank's share of the variants: rank, rank + N, ... (all of them without MPI).
-  std::vector<size_t> mine;
-  for (size_t k = static_cast<size_t>(world.rank); k < n; k += static_cast<size_t>(world.size)) mine.push_back(k);
-  const size_t share = mine.size();
+  // Under MPI rank 0 hands the variants out one at a time to whichever rank has a free slot; a
+  // rank's threads and slots are sized for its expected share.
+  const size_t share = (n + static_cast<size_t>(world.size) - 1) / static_cast<size_t>(world.size);
   const int cores = mpi::cores_per_rank();
   const int threads = options.threads > 0 ? options.threads : (static_cast<int>(share) >= cores ? 1 : cores);
   const int parallel = plan.parallel > 0 ? plan.parallel : std::max(1, cores / threads);
@@ -183,7 +184,7 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     log << fmt::format("sweep: {} variants of {}, {} at a time with {} thread(s) each\n", n, options.case_path, parallel, threads);
   else {
     if (world.rank == 0) log << fmt::format("sweep: {} variants of {} over {} MPI ranks\n", n, options.case_path, world.size);
-    log << fmt::format("{}{} variants, {} at a time with {} thread(s) each\n", who, share, parallel, threads) << std::flush;
+    log << fmt::format("{}{} at a time with {} thread(s) each\n", who, parallel, threads) << std::flush;
   }
   const std::string self = fs::read_symlink("/proc/self/exe").string();
   // The children are plain processes: without the launcher's variables they never join the MPI job.
@@ -199,43 +200,70 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
   };
   std::vector<Running> running;
   std::vector<int> status(n, -1);
-  size_t next = 0, done = 0;
+  std::vector<size_t> mine;  // the variants this rank ran, in the order it started them
+  mpi::WorkQueue queue(n);
+  bool exhausted = false;
+  size_t done = 0;
   double busy_seconds = 0;
-  while (done < share) {
-    while (next < share && static_cast<int>(running.size()) < parallel) {
-      const size_t k = mine[next];
-      const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
-      fs::create_directories(dir);
-      std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
-                                       "--threads", std::to_string(threads), "--quiet"};
-      if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
-      if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      // The child's output goes to its log file; no shell is involved.
-      posix_spawn_file_actions_t files;
-      posix_spawn_file_actions_init(&files);
-      const std::string log_path = dir + "/log.txt";
-      posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
-      pid_t pid = 0;
-      const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), envp.data());
-      posix_spawn_file_actions_destroy(&files);
-      if (err != 0) {
-        log << fmt::format("{}  {} could not be started: {}\n", who, plan.name(k), std::strerror(err));
-        status[k] = 127;
-        ++done;
-      } else {
-        log << fmt::format("{}  {} started: {}\n", who, plan.name(k), plan.label(k)) << std::flush;
-        running.push_back({pid, k, std::chrono::steady_clock::now()});
-      }
-      ++next;
+  // Starts variant k as `demdesign run CASE --variant k` in its folder.
+  const auto start_variant = [&](size_t k) {
+    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+    fs::create_directories(dir);
+    std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
+                                     "--threads", std::to_string(threads), "--quiet"};
+    if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
+    if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    // The child's output goes to its log file; no shell is involved.
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    const std::string log_path = dir + "/log.txt";
+    posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), envp.data());
+    posix_spawn_file_actions_destroy(&files);
+    mine.push_back(k);
+    if (err != 0) {
+      log << fmt::format("{}  {} could not be started: {}\n", who, plan.name(k), std::strerror(err));
+      status[k] = 127;
+      ++done;
+    } else {
+      log << fmt::format("{}  {} started: {}\n", who, plan.name(k), plan.label(k)) << std::flush;
+      running.push_back({pid, k, std::chrono::steady_clock::now()});
     }
-    if (running.empty()) continue;
+  };
+  for (;;) {
+    bool progressed = false;
+    // Free slots take the next variants.
+    while (!exhausted && static_cast<int>(running.size()) < parallel) {
+      const long item = queue.next();
+      if (item == mpi::WorkQueue::kWait) break;
+      if (item == mpi::WorkQueue::kNone) {
+        exhausted = true;
+        break;
+      }
+      start_variant(static_cast<size_t>(item));
+      progressed = true;
+    }
+    progressed = queue.serve() || progressed;  // rank 0 answers the other ranks
+    if (exhausted && running.empty() && queue.all_told()) break;
+    // Without MPI wait for a variant to finish; under MPI look, and keep asking and answering.
     int wstatus = 0;
-    const pid_t pid = waitpid(-1, &wstatus, 0);
-    if (pid < 0) break;
+    const pid_t pid = running.empty() ? 0 : waitpid(-1, &wstatus, world.active() ? WNOHANG : 0);
+    if (pid < 0 && errno == EINTR) continue;
+    if (pid < 0) {
+      // No child to wait for (cannot happen with variants running): count them as failed.
+      for (const Running& r : running) status[r.variant] = 127, ++done;
+      running.clear();
+      continue;
+    }
+    if (pid == 0) {
+      if (!progressed) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
     const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
     if (it == running.end()) continue;
     const size_t v = it->variant;
@@ -244,9 +272,10 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     busy_seconds += took;
     running.erase(it);
     ++done;
-    const double left = busy_seconds / done * static_cast<double>(share - done) / parallel;
-    log << fmt::format("{}  {} {} in {} ({}/{} done, about {} left){}\n", who, plan.name(v), status[v] == 0 ? "finished" : "FAILED",
-                       format_seconds(took), done, share, format_seconds(left),
+    const std::string count = world.active() ? fmt::format("{} done on this rank", done)
+                                             : fmt::format("{}/{} done, about {} left", done, n,
+                                                           format_seconds(busy_seconds / done * static_cast<double>(n - done) / parallel));
+    log << fmt::format("{}  {} {} in {} ({}){}\n", who, plan.name(v), status[v] == 0 ? "finished" : "FAILED", format_seconds(took), count,
                        status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", options.out, plan.name(v)))
         << std::flush;
   }
