@@ -14,6 +14,7 @@
 #include "calibration_report.h"
 #include "material_model.h"
 #include "measurements.h"
+#include "mpi_campaign.h"
 
 namespace dem::app {
 
@@ -83,6 +84,11 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
 bool CalibrationCommands::parsed() const { return test_->parsed() || compare_->parsed() || calibrate_->parsed() || diagnose_->parsed(); }
 
 int CalibrationCommands::run() {
+  // Under MPI, compare, calibrate and diagnose share their simulations among the ranks; a single
+  // test and the synthetic data run on rank 0.
+  const mpi::World& world = mpi::world();
+  const bool campaign = !test_->parsed() && !(compare_->parsed() && !synthetic_from_.empty());
+  if (world.active() && world.rank != 0 && !campaign) return 0;
   if (test_->parsed()) return run_test();
   if (compare_->parsed()) return synthetic_from_.empty() ? run_measured("compare") : write_synthetic();
   if (calibrate_->parsed()) return run_measured("calibrate");
@@ -140,7 +146,12 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.size_factor = size_factor_;
   options.threads = threads_;
   options.seed = static_cast<std::uint64_t>(seed_);
-  if (!quiet_) options.progress = [](const std::string& line) { std::cout << line << std::endl; };
+  // Every rank runs the same calibration in lockstep; the simulations of each batch (a design
+  // round, the replicas of a comparison) are shared among the ranks and every rank gets every
+  // outcome (app/mpi_campaign.h). Rank 0 alone prints, renders and writes.
+  const mpi::World& world = mpi::world();
+  options.batch = mpi::calibration_batch_runner();
+  if (!quiet_ && world.rank == 0) options.progress = [](const std::string& line) { std::cout << line << std::endl; };
   std::vector<FitParameter> params;
   if (!params_.empty()) {
     try {
@@ -149,7 +160,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
       throw CaseError(fmt::format("--params: {}", e.what()));
     }
   }
-  fs::create_directories(out_);
+  if (world.rank == 0) fs::create_directories(out_);
   const std::string ledger_path = (fs::path(out_) / "ledger.yaml").string();
   report::CalibrationReportInput input;
   input.title = fmt::format("{} {}", command, model.name);
@@ -162,6 +173,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
   for (const auto& p : (params.empty() ? fit_parameters(model) : params)) keys.push_back(p.key);
   if (command == "compare") {
     comparison = compare(model, measured, options);
+    if (world.rank != 0) return 0;
     input.comparison = &comparison;
     std::cout << fmt::format("chi^2/n = {:.2f} over {} observations\n", comparison.chi2_per_n(), comparison.n);
     for (const auto& t : comparison.terms)
@@ -170,12 +182,14 @@ int CalibrationCommands::run_measured(const std::string& command) {
     for (const auto& p : comparison.patterns) std::cout << "  " << p.words << "\n";
   } else if (command == "calibrate") {
     calibration = calibrate(model, measured, params, options);
+    if (world.rank != 0) return 0;
     input.calibration = &calibration;
     for (const auto& w : calibration.words) std::cout << w << "\n";
     input.ledger = append_ledger(ledger_path, model.name,
                                  {ledger_entry(model, calibration.before, "start", keys), ledger_entry(calibration.fitted, calibration.after, "calibrated", keys)});
   } else {
     diagnosis = diagnose(model, measured, params, options);
+    if (world.rank != 0) return 0;
     input.diagnosis = &diagnosis;
     for (const auto& w : diagnosis.words) std::cout << w << "\n";
     for (const auto& c : diagnosis.candidates) std::cout << "  " << c.words << "\n";

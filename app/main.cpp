@@ -23,6 +23,7 @@
 #include "library.h"
 #include "mesh_health.h"
 #include "model.h"
+#include "mpi_campaign.h"
 #include "particles.h"
 #include "report.h"
 #include "results_hdf5.h"
@@ -159,7 +160,15 @@ int run_case(const RunArgs& args) {
     sweep.case_path = args.case_path;
     sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
     sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
-    return dem::app::run_sweep(plan, sweep, std::cout);
+    return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
+  }
+  // One simulation is not split over MPI ranks: rank 0 runs it, the others wait.
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  if (world.active()) {
+    if (world.rank != 0) return 0;
+    std::cout << fmt::format("note: {} MPI ranks, but one simulation runs on rank 0 alone (sweeps and calibrations share their "
+                             "simulations among the ranks; a case is not split into subdomains)\n",
+                             world.size);
   }
   if (args.variant >= 0) {
     if (args.variant >= static_cast<long>(plan.variants.size()))
@@ -256,9 +265,25 @@ int render_results(const std::string& out, const std::string& which, const dem::
   return 0;
 }
 
+/// The exit status of an error. Under MPI the error may be this rank's alone, and the others
+/// would wait for it forever: every rank stops.
+int stop_with(int code) {
+  std::cerr << std::flush;
+  dem::app::mpi::abort(code);
+  return code;
+}
+
+std::string rank_prefix() {
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  return world.active() ? fmt::format("rank {}: ", world.rank) : "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // MPI only when mpirun (or another MPI launcher) started this process; see app/mpi_campaign.h.
+  dem::app::mpi::Session mpi_session(&argc, &argv);
+  const dem::app::mpi::World& world = dem::app::mpi::world();
   CLI::App app{"demdesign: DEM simulation for the design of bulk-materials-handling equipment"};
   app.require_subcommand(0, 1);
   RunArgs args;
@@ -310,7 +335,9 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   try {
-    if (calibration.parsed()) return calibration.run();
+    if (calibration.parsed()) return calibration.run();  // compare, calibrate, diagnose: every rank; test: rank 0
+    // Commands that are not campaigns run on rank 0; a case decides in run_case (a sweep uses every rank).
+    if (world.active() && world.rank != 0 && args.case_path.empty()) return 0;
     if (effects_cmd->parsed()) {
       std::cout << dem::describe_effects();
       return 0;
@@ -336,13 +363,13 @@ int main(int argc, char** argv) {
     }
     return run_case(args);
   } catch (const dem::CaseError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
+    std::cerr << rank_prefix() << "error: " << e.what() << "\n";
+    return stop_with(2);
   } catch (const dem::NumericalError& e) {
-    std::cerr << "numerical trouble: " << e.what() << "\n";
-    return 3;
+    std::cerr << rank_prefix() << "numerical trouble: " << e.what() << "\n";
+    return stop_with(3);
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 1;
+    std::cerr << rank_prefix() << "error: " << e.what() << "\n";
+    return stop_with(1);
   }
 }

@@ -139,8 +139,15 @@ void write_metrics(const RunMetrics& metrics, const std::string& path) {
 }
 
 RunMetrics read_metrics(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the metrics file", path));
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error(fmt::format("{}: cannot read the metrics file", path));
+  std::stringstream text;
+  text << file.rdbuf();
+  return parse_metrics(text.str(), path);
+}
+
+RunMetrics parse_metrics(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   RunMetrics m;
   std::string line;
   const std::string text_tag = "# steady_text: ";

@@ -61,6 +61,8 @@ RunMetrics write_run_report(const RunReportInput& input, const std::string& repo
 void write_metrics(const RunMetrics& metrics, const std::string& path);
 /// Reads metrics.csv; throws std::runtime_error naming the file when it cannot be read.
 RunMetrics read_metrics(const std::string& path);
+/// The same from the text of a metrics.csv; `source` names it in errors (source:line: ...).
+RunMetrics parse_metrics(const std::string& text, const std::string& source);
 
 /// One design variant of a sweep.
 struct SweepVariant {

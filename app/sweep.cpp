@@ -1,7 +1,6 @@
 #include "sweep.h"
 
 #include <fmt/format.h>
-#include <omp.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <fcntl.h>
@@ -9,18 +8,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstring>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <regex>
+#include <thread>
 
+#include "mpi_campaign.h"
 #include "report.h"
 #include "spec.h"
 #include "yaml_check.h"
-
-extern char** environ;
 
 namespace dem::app {
 
@@ -170,13 +170,28 @@ YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k)
 
 int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
   namespace fs = std::filesystem;
+  const mpi::World& world = mpi::world();
   const size_t n = plan.variants.size();
-  const int cores = std::max(1, omp_get_num_procs());
-  const int threads = options.threads > 0 ? options.threads : (static_cast<int>(n) >= cores ? 1 : cores);
+  // Under MPI rank 0 hands the variants out one at a time to whichever rank has a free slot; a
+  // rank's threads and slots are sized for its expected share.
+  const size_t share = (n + static_cast<size_t>(world.size) - 1) / static_cast<size_t>(world.size);
+  const int cores = mpi::cores_per_rank();
+  const int threads = options.threads > 0 ? options.threads : (static_cast<int>(share) >= cores ? 1 : cores);
   const int parallel = plan.parallel > 0 ? plan.parallel : std::max(1, cores / threads);
+  const std::string who = world.active() ? fmt::format("rank {}: ", world.rank) : "";
   fs::create_directories(options.out + "/variants");
-  log << fmt::format("sweep: {} variants of {}, {} at a time with {} thread(s) each\n", n, options.case_path, parallel, threads);
+  if (!world.active())
+    log << fmt::format("sweep: {} variants of {}, {} at a time with {} thread(s) each\n", n, options.case_path, parallel, threads);
+  else {
+    if (world.rank == 0) log << fmt::format("sweep: {} variants of {} over {} MPI ranks\n", n, options.case_path, world.size);
+    log << fmt::format("{}{} at a time with {} thread(s) each\n", who, parallel, threads) << std::flush;
+  }
   const std::string self = fs::read_symlink("/proc/self/exe").string();
+  // The children are plain processes: without the launcher's variables they never join the MPI job.
+  std::vector<std::string> environment = mpi::child_environment();
+  std::vector<char*> envp;
+  for (auto& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
 
   struct Running {
     pid_t pid;
@@ -185,43 +200,70 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
   };
   std::vector<Running> running;
   std::vector<int> status(n, -1);
-  const auto start = std::chrono::steady_clock::now();
-  size_t next = 0, done = 0;
+  std::vector<size_t> mine;  // the variants this rank ran, in the order it started them
+  mpi::WorkQueue queue(n);
+  bool exhausted = false;
+  size_t done = 0;
   double busy_seconds = 0;
-  while (done < n) {
-    while (next < n && static_cast<int>(running.size()) < parallel) {
-      const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(next));
-      fs::create_directories(dir);
-      std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(next), "--out", dir,
-                                       "--threads", std::to_string(threads), "--quiet"};
-      if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
-      if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      // The child's output goes to its log file; no shell is involved.
-      posix_spawn_file_actions_t files;
-      posix_spawn_file_actions_init(&files);
-      const std::string log_path = dir + "/log.txt";
-      posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
-      pid_t pid = 0;
-      const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), environ);
-      posix_spawn_file_actions_destroy(&files);
-      if (err != 0) {
-        log << fmt::format("  {} could not be started: {}\n", plan.name(next), std::strerror(err));
-        status[next] = 127;
-        ++done;
-      } else {
-        log << fmt::format("  {} started: {}\n", plan.name(next), plan.label(next));
-        running.push_back({pid, next, std::chrono::steady_clock::now()});
-      }
-      ++next;
+  // Starts variant k as `demdesign run CASE --variant k` in its folder.
+  const auto start_variant = [&](size_t k) {
+    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+    fs::create_directories(dir);
+    std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
+                                     "--threads", std::to_string(threads), "--quiet"};
+    if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
+    if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    // The child's output goes to its log file; no shell is involved.
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    const std::string log_path = dir + "/log.txt";
+    posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), envp.data());
+    posix_spawn_file_actions_destroy(&files);
+    mine.push_back(k);
+    if (err != 0) {
+      log << fmt::format("{}  {} could not be started: {}\n", who, plan.name(k), std::strerror(err));
+      status[k] = 127;
+      ++done;
+    } else {
+      log << fmt::format("{}  {} started: {}\n", who, plan.name(k), plan.label(k)) << std::flush;
+      running.push_back({pid, k, std::chrono::steady_clock::now()});
     }
-    if (running.empty()) continue;
+  };
+  for (;;) {
+    bool progressed = false;
+    // Free slots take the next variants.
+    while (!exhausted && static_cast<int>(running.size()) < parallel) {
+      const long item = queue.next();
+      if (item == mpi::WorkQueue::kWait) break;
+      if (item == mpi::WorkQueue::kNone) {
+        exhausted = true;
+        break;
+      }
+      start_variant(static_cast<size_t>(item));
+      progressed = true;
+    }
+    progressed = queue.serve() || progressed;  // rank 0 answers the other ranks
+    if (exhausted && running.empty() && queue.all_told()) break;
+    // Without MPI wait for a variant to finish; under MPI look, and keep asking and answering.
     int wstatus = 0;
-    const pid_t pid = waitpid(-1, &wstatus, 0);
-    if (pid < 0) break;
+    const pid_t pid = running.empty() ? 0 : waitpid(-1, &wstatus, world.active() ? WNOHANG : 0);
+    if (pid < 0 && errno == EINTR) continue;
+    if (pid < 0) {
+      // No child to wait for (cannot happen with variants running): count them as failed.
+      for (const Running& r : running) status[r.variant] = 127, ++done;
+      running.clear();
+      continue;
+    }
+    if (pid == 0) {
+      if (!progressed) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
     const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
     if (it == running.end()) continue;
     const size_t v = it->variant;
@@ -230,13 +272,52 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     busy_seconds += took;
     running.erase(it);
     ++done;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double left = busy_seconds / done * static_cast<double>(n - done) / parallel;
-    log << fmt::format("  {} {} in {} ({}/{} done, about {} left){}\n", plan.name(v), status[v] == 0 ? "finished" : "FAILED",
-                       format_seconds(took), done, n, format_seconds(left),
-                       status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", options.out, plan.name(v)));
-    (void)elapsed;
+    const std::string count = world.active() ? fmt::format("{} done on this rank", done)
+                                             : fmt::format("{}/{} done, about {} left", done, n,
+                                                           format_seconds(busy_seconds / done * static_cast<double>(n - done) / parallel));
+    log << fmt::format("{}  {} {} in {} ({}){}\n", who, plan.name(v), status[v] == 0 ? "finished" : "FAILED", format_seconds(took), count,
+                       status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", options.out, plan.name(v)))
+        << std::flush;
   }
+
+  // What rank 0 needs of each variant this rank ran: exit status, metrics.csv as text, why it
+  // failed (the last lines of its log) and its last flow image; gathered over MPI, so rank 0
+  // ranks the variants even when the other ranks' folders are not on its file system.
+  mpi::ByteWriter record;
+  for (const size_t k : mine) {
+    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+    std::string metrics, message, image;
+    if (status[k] == 0) {
+      std::ifstream in(dir + "/report/metrics.csv");
+      if (in) metrics.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      else message = fmt::format("{}/report/metrics.csv: cannot read the metrics file", dir);
+      if (fs::is_directory(dir + "/renders"))
+        for (const auto& entry : fs::directory_iterator(dir + "/renders"))
+          if (entry.path().extension() == ".png" && entry.path().filename().string().rfind("frame_", 0) == 0)
+            image = std::max(image, entry.path().string());
+    } else {
+      // The last lines of the variant's log say why it failed.
+      std::ifstream in(dir + "/log.txt");
+      std::vector<std::string> lines;
+      for (std::string line; std::getline(in, line);) lines.push_back(line);
+      for (size_t l = lines.size() > 3 ? lines.size() - 3 : 0; l < lines.size(); ++l) message += lines[l] + " ";
+      if (message.empty()) message = fmt::format("exit status {}", status[k]);
+    }
+    record.u64(k), record.u64(static_cast<std::uint64_t>(status[k])), record.str(metrics), record.str(message), record.str(image);
+  }
+  const std::vector<std::string> records = mpi::gather(record.bytes());
+  if (world.rank != 0) return 0;  // rank 0 reports the campaign and gives its exit status
+  std::vector<std::string> metrics_text(n), messages(n), images(n);
+  for (const std::string& bytes : records) {
+    mpi::ByteReader in(bytes);
+    while (!in.done()) {
+      const size_t k = in.u64();
+      if (k >= n) throw std::runtime_error(fmt::format("sweep: a rank reported variant {} of {}", k, n));
+      status[k] = static_cast<int>(in.u64());
+      metrics_text[k] = in.str(), messages[k] = in.str(), images[k] = in.str();
+    }
+  }
+
   // The comparison: each variant's metrics (from its report) and its last flow image.
   report::SweepReportInput input;
   input.case_path = options.case_path, input.version = DEMDESIGN_VERSION;
@@ -248,26 +329,16 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     v.name = plan.name(k);
     for (size_t p = 0; p < plan.paths.size(); ++p) v.parameters.emplace_back(plan.paths[p], YAML::Dump(plan.variants[k][p]));
     v.report_path = fmt::format("variants/{}/report/report.html", plan.name(k));
-    v.ok = status[k] == 0;
+    v.ok = status[k] == 0 && messages[k].empty();
+    v.message = messages[k];
     if (v.ok) {
       try {
-        v.metrics = report::read_metrics(dir + "/report/metrics.csv");
+        v.metrics = report::parse_metrics(metrics_text[k], dir + "/report/metrics.csv");
       } catch (const std::exception& e) {
         v.ok = false, v.message = e.what();
       }
-      std::string last;
-      if (fs::is_directory(dir + "/renders"))
-        for (const auto& entry : fs::directory_iterator(dir + "/renders"))
-          if (entry.path().extension() == ".png" && entry.path().filename().string().rfind("frame_", 0) == 0)
-            last = std::max(last, entry.path().string());
-      v.image_path = last;
-    } else {
-      // The last lines of the variant's log say why it failed.
-      std::ifstream in(dir + "/log.txt");
-      std::vector<std::string> lines;
-      for (std::string line; std::getline(in, line);) lines.push_back(line);
-      for (size_t l = lines.size() > 3 ? lines.size() - 3 : 0; l < lines.size(); ++l) v.message += lines[l] + " ";
-      if (v.message.empty()) v.message = fmt::format("exit status {}", status[k]);
+      // Shown when rank 0 can read it (a shared file system, as clusters have).
+      if (fs::exists(images[k])) v.image_path = images[k];
     }
     input.variants.push_back(std::move(v));
   }

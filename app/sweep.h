@@ -1,6 +1,7 @@
 // Design sweeps: a case with a `sweep:` section is run once per variant (a parameter of the case
 // replaced by each of its values), the variants in child processes of this program, several at
-// once when the cores allow, and ranked by the criteria the case names.
+// once when the cores allow, and ranked by the criteria the case names. Under `mpirun -np N` the
+// variants are handed out among the ranks and rank 0 writes the report (app/mpi_campaign.h).
 //
 //   sweep:
 //     parameters:                                  # key path in the case -> values
@@ -63,6 +64,8 @@ struct SweepOptions {
 /// Runs every variant as `demdesign run CASE --variant k --out ...` (posix_spawn, no shell), several
 /// at once, with progress and time left; returns 0 when all succeeded (failed variants are
 /// reported in the comparison, not fatal). Writes the comparison report into OUT/report.
+/// Under MPI (collective): each rank runs the variants rank 0 hands it, rank 0 gathers the
+/// results, writes the report and returns the status; the other ranks return 0.
 int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& log);
 
 }  // namespace dem::app

@@ -18,6 +18,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "diagnostics.h"
 #include "effect.h"
 
 namespace dem::materials {
@@ -57,6 +58,112 @@ SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, con
   t.size_factor = options.size_factor;
   if (options.on_final) t.on_final = options.on_final;
   return options.simulator ? options.simulator(model, setup, t) : run_virtual_test(model, setup, t);
+}
+
+/// One simulation of a batch: which model, set-up and packing seed.
+struct Job {
+  const MaterialModel* model;
+  const TestSetup* setup;
+  std::uint64_t seed;
+};
+
+/// Runs one job; an exception becomes the outcome's error (a runner must not throw mid-batch:
+/// under MPI every rank has to reach the gather).
+BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
+  BatchOutcome b;
+  try {
+    b.outcome = run_one(*job.model, *job.setup, options, job.seed);
+    b.error = BatchOutcome::Error::none;
+  } catch (const CaseError& e) {
+    b.error = BatchOutcome::Error::input, b.message = e.what();
+  } catch (const NumericalError& e) {
+    b.error = BatchOutcome::Error::numerical, b.message = e.what();
+  } catch (const std::exception& e) {
+    b.error = BatchOutcome::Error::other, b.message = e.what();
+  }
+  return b;
+}
+
+/// The error of a batch outcome thrown again, with its kind.
+[[noreturn]] void rethrow(const BatchOutcome& b) {
+  if (b.error == BatchOutcome::Error::input) throw CaseError(b.message);
+  if (b.error == BatchOutcome::Error::numerical) throw NumericalError(b.message);
+  throw std::runtime_error(b.message);
+}
+
+/// Runs the jobs as one batch through options.batch (or one after the other here).
+std::vector<BatchOutcome> run_batch(const std::vector<Job>& jobs, const CalibrationOptions& options,
+                                    const std::function<void(size_t, const BatchOutcome&)>& done,
+                                    const std::function<bool(const BatchOutcome&)>& fatal) {
+  const auto simulate = [&](size_t k) { return run_caught(jobs[k], options); };
+  if (options.batch) {
+    std::vector<BatchOutcome> out = options.batch(jobs.size(), simulate, done, fatal);
+    if (out.size() != jobs.size())
+      throw std::logic_error(fmt::format("calibration: the batch runner returned {} outcomes for {} simulations", out.size(), jobs.size()));
+    return out;
+  }
+  std::vector<BatchOutcome> out(jobs.size());
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    out[k] = simulate(k);
+    done(k, out[k]);
+    if (fatal(out[k])) break;
+  }
+  return out;
+}
+
+/// The run of one experiment from the outcomes of its replicas (in seed order).
+ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector<const SimulatedOutcome*>& replicas) {
+  ExperimentRun run;
+  run.id = experiment.id;
+  run.test = experiment.setup.test;
+  run.replicas = static_cast<int>(replicas.size());
+  std::map<std::string, int> flags;
+  for (size_t r = 0; r < replicas.size(); ++r) {
+    const SimulatedOutcome& out = *replicas[r];
+    for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
+    for (const std::string& f : out.flags) ++flags[f];
+    if (r == 0) run.notes = out.notes, run.particles = out.particles;
+    run.wall_seconds += out.wall_seconds;
+  }
+  for (const auto& [key, list] : run.values) {
+    const double n = static_cast<double>(list.size());
+    const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
+    double ss = 0;
+    for (double v : list) ss += (v - mean) * (v - mean);
+    run.mean[key] = mean;
+    run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+  }
+  for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
+  return run;
+}
+
+/// Every experiment simulated `replicas` times (seeds options.seed, +1, ...) as one batch; any
+/// error stops the comparison (the first in experiment and replica order is thrown). A progress
+/// step, labelled prefix + id, when the last replica of an experiment is known.
+std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, const std::vector<Experiment>& experiments,
+                                                const CalibrationOptions& options, int replicas, Progress* progress,
+                                                const std::string& prefix) {
+  replicas = std::max(1, replicas);
+  std::vector<Job> jobs;
+  for (const Experiment& e : experiments)
+    for (int r = 0; r < replicas; ++r) jobs.push_back({&model, &e.setup, options.seed + static_cast<std::uint64_t>(r)});
+  std::vector<int> known(experiments.size(), 0);
+  const std::vector<BatchOutcome> outcomes = run_batch(
+      jobs, options,
+      [&](size_t k, const BatchOutcome& b) {
+        const size_t e = k / static_cast<size_t>(replicas);
+        if (b.error == BatchOutcome::Error::none && ++known[e] == replicas && progress) progress->step(prefix + experiments[e].id);
+      },
+      [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
+  for (const BatchOutcome& b : outcomes)
+    if (b.error != BatchOutcome::Error::none) rethrow(b);
+  std::vector<ExperimentRun> runs;
+  for (size_t e = 0; e < experiments.size(); ++e) {
+    std::vector<const SimulatedOutcome*> list;
+    for (int r = 0; r < replicas; ++r) list.push_back(&outcomes[e * replicas + r].outcome);
+    runs.push_back(summarise_replicas(experiments[e], list));
+  }
+  return runs;
 }
 
 /// The set-up number that varies most (relative) over the experiments of one test.
@@ -108,29 +215,7 @@ double Comparison::residual(const std::string& experiment, const std::string& ob
 // ---- comparison ---------------------------------------------------------------------------
 
 ExperimentRun simulate_experiment(const MaterialModel& model, const Experiment& experiment, const CalibrationOptions& options, int replicas) {
-  ExperimentRun run;
-  run.id = experiment.id;
-  run.test = experiment.setup.test;
-  run.replicas = std::max(1, replicas);
-  const Clock::time_point t0 = Clock::now();
-  std::map<std::string, int> flags;
-  for (int r = 0; r < run.replicas; ++r) {
-    const SimulatedOutcome out = run_one(model, experiment.setup, options, options.seed + static_cast<std::uint64_t>(r));
-    for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
-    for (const std::string& f : out.flags) ++flags[f];
-    if (r == 0) run.notes = out.notes, run.particles = out.particles;
-  }
-  for (const auto& [key, list] : run.values) {
-    const double n = static_cast<double>(list.size());
-    const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
-    double ss = 0;
-    for (double v : list) ss += (v - mean) * (v - mean);
-    run.mean[key] = mean;
-    run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
-  }
-  for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
-  run.wall_seconds = seconds_since(t0);
-  return run;
+  return simulate_experiments(model, {experiment}, options, replicas, nullptr, "").front();
 }
 
 Comparison compare_runs(const MeasurementSet& measured, const std::vector<ExperimentRun>& runs, const CalibrationOptions& options,
@@ -188,12 +273,7 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
 
 Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {
   Progress progress{options, "compare", static_cast<int>(measured.experiments.size())};
-  std::vector<ExperimentRun> runs;
-  for (const Experiment& e : measured.experiments) {
-    runs.push_back(simulate_experiment(model, e, options, options.replicas));
-    progress.step(e.id);
-  }
-  return compare_runs(measured, runs, options);
+  return compare_runs(measured, simulate_experiments(model, measured.experiments, options, options.replicas, &progress, ""), options);
 }
 
 std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms) {
@@ -514,26 +594,43 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
     }
     const Eigen::MatrixXd design = latin_hypercube(box, points, options.seed + 7919u * static_cast<std::uint64_t>(round));
     Eigen::MatrixXd values(points, static_cast<Eigen::Index>(names.size()));
+    values.setConstant(kNaN);
+    // The round's simulations, every experiment at every point, as one batch (common random
+    // numbers: the same packing seed everywhere). A point whose simulation fails is skipped; bad
+    // input (CaseError) stops the calibration.
+    std::vector<MaterialModel> models;
+    for (int k = 0; k < points; ++k) models.push_back(with_values(model, parameters, design.row(k).transpose()));
+    const size_t n_experiments = measured.experiments.size();
+    std::vector<Job> jobs;
+    for (int k = 0; k < points; ++k)
+      for (const Experiment& e : measured.experiments) jobs.push_back({&models[k], &e.setup, options.seed});
+    const std::vector<BatchOutcome> outcomes = run_batch(
+        jobs, options,
+        [&](size_t j, const BatchOutcome& b) {
+          const size_t k = j / n_experiments;
+          const Experiment& e = measured.experiments[j % n_experiments];
+          if (b.error == BatchOutcome::Error::input) return;
+          if (b.error != BatchOutcome::Error::none && options.progress)
+            options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, b.message));
+          progress.step(fmt::format("round {} point {} {}", round + 1, k + 1, e.id));
+        },
+        [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
     std::vector<int> good;
     for (int k = 0; k < points; ++k) {
-      const MaterialModel m = with_values(model, parameters, design.row(k).transpose());
       bool ok = true;
-      values.row(k).setConstant(kNaN);
-      for (const Experiment& e : measured.experiments) {
-        try {
-          const SimulatedOutcome out = run_one(m, e.setup, options, options.seed);
-          for (const auto& [obs, v] : out.observables) {
-            const auto it = index.find(e.id + "/" + obs);
-            if (it != index.end()) values(k, it->second) = v;
-          }
-        } catch (const CaseError&) {
-          throw;
-        } catch (const std::exception& error) {
-          if (options.progress) options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, error.what()));
-          ok = false;
-        }
+      for (size_t x = 0; x < n_experiments; ++x) {
+        const BatchOutcome& b = outcomes[k * n_experiments + x];
+        if (b.error == BatchOutcome::Error::input) rethrow(b);
+        if (b.error == BatchOutcome::Error::not_run) throw std::logic_error("calibration: the batch runner left a design simulation not run");
         ++result.simulations;
-        progress.step(fmt::format("round {} point {} {}", round + 1, k + 1, e.id));
+        if (b.error != BatchOutcome::Error::none) {
+          ok = false;
+          continue;
+        }
+        for (const auto& [obs, v] : b.outcome.observables) {
+          const auto it = index.find(measured.experiments[x].id + "/" + obs);
+          if (it != index.end()) values(k, it->second) = v;
+        }
       }
       if (ok && values.row(k).allFinite()) good.push_back(k);
     }
@@ -779,13 +876,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     c.add(with);
     for (const auto& [key, v] : c.start) set_parameter(with, key, v);
     // Signature: the change of every term, one replica each, same packing seed as the base run's first replica.
-    std::vector<ExperimentRun> runs;
-    CalibrationOptions one = options;
-    one.replicas = 1;
-    for (const Experiment& e : measured.experiments) {
-      runs.push_back(simulate_experiment(with, e, one, 1));
-      progress.step(c.name + " " + e.id);
-    }
+    const std::vector<ExperimentRun> runs = simulate_experiments(with, measured.experiments, options, 1, &progress, c.name + " ");
     std::map<std::string, double> floor;
     for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
     const Comparison& changed = at_start[c.name] = compare_runs(measured, runs, options, floor);

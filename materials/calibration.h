@@ -45,8 +45,28 @@ namespace dem::materials {
 /// Runs one virtual test; the default is run_virtual_test.
 using Simulator = std::function<SimulatedOutcome(const MaterialModel&, const TestSetup&, const TestOptions&)>;
 
+/// One simulation of a batch: its outcome, or the error that stopped it.
+struct BatchOutcome {
+  enum class Error { none, not_run, input, numerical, other };
+  Error error = Error::not_run;  ///< input: CaseError; numerical: NumericalError; other: any other exception
+  std::string message;           ///< what() of the error
+  SimulatedOutcome outcome;      ///< when error is none
+};
+
+/// Runs the independent simulations 0..count-1 of one batch (a design round, the replicas of a
+/// comparison) and returns their outcomes in order. `simulate(k)` runs simulation k and never
+/// throws; `done(k, outcome)` is called as each outcome becomes known (for progress lines).
+/// After an outcome for which `fatal` is true, a runner may leave later simulations not_run:
+/// the caller throws the first fatal error in batch order, so the outcome equals the serial one.
+/// The default (empty) runs them one after the other in this process; the app's MPI runner
+/// (app/mpi_campaign.h) shares them among ranks and gives every rank every outcome.
+using BatchRunner = std::function<std::vector<BatchOutcome>(size_t count, const std::function<BatchOutcome(size_t)>& simulate,
+                                                            const std::function<void(size_t, const BatchOutcome&)>& done,
+                                                            const std::function<bool(const BatchOutcome&)>& fatal)>;
+
 struct CalibrationOptions {
   Simulator simulator;          ///< empty: run_virtual_test
+  BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
   int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
   double size_factor = 1.0;     ///< passed to the virtual tests
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default
