@@ -359,33 +359,40 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   if (width > 0 && (!old_pairs.empty() || !old_walls.empty())) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
-    // Bucket old histories by the lower new slot of the pair.
+    // Old histories bucketed by the lower new slot of the pair (CSR: no allocation per slot),
+    // then each new pair looks through its slot's bucket.
     struct Entry { std::int32_t other; size_t row; };
-    std::vector<std::vector<Entry>> bucket(n);
-    for (const CarriedHistory& h : old_pairs) {
-      const std::int32_t a = slot_of[h.id_a], b = slot_of[h.other];
-      if (a < 0 || b < 0) continue;  // a particle left
-      bucket[std::min(a, b)].push_back({std::max(a, b), h.row});
-    }
-    for (size_t k = 0; k < n_pairs; ++k) {
-      for (const Entry& e : bucket[s.pairs.i[k]])
-        if (e.other == s.pairs.j[k]) {
-          std::memcpy(&s.pairs.history[k * width], &old_pair_history[e.row * width], width * sizeof(double));
-          break;
+    std::vector<std::int32_t> begin(n + 1);
+    std::vector<Entry> entries;
+    auto carry = [&](const std::vector<CarriedHistory>& old, bool walls, ContactList& list, const std::vector<double>& history) {
+      std::fill(begin.begin(), begin.end(), 0);
+      std::vector<std::array<std::int32_t, 2>> keyed;  // (lower slot, other), in the order of `old`
+      keyed.reserve(old.size());
+      for (const CarriedHistory& h : old) {
+        const std::int32_t a = slot_of[h.id_a];
+        const std::int32_t b = walls ? static_cast<std::int32_t>(h.other) : slot_of[h.other];
+        if (a < 0 || b < 0) {  // a particle left
+          keyed.push_back({-1, -1});
+          continue;
         }
-    }
-    for (auto& b : bucket) b.clear();
-    for (const CarriedHistory& h : old_walls) {
-      const std::int32_t a = slot_of[h.id_a];
-      if (a >= 0) bucket[a].push_back({static_cast<std::int32_t>(h.other), h.row});
-    }
-    for (size_t k = 0; k < s.wall_pairs.size(); ++k) {
-      for (const Entry& e : bucket[s.wall_pairs.i[k]])
-        if (e.other == s.wall_pairs.j[k]) {
-          std::memcpy(&s.wall_pairs.history[k * width], &old_wall_history[e.row * width], width * sizeof(double));
-          break;
-        }
-    }
+        keyed.push_back(walls ? std::array<std::int32_t, 2>{a, b} : std::array<std::int32_t, 2>{std::min(a, b), std::max(a, b)});
+        ++begin[keyed.back()[0] + 1];
+      }
+      for (size_t p = 0; p < n; ++p) begin[p + 1] += begin[p];
+      entries.resize(static_cast<size_t>(begin[n]));
+      std::vector<std::int32_t> cursor(begin.begin(), begin.end() - 1);
+      for (size_t q = 0; q < old.size(); ++q)
+        if (keyed[q][0] >= 0) entries[cursor[keyed[q][0]]++] = {keyed[q][1], old[q].row};
+      for (size_t k = 0; k < list.size(); ++k) {
+        for (std::int32_t e = begin[list.i[k]]; e < begin[list.i[k] + 1]; ++e)
+          if (entries[e].other == list.j[k]) {
+            std::memcpy(&list.history[k * width], &history[entries[e].row * width], width * sizeof(double));
+            break;
+          }
+      }
+    };
+    carry(old_pairs, false, s.pairs, old_pair_history);
+    carry(old_walls, true, s.wall_pairs, old_wall_history);
   }
 
   find_mesh_candidates(model, s, work, reach);
