@@ -569,17 +569,20 @@ TEST(DiagnoseReal, HiddenLiquidBridgesWithVirtualTests) {
              "peak_shear_stress", -0.03);
   add_real(set, "density", "bulk_density", {{"cup_diameter", 0.04}, {"cup_height", 0.03}}, {{"base", "steel"}}, "bulk_density", -0.02);
   set = synthesise_real(set, truth, 22, 0.5);
-  const Diagnosis d = diagnose(start, set, {}, real_options());
+  CalibrationOptions options = real_options();
+  options.rounds = 2;  // the second round zooms on the optimum: liquid content acts strongly below 1 %
+  const Diagnosis d = diagnose(start, set, {}, options);
   print("hidden liquid bridges", d, seconds_since(t0));
   EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
   ASSERT_FALSE(d.candidates.empty());
   EXPECT_EQ(d.candidates.front().name, "liquid_bridges");
   EXPECT_EQ(d.recommended, "liquid_bridges") << d.words.front();
-  // RELAXED: with one surrogate round over the effect's full range (liquid content 0-5 %, the
-  // truth at 1 %), the recalibrated yield locus still misses its low-stress point (measured run:
-  // chi^2/n 11.2 -> 6.6, JKR 12.8); a second round (--rounds 2) would refine it but doubles the
-  // cost beyond the suite's budget. Asserted: the error falls by a third with the bridges.
-  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 0.67 * d.base.after.chi2_per_n());
+  // Two surrogate rounds (measured: chi^2/n 31.1 -> 3.8, residuals within 2.7 sigma, 326 s on one
+  // core; one round left 6.6). Not quite the noise level (chi^2/n ~ 1): with two replicas of a
+  // ~500-particle shear cell the simulation noise itself is poorly known (the base model's peak
+  // at 600 Pa scatters by 18 %). Asserted: the bridges take the error down eightfold, below 5.
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 5.0);
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), d.base.after.chi2_per_n() / 5.0);
   ASSERT_GE(d.candidates.size(), 2u);
   EXPECT_GT(d.candidates.front().delta_bic, d.candidates[1].delta_bic + 5);  // bridges beat JKR cohesion on these data
 }
