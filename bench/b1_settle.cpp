@@ -191,14 +191,15 @@ std::size_t particle_bytes_held(const dem::State& s) {
 
 std::size_t contact_list_bytes(const dem::ContactList& c) { return bytes(c.i) + bytes(c.j) + bytes(c.history); }
 
-std::size_t contact_forces_bytes(const dem::ContactForces& f) {
-  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.tjx) +
-         bytes(f.tjy) + bytes(f.tjz) + bytes(f.active);
+std::size_t contact_forces_bytes(const dem::ContactForces& f) { return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.active); }
+
+std::size_t pair_forces_bytes(const dem::PairForces& f) {
+  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.tjx) + bytes(f.tjy) + bytes(f.tjz) + bytes(f.active) + bytes(f.slot);
 }
 
 std::size_t workspace_bytes(const dem::Workspace& w) {
   return bytes(w.pair_begin) + bytes(w.incoming_begin) +
-         bytes(w.incoming) + bytes(w.wall_begin) + contact_forces_bytes(w.pair_forces) +
+         bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order);
 }
 

@@ -48,14 +48,13 @@ void set_load(ContactBatch& b) {
 void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   ContactBatch& b = batch.b;
   evaluate_effects(model, b);
+  PairForces& pf = work.pair_forces;
+  ContactForces& wf = work.wall_forces;
   for (int c = 0; c < b.count; ++c) {
     const std::int32_t k = batch.contact[c], i = batch.owner[c];
-    ContactForces& out = batch.pair[c] ? work.pair_forces : work.wall_forces;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
     const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
-    out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
-    out.active[k] = 1;
     // Torque of the tangential force about each centre: (-lever n) x ft; plus rolling torque.
     const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
     s.fx[i] += fx, s.fy[i] += fy, s.fz[i] += fz;
@@ -63,21 +62,35 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
     s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
     s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
     if (batch.pair[c]) {
-      out.tjx[k] = -batch.lever_j[c] * cx - b.mx[c];
-      out.tjy[k] = -batch.lever_j[c] * cy - b.my[c];
-      out.tjz[k] = -batch.lever_j[c] * cz - b.mz[c];
+      const std::int32_t q = pf.slot[k];
+      pf.active[k] = 1;
+      pf.fx[q] = fx, pf.fy[q] = fy, pf.fz[q] = fz;
+      pf.tjx[q] = -batch.lever_j[c] * cx - b.mx[c];
+      pf.tjy[q] = -batch.lever_j[c] * cy - b.my[c];
+      pf.tjz[q] = -batch.lever_j[c] * cz - b.mz[c];
+    } else {
+      wf.active[k] = 1;
+      wf.fx[k] = fx, wf.fy[k] = fy, wf.fz[k] = fz;
     }
   }
   b.count = 0;
 }
 
-/// A listed contact that is not acting: inactive, history cleared. Only a contact that was
-/// active can have a history (index_contacts marks carried histories active), so idle pairs
-/// of the skin cost one byte read.
-void forget(ContactList& list, ContactForces& out, size_t k, int width) {
-  if (!out.active[k]) return;
-  out.active[k] = 0;
+/// A listed contact that is not acting: inactive, history and kept force cleared. Only a
+/// contact that was active can have a history or a force (index_contacts marks carried
+/// histories active), so idle pairs of the skin cost one byte read.
+void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
+  if (!active) return;
+  active = 0;
   std::fill_n(&list.history[k * width], width, 0.0);
+}
+
+void forget_pair(State& s, PairForces& pf, size_t k, int width) {
+  if (!pf.active[k]) return;
+  forget(s.pairs, pf.active[k], k, width);
+  const std::int32_t q = pf.slot[k];
+  pf.fx[q] = pf.fy[q] = pf.fz[q] = 0.0;
+  pf.tjx[q] = pf.tjy[q] = pf.tjz[q] = 0.0;
 }
 
 /// Relative-motion columns common to particle and wall contacts.
@@ -109,7 +122,7 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     const double dist2 = dx * dx + dy * dy + dz * dz;
     const double reach = ri + s.radius[j] + range;
     if (dist2 >= reach * reach) {
-      forget(s.pairs, work.pair_forces, k, width);
+      forget_pair(s, work.pair_forces, k, width);
       continue;
     }
     const int c = b.count;
@@ -153,7 +166,7 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     const double nx = normal[0], ny = normal[1], nz = normal[2];
     const double overlap = s.radius[i] - dist;
     if (overlap <= -range || dist <= 0.0) {
-      forget(s.wall_pairs, work.wall_forces, k, width);
+      forget(s.wall_pairs, work.wall_forces.active[k], k, width);
       continue;
     }
     const int c = b.count;
@@ -209,17 +222,16 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 
   mesh_contact_forces(model, s, work);
 
-  // Incoming pairs (as j), gravity, and the closing half kick of free spheres.
-  const ContactForces& pf = work.pair_forces;
+  // Incoming pairs (as j, streamed in slot order; idle pairs hold zeros), gravity, and the
+  // closing half kick of free spheres.
+  const PairForces& pf = work.pair_forces;
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (long p = 0; p < n; ++p) {
     double fx = s.fx[p], fy = s.fy[p], fz = s.fz[p], tx = s.tx[p], ty = s.ty[p], tz = s.tz[p];
     for (std::int32_t q = work.incoming_begin[p]; q < work.incoming_begin[p + 1]; ++q) {
-      const std::int32_t k = work.incoming[q];
-      if (!pf.active[k]) continue;
-      fx -= pf.fx[k], fy -= pf.fy[k], fz -= pf.fz[k];
-      tx += pf.tjx[k], ty += pf.tjy[k], tz += pf.tjz[k];
+      fx -= pf.fx[q], fy -= pf.fy[q], fz -= pf.fz[q];
+      tx += pf.tjx[q], ty += pf.tjy[q], tz += pf.tjz[q];
     }
     // A body carries its own weight; a glued sphere is part of its wall, which has none.
     const bool free = s.body[p] < 0 && s.attached[p] < 0;

@@ -190,7 +190,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   if (model.meshes.empty()) return;
   MeshSlotResults& slot_results = work.mesh_slots;
   if (work.mesh_forces.fx.size() != n * kSlots) {  // slots beyond a particle's count are never read
-    work.mesh_forces.resize(n * kSlots, false);
+    work.mesh_forces.resize(n * kSlots);
     slot_results.resize(n * kSlots);
   }
   const double range = model.interaction_range;

@@ -179,9 +179,8 @@ void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>
 
 }  // namespace
 
-void ContactForces::resize(std::size_t n, bool reaction_torques) {
+void ContactForces::resize(std::size_t n) {
   for (auto* c : {&fx, &fy, &fz}) c->assign(n, 0.0);
-  for (auto* c : {&tjx, &tjy, &tjz}) c->assign(reaction_torques ? n : 0, 0.0);
   active.assign(n, 0);
 }
 
@@ -194,12 +193,13 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr(work.pair_begin, s.pairs.i, n);
   build_csr(work.wall_begin, s.wall_pairs.i, n);
-  // Incoming index: pairs in which slot p is j, in pair order.
+  // Incoming slots: the pairs in which slot p is j, in pair order, are contiguous.
   build_csr(work.incoming_begin, s.pairs.j, n);
-  work.incoming.resize(s.pairs.size());
+  PairForces& pf = work.pair_forces;
+  pf.slot.resize(s.pairs.size());
   {
     std::vector<std::int32_t> cursor(work.incoming_begin.begin(), work.incoming_begin.end() - 1);
-    for (size_t k = 0; k < s.pairs.size(); ++k) work.incoming[cursor[s.pairs.j[k]]++] = static_cast<std::int32_t>(k);
+    for (size_t k = 0; k < s.pairs.size(); ++k) pf.slot[k] = cursor[s.pairs.j[k]]++;
   }
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
@@ -212,15 +212,16 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
     for (size_t p = 0; p < n; ++p)
       if (s.body[p] >= 0) work.body_members[cursor[s.body[p]]++] = static_cast<std::int32_t>(p);
   }
-  work.pair_forces.resize(s.pairs.size(), true);
-  work.wall_forces.resize(s.wall_pairs.size(), false);
+  for (auto* c : {&pf.fx, &pf.fy, &pf.fz, &pf.tjx, &pf.tjy, &pf.tjz}) c->assign(s.pairs.size(), 0.0);
+  pf.active.assign(s.pairs.size(), 0);
+  work.wall_forces.resize(s.wall_pairs.size());
   // A contact with a history counts as active until it is next evaluated: the contact loop
   // clears the history of an inactive contact only when it was active (idle pairs of the skin
   // are then read, never written, and their history rows not touched at all).
   const int width = model.history_width;
-  for (auto [list, forces] : {std::pair{&s.pairs, &work.pair_forces}, std::pair{&s.wall_pairs, &work.wall_forces}})
+  for (auto [list, active] : {std::pair{&s.pairs, &pf.active}, std::pair{&s.wall_pairs, &work.wall_forces.active}})
     for (size_t k = 0; k < list->size() && width > 0; ++k)
-      forces->active[k] = !row_is_zero(&list->history[k * width], width);
+      (*active)[k] = !row_is_zero(&list->history[k * width], width);
   work.valid = true;
 }
 

@@ -6,13 +6,13 @@ namespace dem {
 
 Eigen::Matrix3d contact_stress(const Model& model, const State& s, const Workspace& work, double volume, bool with_walls) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();  // [N m]
-  const ContactForces& pf = work.pair_forces;
+  const PairForces& pf = work.pair_forces;
   for (size_t k = 0; k < s.pairs.size(); ++k) {
     if (!pf.active[k]) continue;
     const size_t i = s.pairs.i[k], j = s.pairs.j[k];
     double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
     minimum_image(model, d);
-    const Eigen::Vector3d branch(d[0], d[1], d[2]), force(pf.fx[k], pf.fy[k], pf.fz[k]);
+    const Eigen::Vector3d branch(d[0], d[1], d[2]), force(pf.force(k, 0), pf.force(k, 1), pf.force(k, 2));
     sum += branch * force.transpose();
   }
   if (with_walls) {

@@ -8,16 +8,30 @@
 
 namespace dem {
 
-/// Forces of each listed contact from the last evaluation. The force and torque on body i are
-/// added to i's totals as the contact is evaluated (by the thread that owns i); what body j
-/// receives is kept here and summed per particle afterwards, in list order, so results do not
-/// depend on the thread count. Per contact: 6 doubles + 1 byte = 49 bytes (3 + 1 = 25 without
-/// reaction torques: wall and mesh contacts).
+/// Forces of each listed wall or mesh contact from the last evaluation (by contact index). The
+/// force and torque on the particle were added to its totals as the contact was evaluated.
+/// Per contact: 3 doubles + 1 byte.
 struct ContactForces {
-  std::vector<double> fx, fy, fz;     // [N] on body i
-  std::vector<double> tjx, tjy, tjz;  // [N m] on body j (particle pairs only, else empty)
+  std::vector<double> fx, fy, fz;     // [N] on the particle
   std::vector<std::uint8_t> active;   // 1 when the contact exerted a force this step
-  void resize(std::size_t n, bool reaction_torques);
+  void resize(std::size_t n);
+};
+
+/// Particle pairs. The force and torque on body i were added to i's totals by the thread that
+/// owns i, in list order; what body j receives is kept here in j's incoming order (slot q =
+/// slot[k] of pair k; j's incoming pairs are contiguous and in pair order), so the per-particle
+/// sum afterwards streams through them and does not depend on the thread count. A pair that is
+/// not acting has zeros in its slot. Per pair: 6 doubles + 4 bytes + 1 byte = 53 bytes.
+struct PairForces {
+  std::vector<std::uint8_t> active;   ///< by pair k: 1 when the contact exerted a force this step
+  std::vector<std::int32_t> slot;     ///< by pair k: its incoming slot q
+  std::vector<double> fx, fy, fz;     // [N] by slot q: force on body i (body j receives minus this)
+  std::vector<double> tjx, tjy, tjz;  // [N m] by slot q: torque on body j
+  /// Force on body i of pair k [N].
+  double force(std::size_t k, int axis) const {
+    const std::size_t q = static_cast<std::size_t>(slot[k]);
+    return axis == 0 ? fx[q] : axis == 1 ? fy[q] : fz[q];
+  }
 };
 
 /// Per mesh-contact slot, what the records of triangles and meshes need from the evaluation.
@@ -38,10 +52,12 @@ struct Workspace {
   std::int64_t rebuilds = 0;
 
   // Contact-list indexing (n + 1 entries each): pairs owned by slot p are
-  // [pair_begin[p], pair_begin[p+1]); pairs where p is j are incoming[incoming_begin[p] ...].
-  std::vector<std::int32_t> pair_begin, incoming_begin, incoming, wall_begin;
+  // [pair_begin[p], pair_begin[p+1]); the incoming slots of pairs where p is j are
+  // [incoming_begin[p], incoming_begin[p+1]) (PairForces::slot).
+  std::vector<std::int32_t> pair_begin, incoming_begin, wall_begin;
 
-  ContactForces pair_forces, wall_forces;
+  PairForces pair_forces;
+  ContactForces wall_forces;
 
   // Meshes where they are at the time forces are evaluated: x_world = R x_local + T, and the
   // rigid velocity field. (n_meshes)

@@ -81,7 +81,7 @@ TEST(ServoWall, HoldsItsTargetStressAndTheContactStressTensorAgrees) {
     const double dx = st.x[i] - st.x[j], dy = st.y[i] - st.y[j];
     if (std::abs(dx) > 0.015 || std::abs(dy) > 0.015) {
       const double wrapped = dx - 0.03 * std::nearbyint(dx / 0.03);
-      across += wrapped * sim.work.pair_forces.fx[k] / volume;
+      across += wrapped * sim.work.pair_forces.force(k, 0) / volume;
     }
   }
   EXPECT_GT(across, 0.05 * all(0, 0)) << "periodic pairs carry a share of the lateral stress";
@@ -177,7 +177,7 @@ particles:
   double sum[2][3] = {};  // contact forces on the glued spheres of each wall
   for (size_t k = 0; k < s.pairs.size(); ++k) {
     if (!sim.work.pair_forces.active[k]) continue;
-    const double f[3] = {sim.work.pair_forces.fx[k], sim.work.pair_forces.fy[k], sim.work.pair_forces.fz[k]};
+    const double f[3] = {sim.work.pair_forces.force(k, 0), sim.work.pair_forces.force(k, 1), sim.work.pair_forces.force(k, 2)};
     const std::int32_t wi = s.attached[s.pairs.i[k]], wj = s.attached[s.pairs.j[k]];
     EXPECT_FALSE(wi >= 0 && wi == wj) << "no contacts within one glued layer";
     for (int a = 0; a < 3; ++a) {

@@ -40,12 +40,14 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
 
 // MV-1: W = C rho_b sqrt(g) (D0 - k d)^2.5, flat-bottomed silo, circular orifice. Published
 // ranges: C = 0.55-0.65, k = 1.3-2.9 (Beverloo et al. 1961; Nedderman 1992; reference values G).
-// The simulated discharge of three orifices (5, 6.7 and 8.3 particle diameters) must follow the
-// 5/2 power (W^0.4 linear in D0 within 3 %) with C and k in the published ranges, widened to
-// C 0.45-0.75 and k 1.0-3.0 for a frictional sphere model.
+// The law holds for D0 > ~6 d and a silo wider than 2.5 D0, so the three orifices span that window
+// in this 0.125 m silo: 6.2, 7.3 and 8.3 particle diameters (a 5 d orifice flows intermittently,
+// near clogging, and its rate moved the fitted C by 20 % between runs that differ only in the
+// last bits). The discharge must follow the 5/2 power (W^0.4 linear in D0 within 3 %) with C and
+// k in the published ranges, widened to C 0.45-0.75 and k 1.0-3.0 for a frictional sphere model.
 TEST(Beverloo, SiloDischargeFollowsTheFiveHalvesLawWithPublishedConstants) {
   const double d = 0.006, g = 9.81;
-  std::vector<double> orifices = {0.03, 0.04, 0.05}, rates;
+  std::vector<double> orifices = {0.037, 0.0435, 0.05}, rates;
   double bulk_density_sum = 0;
   for (double orifice : orifices) {
     Sim sim(equipment_case("silo_discharge.yaml", [&](YAML::Node& root) { root["equipment"]["silo"]["orifice_diameter"] = orifice; }));
