@@ -194,11 +194,11 @@ std::size_t contact_list_bytes(const dem::ContactList& c) { return bytes(c.i) + 
 std::size_t contact_forces_bytes(const dem::ContactForces& f) { return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.active); }
 
 std::size_t pair_forces_bytes(const dem::PairForces& f) {
-  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.tjx) + bytes(f.tjy) + bytes(f.tjz) + bytes(f.active) + bytes(f.slot);
+  return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.active);
 }
 
 std::size_t workspace_bytes(const dem::Workspace& w) {
-  return bytes(w.pair_begin) + bytes(w.incoming_begin) +
+  return bytes(w.pair_begin) +
          bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order);
 }

@@ -95,18 +95,31 @@ void remove_lost(const Model& model, State& state) {
 }
 
 /// Cells along each axis; periodic axes span exactly one period, others the particles' extent.
+/// Cells are numbered with the non-periodic axis of most cells varying slowest (`order`: minor,
+/// middle, major), so that after the sort a particle's neighbours lie within a short run of slots (the
+/// block size of the force evaluation, see forces.cpp) even in long, flat equipment.
 struct Grid {
   double origin[3];
   double cell[3];
   int dims[3];
   bool wrap[3];
   double period[3];
+  int order[3] = {0, 1, 2};
   int axis_index(int a, double v) const {
     if (wrap[a]) v -= period[a] * std::floor((v - origin[a]) / period[a]);
     return std::clamp(static_cast<int>((v - origin[a]) / cell[a]), 0, dims[a] - 1);
   }
+  int encode(const int at[3]) const {
+    return (at[order[2]] * dims[order[1]] + at[order[1]]) * dims[order[0]] + at[order[0]];
+  }
+  void decode(int c, int at[3]) const {
+    at[order[0]] = c % dims[order[0]];
+    at[order[1]] = (c / dims[order[0]]) % dims[order[1]];
+    at[order[2]] = c / (dims[order[0]] * dims[order[1]]);
+  }
   int index(double x, double y, double z) const {
-    return (axis_index(2, z) * dims[1] + axis_index(1, y)) * dims[0] + axis_index(0, x);
+    const int at[3] = {axis_index(0, x), axis_index(1, y), axis_index(2, z)};
+    return encode(at);
   }
 };
 
@@ -140,6 +153,11 @@ Grid make_grid(const Model& model, const State& s, double cell) {
     if (cells <= cap) break;
     cell *= 1.26;
   }
+  // Major axis: the non-periodic axis of most cells (a pair across a periodic boundary of the
+  // major axis would stretch the slot span to the whole system).
+  std::stable_sort(g.order, g.order + 3, [&](int a, int b) {
+    return std::pair(!g.wrap[a], g.dims[a]) < std::pair(!g.wrap[b], g.dims[b]);
+  });
   return g;
 }
 
@@ -193,14 +211,10 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr(work.pair_begin, s.pairs.i, n);
   build_csr(work.wall_begin, s.wall_pairs.i, n);
-  // Incoming slots: the pairs in which slot p is j, in pair order, are contiguous.
-  build_csr(work.incoming_begin, s.pairs.j, n);
-  PairForces& pf = work.pair_forces;
-  pf.slot.resize(s.pairs.size());
-  {
-    std::vector<std::int32_t> cursor(work.incoming_begin.begin(), work.incoming_begin.end() - 1);
-    for (size_t k = 0; k < s.pairs.size(); ++k) pf.slot[k] = cursor[s.pairs.j[k]]++;
-  }
+  // Block size of the force evaluation: every pair's partner lies in its own block or the next.
+  std::int32_t span = 0;
+  for (size_t k = 0; k < s.pairs.size(); ++k) span = std::max(span, s.pairs.j[k] - s.pairs.i[k]);
+  work.block = std::max<std::int32_t>(span + 1, 64);
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
   for (size_t p = 0; p < n; ++p)
@@ -212,7 +226,8 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
     for (size_t p = 0; p < n; ++p)
       if (s.body[p] >= 0) work.body_members[cursor[s.body[p]]++] = static_cast<std::int32_t>(p);
   }
-  for (auto* c : {&pf.fx, &pf.fy, &pf.fz, &pf.tjx, &pf.tjy, &pf.tjz}) c->assign(s.pairs.size(), 0.0);
+  PairForces& pf = work.pair_forces;
+  for (auto* c : {&pf.fx, &pf.fy, &pf.fz}) c->assign(s.pairs.size(), 0.0);
   pf.active.assign(s.pairs.size(), 0);
   work.wall_forces.resize(s.wall_pairs.size());
   // A contact with a history counts as active until it is next evaluated: the contact loop
@@ -289,8 +304,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   std::vector<std::int32_t> count(n + 1, 0);
   // The up to 27 distinct cells around a cell (fewer where a periodic axis has < 3 cells).
   auto visit = [&](size_t i, auto&& emit) {
-    const int c = work.cell_of[i];
-    const int at[3] = {c % grid.dims[0], (c / grid.dims[0]) % grid.dims[1], c / (grid.dims[0] * grid.dims[1])};
+    int at[3];
+    grid.decode(work.cell_of[i], at);
     int axis_cells[3][3] = {}, axis_count[3] = {};
     for (int a = 0; a < 3; ++a) {
       axis_count[a] = 0;
@@ -306,7 +321,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     for (int iz = 0; iz < axis_count[2]; ++iz)
       for (int iy = 0; iy < axis_count[1]; ++iy)
         for (int ix = 0; ix < axis_count[0]; ++ix) {
-          const int cell = (axis_cells[2][iz] * grid.dims[1] + axis_cells[1][iy]) * grid.dims[0] + axis_cells[0][ix];
+          const int around[3] = {axis_cells[0][ix], axis_cells[1][iy], axis_cells[2][iz]};
+          const int cell = grid.encode(around);
           for (int j = std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1); j < work.cell_start[cell + 1]; ++j) {
             if (s.body[i] >= 0 && s.body[i] == s.body[j]) continue;  // spheres of one clump
             if (s.attached[i] >= 0 && s.attached[i] == s.attached[j]) continue;  // glued to one wall

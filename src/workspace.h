@@ -17,21 +17,13 @@ struct ContactForces {
   void resize(std::size_t n);
 };
 
-/// Particle pairs. The force and torque on body i were added to i's totals by the thread that
-/// owns i, in list order; what body j receives is kept here in j's incoming order (slot q =
-/// slot[k] of pair k; j's incoming pairs are contiguous and in pair order), so the per-particle
-/// sum afterwards streams through them and does not depend on the thread count. A pair that is
-/// not acting has zeros in its slot. Per pair: 6 doubles + 4 bytes + 1 byte = 53 bytes.
+/// Particle pairs, by pair k: whether the contact acted at the last evaluation and its force on
+/// body i (body j received minus this). Per pair: 3 doubles + 1 byte = 25 bytes.
 struct PairForces {
-  std::vector<std::uint8_t> active;   ///< by pair k: 1 when the contact exerted a force this step
-  std::vector<std::int32_t> slot;     ///< by pair k: its incoming slot q
-  std::vector<double> fx, fy, fz;     // [N] by slot q: force on body i (body j receives minus this)
-  std::vector<double> tjx, tjy, tjz;  // [N m] by slot q: torque on body j
+  std::vector<std::uint8_t> active;  ///< 1 when the contact exerted a force this step
+  std::vector<double> fx, fy, fz;    // [N] on body i
   /// Force on body i of pair k [N].
-  double force(std::size_t k, int axis) const {
-    const std::size_t q = static_cast<std::size_t>(slot[k]);
-    return axis == 0 ? fx[q] : axis == 1 ? fy[q] : fz[q];
-  }
+  double force(std::size_t k, int axis) const { return axis == 0 ? fx[k] : axis == 1 ? fy[k] : fz[k]; }
 };
 
 /// Per mesh-contact slot, what the records of triangles and meshes need from the evaluation.
@@ -52,9 +44,11 @@ struct Workspace {
   std::int64_t rebuilds = 0;
 
   // Contact-list indexing (n + 1 entries each): pairs owned by slot p are
-  // [pair_begin[p], pair_begin[p+1]); the incoming slots of pairs where p is j are
-  // [incoming_begin[p], incoming_begin[p+1]) (PairForces::slot).
-  std::vector<std::int32_t> pair_begin, incoming_begin, wall_begin;
+  // [pair_begin[p], pair_begin[p+1]); wall contacts likewise.
+  std::vector<std::int32_t> pair_begin, wall_begin;
+  /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
+  /// (forces.cpp).
+  std::int32_t block = 64;
 
   PairForces pair_forces;
   ContactForces wall_forces;
