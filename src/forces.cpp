@@ -37,10 +37,13 @@ struct Batch {
 };
 
 void zero_outputs(ContactBatch& b) {
-  const size_t bytes = sizeof(double) * b.count;
-  for (double* column : {b.fn, b.fn_elastic, b.load, b.kn, b.kt, b.damp_sn, b.damp_st, b.damp_shape, b.gamma_n,
-                         b.gamma_t, b.ftx, b.fty, b.ftz, b.mx, b.my, b.mz, b.energy_dissipated})
-    std::memset(column, 0, bytes);
+  // One loop over the outputs rather than a memset per column: 17 short memsets cost more in
+  // calls than the stores themselves.
+  for (int c = 0; c < b.count; ++c) {
+    b.fn[c] = b.fn_elastic[c] = b.load[c] = b.kn[c] = b.kt[c] = 0.0;
+    b.damp_sn[c] = b.damp_st[c] = b.damp_shape[c] = b.gamma_n[c] = b.gamma_t[c] = 0.0;
+    b.ftx[c] = b.fty[c] = b.ftz[c] = b.mx[c] = b.my[c] = b.mz[c] = b.energy_dissipated[c] = 0.0;
+  }
 }
 
 void set_load(ContactBatch& b) {
