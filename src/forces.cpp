@@ -127,8 +127,8 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
       continue;
     }
     const int c = b.count;
-    const double dist = std::sqrt(dist2);
-    const double nx = dx / dist, ny = dy / dist, nz = dz / dist;
+    const double dist = std::sqrt(dist2), inv_dist = 1.0 / dist;
+    const double nx = dx * inv_dist, ny = dy * inv_dist, nz = dz * inv_dist;
     const double overlap = ri + s.radius[j] - dist;
     const double lever_i = ri - 0.5 * overlap, lever_j = s.radius[j] - 0.5 * overlap;
     // Contact-point velocity of j: v_j + w_j x (lever_j n).

@@ -63,9 +63,10 @@ void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
       fx *= scale;
       fy *= scale;
       fz *= scale;
-      xi[0] = -fx / kt;
-      xi[1] = -fy / kt;
-      xi[2] = -fz / kt;
+      const double inv_kt = 1.0 / kt;
+      xi[0] = -fx * inv_kt;
+      xi[1] = -fy * inv_kt;
+      xi[2] = -fz * inv_kt;
     }
     b.ftx[c] += fx;
     b.fty[c] += fy;
