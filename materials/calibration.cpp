@@ -308,50 +308,64 @@ std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms) {
     const bool varies = !p.varied.empty() && hi > lo;
     std::set<double> distinct;
     for (const Term* t : list) distinct.insert(t->varied_value);
-    Eigen::VectorXd y(p.count);
-    Eigen::VectorXd z(p.count);
-    for (int i = 0; i < p.count; ++i) y[i] = list[i]->residual, z[i] = varies ? 2 * (list[i]->varied_value - lo) / (hi - lo) - 1 : 0;
-    const double mean_se = 1.0 / std::sqrt(static_cast<double>(p.count));
+    // Weighted least squares on the differences d = simulated - measured in the observable's own
+    // unit (d_i = r_i s_i, s_i = sqrt(s_meas^2 + s_sim^2)): rows scaled by 1/s_i, so y = r. A
+    // constant offset in stress units (cohesion) is then told apart from a slope (friction) even
+    // when the experiments' uncertainties differ, which residuals in sigma would read as a trend.
+    Eigen::VectorXd y(p.count), z(p.count), w(p.count);
+    double typical = 0;  // rms uncertainty of the group, in the observable's unit
+    for (int i = 0; i < p.count; ++i) {
+      const Term& t = *list[i];
+      const double sigma = std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
+      w[i] = sigma > 0 ? 1.0 / sigma : 1.0;
+      y[i] = t.residual;
+      z[i] = varies ? 2 * (t.varied_value - lo) / (hi - lo) - 1 : 0;
+      typical += 1.0 / (w[i] * w[i]) / p.count;
+    }
+    typical = std::sqrt(typical);
     bool slope_significant = false, curve_significant = false;
     if (varies && distinct.size() >= 2) {
       Eigen::MatrixXd X(p.count, 2);
-      X.col(0).setOnes(), X.col(1) = z;
+      X.col(0) = w, X.col(1) = z.cwiseProduct(w);
       Eigen::VectorXd coef, se;
       regress(X, y, coef, se);
       p.slope = 2 * coef[1];  // change over the whole range
-      slope_significant = std::abs(coef[1]) > 2 * se[1] && std::abs(p.slope) > 1.5;
+      p.at_low = coef[0] - coef[1], p.at_high = coef[0] + coef[1];
+      slope_significant = std::abs(coef[1]) > 2 * se[1] && std::abs(p.slope) > 1.5 * typical;
       if (distinct.size() >= 4) {
         Eigen::MatrixXd Q(p.count, 3);
-        Q.col(0).setOnes(), Q.col(1) = z, Q.col(2) = z.cwiseProduct(z);
+        Q.col(0) = w, Q.col(1) = z.cwiseProduct(w), Q.col(2) = z.cwiseProduct(z).cwiseProduct(w);
         regress(Q, y, coef, se);
         p.curvature = coef[2];
-        curve_significant = std::abs(coef[2]) > 2 * se[2] && std::abs(coef[2]) > 1.0;
+        curve_significant = std::abs(coef[2]) > 2 * se[2] && std::abs(coef[2]) > 1.0 * typical;
       }
     }
-    const bool offset_significant = std::abs(p.mean) > 2 * mean_se && std::abs(p.mean) > 1.0;
+    // The weighted mean difference and its standard error.
+    p.offset = w.dot(y) / w.squaredNorm();
+    const double offset_se = 1.0 / w.norm();
+    const bool offset_significant = std::abs(p.offset) > 2 * offset_se && std::abs(p.offset) > 1.0 * typical;
     const std::string range = varies ? fmt::format("{} from {:g} to {:g}", p.varied, lo, hi) : "the experiments";
     if (p.chi2 / p.count <= 2.0 && !slope_significant && !offset_significant) {
       p.kind = "fits";
       p.words = fmt::format("{}: fits within the noise over {} (mean residual {}).", what, range, signed_sigma(p.mean));
     } else if (curve_significant) {
       p.kind = "curvature";
-      p.words = fmt::format("{}: wrong curvature with {}: the residuals bend ({:+.1f} sigma at the ends relative to the middle) over {}.", what,
+      p.words = fmt::format("{}: wrong curvature with {}: simulated - measured bends by {:+.4g} at the ends relative to the middle over {}.", what,
                             p.varied, p.curvature, range);
     } else if (slope_significant) {
       p.kind = "trend";
-      p.words = fmt::format("{}: wrong trend with {}: the residual goes from {} to {} over {} (the simulated value {} faster with {} than the measured one).",
-                            what, p.varied, signed_sigma(p.mean - p.slope / 2), signed_sigma(p.mean + p.slope / 2), range,
-                            p.slope > 0 ? "rises" : "falls", p.varied);
+      p.words = fmt::format("{}: wrong trend with {}: simulated - measured goes from {:+.4g} to {:+.4g} over {} (the simulated value {} faster with {} than the measured one).",
+                            what, p.varied, p.at_low, p.at_high, range, p.slope > 0 ? "rises" : "falls", p.varied);
       if (p.test == "direct_shear" && p.observable == "peak_shear_stress")
         p.words += " The yield locus has the wrong slope: the internal friction (sliding or rolling friction) is off.";
       if (p.test == "rotating_drum") p.words += " The speed dependence of the dynamic angle is wrong (damping, rolling resistance or cohesion).";
     } else if (offset_significant) {
       p.kind = "offset";
-      p.words = fmt::format("{}: a constant offset: simulated {} than measured by {:.1f} sigma on average over {}, with no trend.", what, sign_word,
-                            std::abs(p.mean), range);
+      p.words = fmt::format("{}: a constant offset: simulated {} than measured by {:.4g} ({:.1f} sigma) on average over {}, with no trend.", what,
+                            p.offset > 0 ? "higher" : "lower", std::abs(p.offset), std::abs(p.mean), range);
       if (p.test == "direct_shear" && p.observable == "peak_shear_stress")
         p.words += fmt::format(" The yield locus is offset by a constant while its slope fits: {}.",
-                               p.mean < 0 ? "cohesion is missing (liquid bridges or van der Waals)" : "the model has too much cohesion");
+                               p.offset < 0 ? "cohesion is missing (liquid bridges or van der Waals)" : "the model has too much cohesion");
     } else {
       p.kind = "scatter";
       p.words = fmt::format("{}: misfit without a pattern (chi^2/n = {:.1f} over {}): scattered beyond the stated noise.", what, p.chi2 / p.count, range);
@@ -904,9 +918,14 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                   base.chi2_per_n(), options.fits_within_noise));
   } else {
     // Confirm the leading candidates by adding each and recalibrating.
+    // The signature is a linear screen from one step to the effect's start values; a strong,
+    // nonlinear effect (cohesion at a start far from the truth) can overshoot and show little
+    // projection. When no candidate passes the screen although the model misfits, the leading
+    // ones are confirmed anyway: recalibration, not the screen, decides.
+    const bool screen_silent = std::none_of(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
     int confirmed = 0;
     for (CandidateResult& cr : d.candidates) {
-      if (confirmed >= options.confirm_candidates || cr.explained < 0.05) break;
+      if (confirmed >= options.confirm_candidates || (cr.explained < 0.05 && !screen_silent)) break;
       const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
       MaterialModel with = d.base.fitted;
       it->add(with);
@@ -944,6 +963,9 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                     base.chi2_per_n(), options.bic_margin,
                                     best ? fmt::format(" (best: {}, by {:.1f})", best->name, best->delta_bic) : ""));
     }
+    if (screen_silent && !d.candidates.empty())
+      d.words.push_back("The signatures explained little of the misfit (they are a linear screen from one step to each effect's start "
+                        "values); the leading candidates were confirmed by recalibration anyway.");
   }
   for (CandidateResult& cr : d.candidates) {
     cr.words = cr.confirmed ? fmt::format("{}: explains {:.0f} % of the residual; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).",

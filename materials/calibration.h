@@ -123,8 +123,11 @@ struct Pattern {
   std::string kind;   ///< fits, offset, trend, curvature, scatter, single
   int count = 0;
   double mean = 0;    ///< mean residual [sigma]
-  double slope = 0;   ///< residual change from the lowest to the highest varied value [sigma] (linear fit)
-  double curvature = 0;  ///< quadratic coefficient in normalised x in [-1, 1] [sigma]
+  // Weighted fits of simulated - measured in the observable's own unit (weights 1/sigma^2):
+  double offset = 0;     ///< weighted mean difference
+  double slope = 0;      ///< change of the difference from the lowest to the highest varied value (linear fit)
+  double at_low = 0, at_high = 0;  ///< the linear fit's difference at the lowest and highest varied value
+  double curvature = 0;  ///< quadratic coefficient in normalised x in [-1, 1]
   double chi2 = 0;
   std::string words;
 };
