@@ -169,6 +169,13 @@ std::size_t append_mesh(const aiMesh& mesh, const Affine& placement, VertexWelde
   return dropped;
 }
 
+/// Text from a damaged file, fit for an error message: bytes outside printable ASCII become '?'.
+std::string printable(std::string text) {
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  return text;
+}
+
 /// Refuses OFF and PLY files whose header declares more vertices or faces than the file has bytes.
 /// assimp 5.2 trusts those counts: assimp-testmodels' invalid/OutOfMemory.off declares 353535235358
 /// vertices in 309 bytes and takes 16 GB and minutes before it fails. Any encoding needs at least
@@ -204,8 +211,23 @@ void refuse_impossible_counts(const std::string& path) {
       static const char* const kKeywords[] = {"ply", "format", "comment", "obj_info", "element", "property"};
       if (!keyword.empty() && std::none_of(std::begin(kKeywords), std::end(kKeywords), [&](const char* k) { return keyword == k; }))
         throw MeshError(MeshError::Kind::unreadable,
-                        path + ": line " + std::to_string(line_number) + " of the PLY header starts with '" + keyword.substr(0, 40) +
+                        path + ": line " + std::to_string(line_number) + " of the PLY header starts with '" + printable(keyword.substr(0, 40)) +
                             "'; valid: ply, format, comment, obj_info, element, property, end_header. The file is damaged: re-export it");
+      // Likewise on a property of an unknown type (a garbled "list" or "float"; fuzzer finding
+      // tests/fuzz/regressions/mesh/ply_bad_property_type_hang): check the types too.
+      if (keyword == "property") {
+        static const char* const kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8",
+                                             "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+        auto is_type = [&](const std::string& t) { return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* k) { return t == k; }); };
+        std::string type, count_type, item_type;
+        keyword_words >> type;
+        const bool valid = type == "list" ? (keyword_words >> count_type >> item_type) && is_type(count_type) && is_type(item_type) : is_type(type);
+        if (!valid)
+          throw MeshError(MeshError::Kind::unreadable,
+                          path + ": line " + std::to_string(line_number) + " of the PLY header declares a property of type '" +
+                              printable(type.substr(0, 40)) + "'; valid: list, char, uchar, short, ushort, int, uint, float, double (or int8 ... float64). "
+                              "The file is damaged: re-export it");
+      }
       if (words >> word && word == "element" && words >> word && words >> word) counts.push_back(word);
       continue;
     }
