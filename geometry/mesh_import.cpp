@@ -194,43 +194,67 @@ void refuse_impossible_counts(const std::string& path) {
   bool off_header_seen = false;
   int line_number = 0;
   bool end_seen = false;
+  bool format_seen = false, element_seen = false;
   while (std::getline(lines, line)) {
     ++line_number;
-    if (line.find("end_header") == 0) {
-      end_seen = true;
-      break;
+    if (extension == ".ply") {
+      // assimp 5.2's PLY reader loops forever on damaged headers (the mesh fuzzer found an unknown
+      // keyword, a garbled property type, and a garbled element line with a second format line;
+      // tests/fuzz/regressions/mesh/ply_*): the header must follow the PLY grammar line by line.
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      auto refuse = [&](const std::string& why) {
+        throw MeshError(MeshError::Kind::unreadable, path + ": line " + std::to_string(line_number) + " of the PLY header ('" +
+                                                         printable(line.substr(0, 60)) + "') " + why +
+                                                         ". The file is damaged: re-export it");
+      };
+      if (std::any_of(line.begin(), line.end(), [](char c) { return static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126; }))
+        refuse("holds bytes that are not text");
+      std::istringstream keyword_words(line);
+      std::vector<std::string> w;
+      for (std::string token; keyword_words >> token;) w.push_back(token);
+      const std::string keyword = w.empty() ? "" : w[0];
+      static const char* const kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8",
+                                           "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+      auto is_type = [&](const std::string& t) { return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* k) { return t == k; }); };
+      auto is_count = [](const std::string& t) { return !t.empty() && t.size() <= 20 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; }); };
+      if (line_number == 1) {
+        if (keyword != "ply" || w.size() != 1) refuse("must be 'ply'");
+        continue;
+      }
+      if (keyword == "end_header") {
+        if (w.size() != 1 || line != "end_header") refuse("must be exactly 'end_header'");
+        if (!format_seen || !element_seen) refuse("ends a header without a format line or an element");
+        end_seen = true;
+        break;
+      }
+      if (keyword == "comment" || keyword == "obj_info") continue;
+      if (keyword == "format") {
+        const bool known = w.size() == 3 && (w[1] == "ascii" || w[1] == "binary_little_endian" || w[1] == "binary_big_endian");
+        if (!known || format_seen) refuse(format_seen ? "is a second format line" : "must be 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+        format_seen = true;
+        continue;
+      }
+      if (keyword == "element") {
+        if (w.size() != 3 || !is_count(w[2])) refuse("must be 'element NAME COUNT' with a whole number");
+        counts.push_back(w[2]);
+        element_seen = true;
+        continue;
+      }
+      if (keyword == "property") {
+        const bool valid = element_seen && (w.size() == 3 ? is_type(w[1])
+                                                           : w.size() == 5 && w[1] == "list" && is_type(w[2]) && is_type(w[3]));
+        if (!valid)
+          refuse("must be 'property TYPE NAME' or 'property list TYPE TYPE NAME' after an element; types: char, uchar, short, ushort, "
+                 "int, uint, float, double (or int8 ... float64)");
+        continue;
+      }
+      // Free text before the first element is read as a comment (Blender 2.4x writes a
+      // "Created by ..." line without the keyword, e.g. assimp-testmodels' PLY/Wuson.ply).
+      if (!element_seen) continue;
+      refuse("starts with an unknown keyword; valid: ply, format, comment, obj_info, element, property, end_header");
     }
     std::istringstream words(line.substr(0, line.find('#')));
     std::string word;
-    if (extension == ".ply") {
-      // assimp 5.2's PLY reader loops forever on a header line with an unknown keyword (found by
-      // the mesh fuzzer, tests/fuzz/regressions/mesh/): refuse those first.
-      std::istringstream keyword_words(line);
-      std::string keyword;
-      keyword_words >> keyword;
-      static const char* const kKeywords[] = {"ply", "format", "comment", "obj_info", "element", "property"};
-      if (!keyword.empty() && std::none_of(std::begin(kKeywords), std::end(kKeywords), [&](const char* k) { return keyword == k; }))
-        throw MeshError(MeshError::Kind::unreadable,
-                        path + ": line " + std::to_string(line_number) + " of the PLY header starts with '" + printable(keyword.substr(0, 40)) +
-                            "'; valid: ply, format, comment, obj_info, element, property, end_header. The file is damaged: re-export it");
-      // Likewise on a property of an unknown type (a garbled "list" or "float"; fuzzer finding
-      // tests/fuzz/regressions/mesh/ply_bad_property_type_hang): check the types too.
-      if (keyword == "property") {
-        static const char* const kTypes[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8",
-                                             "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
-        auto is_type = [&](const std::string& t) { return std::any_of(std::begin(kTypes), std::end(kTypes), [&](const char* k) { return t == k; }); };
-        std::string type, count_type, item_type;
-        keyword_words >> type;
-        const bool valid = type == "list" ? (keyword_words >> count_type >> item_type) && is_type(count_type) && is_type(item_type) : is_type(type);
-        if (!valid)
-          throw MeshError(MeshError::Kind::unreadable,
-                          path + ": line " + std::to_string(line_number) + " of the PLY header declares a property of type '" +
-                              printable(type.substr(0, 40)) + "'; valid: list, char, uchar, short, ushort, int, uint, float, double (or int8 ... float64). "
-                              "The file is damaged: re-export it");
-      }
-      if (words >> word && word == "element" && words >> word && words >> word) counts.push_back(word);
-      continue;
-    }
     // OFF: a keyword ending in "OFF", then the vertex and face counts (on the same line or the next).
     while (words >> word && counts.size() < 2) {
       if (!off_header_seen && word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0)
