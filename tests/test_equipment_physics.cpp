@@ -43,7 +43,8 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
 // The law holds for D0 > ~6 d and a silo wider than 2.5 D0, so the three orifices span that window
 // in this 0.125 m silo: 6.2, 7.3 and 8.3 particle diameters (a 5 d orifice flows intermittently,
 // near clogging, and its rate moved the fitted C by 20 % between runs that differ only in the
-// last bits). The discharge must follow the 5/2 power (W^0.4 linear in D0 within 3 %) with C and
+// last bits; rates are taken over 0.7 s of discharge for the same reason). Measured: C = 0.620,
+// k = 2.05. The discharge must follow the 5/2 power (W^0.4 linear in D0 within 3 %) with C and
 // k in the published ranges, widened to C 0.45-0.75 and k 1.0-3.0 for a frictional sphere model.
 TEST(Beverloo, SiloDischargeFollowsTheFiveHalvesLawWithPublishedConstants) {
   const double d = 0.006, g = 9.81;
@@ -60,9 +61,11 @@ TEST(Beverloo, SiloDischargeFollowsTheFiveHalvesLawWithPublishedConstants) {
       if (sim.state.z[p] > z0 && sim.state.z[p] < z1) slab_mass += 1.0 / sim.state.inv_mass[p];
     const double bulk_density = slab_mass / (std::numbers::pi * R * R * (z1 - z0));
     bulk_density_sum += bulk_density;
-    // Steady discharge: slope of the outlet's cumulative mass from 0.15 s to 0.5 s after opening.
+    // Steady discharge: slope of the outlet's cumulative mass from 0.15 s to 0.85 s after opening
+    // (the largest orifice has then drained a third of the bed; Beverloo's rate does not depend
+    // on the head while the bed stands higher than the orifice is wide).
     std::vector<double> t, m;
-    while (sim.state.time < open_at + 0.5) {
+    while (sim.state.time < open_at + 0.85) {
       sim.advance();
       if (sim.state.time > open_at + 0.15 && sim.state.step % 100 == 0)
         t.push_back(sim.state.time), m.push_back(sim.state.outlets[0].removed_mass);
