@@ -273,6 +273,65 @@ void refuse_impossible_counts(const std::string& path) {
                                                        " bytes; the file is damaged, re-export it");
 }
 
+/// Checks an OFF file line by line before assimp reads it: assimp 5.2's OFF reader crashes
+/// (segmentation fault) on face lines whose vertex count or indices do not fit the declared
+/// vertices (fuzzer finding tests/fuzz/regressions/mesh/off_bad_face_crash). Grammar: a keyword
+/// ending in OFF, the counts "V F [E]", V vertex lines of at least three numbers, then F face lines
+/// "n i_1 ... i_n" with 3 <= n <= 64 and every index in [0, V); '#' starts a comment.
+void check_off_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  int line_number = 0;
+  auto refuse = [&](const std::string& why) {
+    throw MeshError(MeshError::Kind::unreadable, path + ": line " + std::to_string(line_number) + " of the OFF file ('" +
+                                                     printable(line.substr(0, 60)) + "') " + why + ". The file is damaged: re-export it");
+  };
+  std::vector<std::string> pending;  // tokens of the header not yet used
+  auto next_tokens = [&]() -> std::vector<std::string> {
+    while (std::getline(in, line)) {
+      ++line_number;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const std::string text = line.substr(0, line.find('#'));
+      std::istringstream words(text);
+      std::vector<std::string> w;
+      for (std::string token; words >> token;) w.push_back(token);
+      if (!w.empty()) return w;
+    }
+    return {};
+  };
+  auto integer = [&](const std::string& t, long long& v) {
+    if (t.empty() || t.size() > 18 || !std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; })) return false;
+    v = std::stoll(t);
+    return true;
+  };
+  auto number = [](const std::string& t) {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    return end != t.c_str() && *end == '\0' && std::isfinite(v);
+  };
+  std::vector<std::string> w = next_tokens();
+  if (w.empty() || w[0].size() < 3 || w[0].compare(w[0].size() - 3, 3, "OFF") != 0) refuse("must start with OFF");
+  w.erase(w.begin());
+  if (w.empty()) w = next_tokens();
+  long long vertices = 0, faces = 0;
+  if (w.size() < 2 || w.size() > 3 || !integer(w[0], vertices) || !integer(w[1], faces)) refuse("must give the counts 'V F [E]'");
+  for (long long v = 0; v < vertices; ++v) {
+    w = next_tokens();
+    if (w.size() < 3 || !number(w[0]) || !number(w[1]) || !number(w[2])) refuse("must be a vertex: three finite numbers");
+  }
+  for (long long f = 0; f < faces; ++f) {
+    w = next_tokens();
+    long long n = 0;
+    if (w.empty() || !integer(w[0], n) || n < 3 || n > 64 || static_cast<long long>(w.size()) < n + 1)
+      refuse("must be a face: 'n i_1 ... i_n' with 3 <= n <= 64");
+    for (long long k = 1; k <= n; ++k) {
+      long long index = 0;
+      if (!integer(w[k], index) || index >= vertices)
+        refuse("has a vertex index that is not one of the " + std::to_string(vertices) + " vertices (0-based)");
+    }
+  }
+}
+
 }  // namespace
 
 bool has_importable_extension(const std::string& path) {
@@ -303,6 +362,7 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
                     path + ": no such file (expected a mesh file: STL, OBJ, PLY, 3MF, glTF, ...)");
 
   refuse_impossible_counts(path);
+  if (lower_extension(path) == ".off") check_off_file(path);
 
   // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
   Assimp::Importer importer;
