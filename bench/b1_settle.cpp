@@ -57,6 +57,7 @@
 #include <vector>
 
 #include "diagnostics.h"
+#include "peak_memory.h"
 #include "model.h"
 #include "particles.h"
 #include "spec.h"
@@ -155,22 +156,8 @@ void write_liggghts_data(const Size& b, const std::string& path) {
     out << fmt::format("{} 1 0.004 2500 {:.17g} {:.17g} {:.17g}\n", p + 1, centres[p].x(), centres[p].y(), centres[p].z());
 }
 
-/// VmHWM in bytes (0 when unknown).
-std::size_t peak_rss_bytes() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("VmHWM:", 0) == 0) return static_cast<std::size_t>(std::strtoull(line.c_str() + 6, nullptr, 10)) * 1024;
-  return 0;
-}
-
-/// Resets VmHWM to the current RSS (Linux: write "5" to /proc/self/clear_refs).
-bool reset_peak_rss() {
-  std::FILE* f = std::fopen("/proc/self/clear_refs", "w");
-  if (!f) return false;
-  const bool ok = std::fputs("5", f) >= 0;
-  return (std::fclose(f) == 0) && ok;
-}
+using bench::peak_rss_bytes;
+using bench::reset_peak_rss;
 
 /// Bytes a vector holds (capacity, i.e. what it really occupies).
 template <typename T>

@@ -68,6 +68,7 @@
 #include <vector>
 
 #include "diagnostics.h"
+#include "peak_memory.h"
 #include "mesh_health.h"
 #include "model.h"
 #include "particles.h"
@@ -232,14 +233,7 @@ dem::TriangleSoup load_mesh(const dem::MeshWallSpec& spec) {
   return {std::move(mesh.vertices), std::move(mesh.triangles)};
 }
 
-/// VmHWM in bytes (0 when unknown).
-std::size_t peak_rss_bytes() {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("VmHWM:", 0) == 0) return static_cast<std::size_t>(std::strtoull(line.c_str() + 6, nullptr, 10)) * 1024;
-  return 0;
-}
+using bench::peak_rss_bytes;
 
 /// Touching particle-particle pairs (overlap > 0).
 std::size_t touching_pairs(const dem::State& s) {
