@@ -70,7 +70,10 @@ void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, in
     }
     active.options[option - spec->options.begin()] = static_cast<std::uint8_t>(at - option->values.begin());
   }
-  for (const HistorySpec& h : spec->history) model.history_width += h.width;
+  for (const HistorySpec& h : spec->history) {
+    model.history_width += h.width;
+    model.history_odd.insert(model.history_odd.end(), h.width, h.odd ? 1 : 0);
+  }
   param_cursor += static_cast<int>(spec->params.size()) + spec->derived_count;
   model.effects.push_back(active);
 }

@@ -53,10 +53,13 @@ struct OptionSpec {
   std::string_view doc;
 };
 
-/// Per-contact state an effect keeps from step to step, in doubles.
+/// Per-contact state an effect keeps from step to step, in doubles. A pair's history is seen
+/// from body i; `odd` history (vectors of i relative to j: a tangential spring, a rolling
+/// torque) changes sign when the two bodies swap roles, as they do when the slots are re-sorted.
 struct HistorySpec {
   std::string_view name;
   int width;
+  bool odd = false;
 };
 
 /// Contacts evaluated together. Columns, so kernels stream through them; 64 contacts keep a

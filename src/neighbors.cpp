@@ -378,7 +378,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
     // Old histories bucketed by the lower new slot of the pair (CSR: no allocation per slot),
     // then each new pair looks through its slot's bucket.
-    struct Entry { std::int32_t other; size_t row; };
+    // A pair whose bodies swapped roles (the old i is now j) takes its odd history negated.
+    struct Entry { std::int32_t other; size_t row; bool swapped; };
     std::vector<std::int32_t> begin(n + 1);
     std::vector<Entry> entries;
     auto carry = [&](const std::vector<CarriedHistory>& old, bool walls, ContactList& list, const std::vector<double>& history) {
@@ -399,11 +400,16 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
       entries.resize(static_cast<size_t>(begin[n]));
       std::vector<std::int32_t> cursor(begin.begin(), begin.end() - 1);
       for (size_t q = 0; q < old.size(); ++q)
-        if (keyed[q][0] >= 0) entries[cursor[keyed[q][0]]++] = {keyed[q][1], old[q].row};
+        if (keyed[q][0] >= 0)
+          entries[cursor[keyed[q][0]]++] = {keyed[q][1], old[q].row, !walls && slot_of[old[q].id_a] != keyed[q][0]};
       for (size_t k = 0; k < list.size(); ++k) {
         for (std::int32_t e = begin[list.i[k]]; e < begin[list.i[k] + 1]; ++e)
           if (entries[e].other == list.j[k]) {
-            std::memcpy(&list.history[k * width], &history[entries[e].row * width], width * sizeof(double));
+            double* row = &list.history[k * width];
+            std::memcpy(row, &history[entries[e].row * width], width * sizeof(double));
+            if (entries[e].swapped)
+              for (int q = 0; q < width; ++q)
+                if (model.history_odd[q]) row[q] = -row[q];
             break;
           }
       }

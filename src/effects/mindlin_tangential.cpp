@@ -22,7 +22,7 @@ enum Param { kFriction };
 constexpr ParamSpec kParams[] = {
     {"friction", "-", 0.5, 0.0, 10.0, Mixing::arithmetic, true, "Coulomb sliding friction coefficient"},
 };
-constexpr HistorySpec kHistory[] = {{"tangential_spring", 3}};
+constexpr HistorySpec kHistory[] = {{"tangential_spring", 3, /*odd=*/true}};
 
 void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
   const double dt = ctx.dt;

@@ -20,7 +20,7 @@ constexpr ParamSpec kParams[] = {
     {"rolling_damping", "-", 0.3, 0.0, 2.0, Mixing::arithmetic, false,
      "viscous damping ratio eta_r of the rolling spring (Ai et al. use 0.3)"},
 };
-constexpr HistorySpec kHistory[] = {{"rolling_spring_torque", 3}};
+constexpr HistorySpec kHistory[] = {{"rolling_spring_torque", 3, /*odd=*/true}};
 
 void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
   const double dt = ctx.dt;
