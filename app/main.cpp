@@ -24,6 +24,7 @@
 #include "mesh_health.h"
 #include "model.h"
 #include "mpi_campaign.h"
+#include "mpi_domain.h"
 #include "particles.h"
 #include "report.h"
 #include "results_hdf5.h"
@@ -162,14 +163,6 @@ int run_case(const RunArgs& args) {
     sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
     return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
   }
-  // One simulation is not split over MPI ranks: rank 0 runs it, the others wait.
-  const dem::app::mpi::World& world = dem::app::mpi::world();
-  if (world.active()) {
-    if (world.rank != 0) return 0;
-    std::cout << fmt::format("note: {} MPI ranks, but one simulation runs on rank 0 alone (sweeps and calibrations share their "
-                             "simulations among the ranks; a case is not split into subdomains)\n",
-                             world.size);
-  }
   if (args.variant >= 0) {
     if (args.variant >= static_cast<long>(plan.variants.size()))
       throw dem::CaseError(fmt::format("--variant {}: the case has {} sweep variants", args.variant, plan.variants.size()));
@@ -183,7 +176,17 @@ int run_case(const RunArgs& args) {
   if (threads > 0) omp_set_num_threads(threads);
   dem::State state = dem::initial_state(model);
   dem::Workspace work;
+  // Under mpirun the case is split into slabs, one per rank (app/mpi_domain.h); rank 0 writes.
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  std::string domain_note;
+  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note) : nullptr;
+  if (domain && threads <= 0) omp_set_num_threads(dem::app::mpi::cores_per_rank());  // the ranks share the machine's cores
+  if (domain && world.rank == 0)
+    std::cout << fmt::format("domain decomposition: {}, {} OpenMP threads per rank\n", domain_note, omp_get_max_threads());
+  std::ostringstream quiet;  // the other ranks' log
+  std::ostream& log = world.rank == 0 ? std::cout : quiet;
   dem::RunOptions options;
+  options.domain = domain.get();
   options.duration = args.duration;
   options.max_steps = args.max_steps;
   options.output_directory = args.out;
@@ -200,7 +203,8 @@ int run_case(const RunArgs& args) {
     dem::app::render_state(m, s, image_options(m), path);
     if (last) std::cout << fmt::format("  rendered {}\n", path);
   };
-  const dem::RunSummary summary = dem::run(model, state, work, options, std::cout);
+  const dem::RunSummary summary = dem::run(model, state, work, options, log);
+  if (world.rank != 0) return 0;
   const std::string out = summary.output_directory;
   dem::write_file_atomically(out + "/case.yaml", case_text);
   if (spec.equipment) {

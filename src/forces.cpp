@@ -15,6 +15,7 @@
 #include "parallel.h"
 #include "forces.h"
 
+#include "domain.h"
 #include "mesh_contacts.h"
 #include "neighbors.h"
 
@@ -109,7 +110,9 @@ inline void fill_motion(ContactBatch& b, int c, const State& s, size_t i, double
   b.wx[c] = s.wx[i] - wjx, b.wy[c] = s.wy[i] - wjy, b.wz[c] = s.wz[i] - wjz;
 }
 
-void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i) {
+/// The pairs of slot i with partners j in [lo, hi): owned partners in the parallel block pass,
+/// ghosts in a pass of their own (a ghost may touch spheres of several blocks).
+void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi) {
   const int width = model.history_width;
   const bool periodic = model.periodic();
   const double range = model.interaction_range;
@@ -117,6 +120,7 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
   const double xi = s.x[i], yi = s.y[i], zi = s.z[i], ri = s.radius[i];
   for (std::int32_t k = work.pair_begin[i]; k < work.pair_begin[i + 1]; ++k) {
     const std::int32_t j = s.pairs.j[k];
+    if (j < lo || j >= hi) continue;
     double d[3] = {xi - s.x[j], yi - s.y[j], zi - s.z[j]};
     if (periodic) minimum_image(model, d);
     const double dx = d[0], dy = d[1], dz = d[2];
@@ -205,12 +209,14 @@ void evaluate_effects(const Model& model, ContactBatch& b) {
 }
 
 void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
-  const long n = static_cast<long>(s.size());
+  const long n_all = static_cast<long>(s.size());
+  const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
+  const std::int32_t owned = static_cast<std::int32_t>(n);
   const long block = work.block, blocks = (n + block - 1) / block;
 #pragma omp parallel if (n >= kParallelMin)
   {
 #pragma omp for schedule(static)
-    for (long p = 0; p < n; ++p) {
+    for (long p = 0; p < n_all; ++p) {
       s.fx[p] = s.fy[p] = s.fz[p] = 0.0;
       s.tx[p] = s.ty[p] = s.tz[p] = 0.0;
     }
@@ -221,7 +227,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
       for (long b = parity; b < blocks; b += 2) {
         const long last = std::min(n, (b + 1) * block);
         for (long i = b * block; i < last; ++i) {
-          particle_contacts(model, s, work, batch, i);
+          particle_contacts(model, s, work, batch, i, 0, owned);
           wall_contacts(model, s, work, batch, i);
         }
       }
@@ -229,8 +235,15 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 #pragma omp barrier
     }
   }
+  if (s.ghosts > 0) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
+    Batch batch;
+    batch.b.count = 0;
+    for (long i = 0; i < n; ++i) particle_contacts(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+    if (batch.b.count) flush(model, batch, s, work);
+  }
 
   mesh_contact_forces(model, s, work);
+  if (work.domain) work.domain->return_ghost_loads(s);
 
   // Gravity, and the closing half kick of free spheres.
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
@@ -288,6 +301,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
       const std::int32_t w = wall[k];
       wfx[w] -= wf.fx[k], wfy[w] -= wf.fy[k], wfz[w] -= wf.fz[k];
     }
+    if (work.domain) work.domain->sum_wall_loads(s);
   }
   // Glued spheres pass their contact forces to their wall, summed in slot order.
   if (!model.has_attached) return;

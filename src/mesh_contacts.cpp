@@ -154,7 +154,7 @@ double mesh_displacement_since_build(const Model& model, const State& state, dou
 }
 
 void find_mesh_candidates(const Model& model, State& s, Workspace& work, double reach) {
-  const size_t n = s.size();
+  const size_t n = s.owned();  // ghosts touch no wall
   s.candidate_begin.assign(n + 1, 0);
   s.mesh_candidates.clear();
   s.lists_built_time = work.mesh_time;
@@ -184,14 +184,14 @@ void find_mesh_candidates(const Model& model, State& s, Workspace& work, double 
 }
 
 void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
-  const size_t n = s.size();
+  const size_t n = s.owned();  // ghosts touch no wall
   const int width = model.history_width;
   MeshContacts& mc = s.mesh_contacts;
   if (model.meshes.empty()) return;
   MeshSlotResults& slot_results = work.mesh_slots;
-  if (work.mesh_forces.fx.size() != n * kSlots) {  // slots beyond a particle's count are never read
-    work.mesh_forces.resize(n * kSlots);
-    slot_results.resize(n * kSlots);
+  if (work.mesh_forces.fx.size() != s.size() * kSlots) {  // slots beyond a particle's count are never read
+    work.mesh_forces.resize(s.size() * kSlots);
+    slot_results.resize(s.size() * kSlots);
   }
   const double range = model.interaction_range;
   const long nl = static_cast<long>(n);

@@ -1,5 +1,6 @@
 #include "neighbors.h"
 
+#include "domain.h"
 #include "mesh_contacts.h"
 
 #include "parallel.h"
@@ -8,16 +9,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 namespace dem {
 
 namespace {
-
-/// A contact's history found before the rebuild, keyed by particle ids.
-struct CarriedHistory {
-  std::int64_t id_a, other;  ///< other: particle id, or wall index for wall contacts
-  size_t row;                ///< in the old history array
-};
 
 bool row_is_zero(const double* row, int width) {
   for (int k = 0; k < width; ++k)
@@ -25,13 +21,14 @@ bool row_is_zero(const double* row, int width) {
   return true;
 }
 
-/// Histories worth keeping (non-zero), with the ids they belong to.
-std::vector<CarriedHistory> collect(const ContactList& list, const State& state, int width, bool walls) {
-  std::vector<CarriedHistory> out;
+/// Histories worth keeping (non-zero), keyed by the ids they belong to.
+HistoryRows collect(const ContactList& list, const State& state, int width, bool walls) {
+  HistoryRows out;
   if (width == 0) return out;
   for (size_t k = 0; k < list.size(); ++k) {
-    if (row_is_zero(&list.history[k * width], width)) continue;
-    out.push_back({state.id[list.i[k]], walls ? list.j[k] : state.id[list.j[k]], k});
+    const double* row = &list.history[k * width];
+    if (row_is_zero(row, width)) continue;
+    out.add(state.id[list.i[k]], walls ? list.j[k] : state.id[list.j[k]], row, width);
   }
   return out;
 }
@@ -202,6 +199,14 @@ void ContactForces::resize(std::size_t n) {
   active.assign(n, 0);
 }
 
+void drop_ghosts(State& s) {
+  if (s.ghosts == 0) return;
+  std::vector<std::uint8_t> keep(s.size(), 0);
+  std::fill_n(keep.begin(), s.owned(), 1);
+  s.compact(keep);
+  s.ghosts = 0;
+}
+
 void minimum_image(const Model& model, double d[3]) {
   for (int a = 0; a < 3; ++a)
     if (model.period[a] > 0) d[a] -= model.period[a] * std::nearbyint(d[a] / model.period[a]);
@@ -211,9 +216,12 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr(work.pair_begin, s.pairs.i, n);
   build_csr(work.wall_begin, s.wall_pairs.i, n);
-  // Block size of the force evaluation: every pair's partner lies in its own block or the next.
+  // Block size of the force evaluation: every pair's partner lies in its own block or the next
+  // (pairs with ghosts are evaluated apart, forces.cpp).
   std::int32_t span = 0;
-  for (size_t k = 0; k < s.pairs.size(); ++k) span = std::max(span, s.pairs.j[k] - s.pairs.i[k]);
+  const std::int32_t owned = static_cast<std::int32_t>(s.owned());
+  for (size_t k = 0; k < s.pairs.size(); ++k)
+    if (s.pairs.j[k] < owned) span = std::max(span, s.pairs.j[k] - s.pairs.i[k]);
   work.block = std::max<std::int32_t>(span + 1, 64);
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
@@ -243,7 +251,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
 bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bool free_spheres_checked) {
   if (!work.valid || s.x_built.size() != s.size()) return true;
   const double limit2 = 0.25 * model.skin * model.skin;
-  const long n = static_cast<long>(s.size());
+  const long n = static_cast<long>(s.owned());
   const bool all = !free_spheres_checked;
   const bool others = s.bodies.size() > 0 || model.has_attached;
   int moved = 0;
@@ -262,19 +270,42 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bo
 
 void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const int width = model.history_width;
-  const std::vector<CarriedHistory> old_pairs = collect(s.pairs, s, width, false);
-  const std::vector<CarriedHistory> old_walls = collect(s.wall_pairs, s, width, true);
-  const std::vector<double> old_pair_history = std::move(s.pairs.history);
-  const std::vector<double> old_wall_history = std::move(s.wall_pairs.history);
+  HistoryRows old_pairs = collect(s.pairs, s, width, false);
+  HistoryRows old_walls = collect(s.wall_pairs, s, width, true);
+  Domain* domain = work.domain;
 
+  drop_ghosts(s);
+  // Migration first: it carries particles across a periodic face the ranks share (the local
+  // model no longer wraps that axis), which remove_lost would take for particles that left.
+  if (domain) domain->migrate(model, s, old_pairs, old_walls);
   remove_lost(model, s);
-  const size_t n = s.size();
   double radius_max = model.radius_max;
-  for (size_t p = 0; p < n; ++p) radius_max = std::max(radius_max, s.radius[p]);
+  for (size_t p = 0; p < s.size(); ++p) radius_max = std::max(radius_max, s.radius[p]);
   const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
+  const double cell_size = std::max(2.0 * radius_max + reach, 1e-12);
 
-  // Sort slots by cell (counting sort); cells are at least one pair reach wide.
+  // Sort the owned slots by cell (counting sort); cells are at least one pair reach wide.
   wrap_into_period(model, s);
+  std::optional<Grid> sorted_by;
+  if (s.size() > 0) {
+    sorted_by = make_grid(model, s, cell_size);
+    const Grid& grid = *sorted_by;
+    const size_t owned = s.size();
+    const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
+    work.cell_of.resize(owned);
+    work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
+    for (size_t p = 0; p < owned; ++p) {
+      work.cell_of[p] = grid.index(s.x[p], s.y[p], s.z[p]);
+      ++work.cell_start[work.cell_of[p] + 1];
+    }
+    for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
+    work.order.resize(owned);
+    std::vector<std::int32_t> cursor(work.cell_start.begin(), work.cell_start.end() - 1);
+    for (size_t p = 0; p < owned; ++p) work.order[cursor[work.cell_of[p]]++] = static_cast<std::int32_t>(p);
+    s.permute(work.order);
+  }
+  if (domain) domain->make_ghosts(model, s);
+  const size_t n = s.size(), n_owned = s.owned();
   if (n == 0) {  // nothing yet (an inlet will bring particles) or everything left
     s.pairs.clear(), s.wall_pairs.clear();
     s.candidate_begin.assign(1, 0), s.mesh_candidates.clear();
@@ -283,22 +314,26 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     ++work.rebuilds;
     return;
   }
-  const Grid grid = make_grid(model, s, std::max(2.0 * radius_max + reach, 1e-12));
+  // Cells of every slot. The owned slots are sorted, so a cell's owned spheres are a run of
+  // slots (cell_start); ghosts, unsorted after them, need a second grid over all slots with the
+  // slots listed by cell (`members`).
+  const bool with_ghosts = s.ghosts > 0;
+  if (with_ghosts) {
+    for (size_t p = n_owned; p < n; ++p) radius_max = std::max(radius_max, s.radius[p]);
+    sorted_by = make_grid(model, s, std::max(2.0 * radius_max + reach, 1e-12));
+  }
+  const Grid& grid = *sorted_by;
   const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
   work.cell_of.resize(n);
-  work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
-  for (size_t p = 0; p < n; ++p) {
-    work.cell_of[p] = grid.index(s.x[p], s.y[p], s.z[p]);
-    ++work.cell_start[work.cell_of[p] + 1];
-  }
-  for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
-  work.order.resize(n);
-  {
-    std::vector<std::int32_t> cursor(work.cell_start.begin(), work.cell_start.end() - 1);
-    for (size_t p = 0; p < n; ++p) work.order[cursor[work.cell_of[p]]++] = static_cast<std::int32_t>(p);
-  }
-  s.permute(work.order);
   for (size_t p = 0; p < n; ++p) work.cell_of[p] = grid.index(s.x[p], s.y[p], s.z[p]);
+  if (with_ghosts) {
+    work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
+    for (size_t p = 0; p < n; ++p) ++work.cell_start[work.cell_of[p] + 1];
+    for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
+    work.members.resize(n);
+    std::vector<std::int32_t> cursor(work.cell_start.begin(), work.cell_start.end() - 1);
+    for (size_t p = 0; p < n; ++p) work.members[cursor[work.cell_of[p]]++] = static_cast<std::int32_t>(p);
+  }
 
   // Particle pairs: each slot lists partners j > i in the 27 cells around it.
   std::vector<std::int32_t> count(n + 1, 0);
@@ -323,7 +358,10 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
         for (int ix = 0; ix < axis_count[0]; ++ix) {
           const int around[3] = {axis_cells[0][ix], axis_cells[1][iy], axis_cells[2][iz]};
           const int cell = grid.encode(around);
-          for (int j = std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1); j < work.cell_start[cell + 1]; ++j) {
+          const int first = with_ghosts ? work.cell_start[cell] : std::max<int>(work.cell_start[cell], static_cast<int>(i) + 1);
+          for (int q = first; q < work.cell_start[cell + 1]; ++q) {
+            const int j = with_ghosts ? work.members[q] : q;
+            if (j <= static_cast<int>(i)) continue;
             if (s.body[i] >= 0 && s.body[i] == s.body[j]) continue;  // spheres of one clump
             if (s.attached[i] >= 0 && s.attached[i] == s.attached[j]) continue;  // glued to one wall
             double d[3] = {s.x[i] - s.x[j], s.y[i] - s.y[j], s.z[i] - s.z[j]};
@@ -333,7 +371,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
           }
         }
   };
-  const long nl = static_cast<long>(n);
+  const long nl = static_cast<long>(n_owned);  // ghosts list no pairs: ghost-ghost pairs are another rank's
 #pragma omp parallel for schedule(static) if (nl >= kParallelMin)
   for (long i = 0; i < nl; ++i) {
     std::int32_t k = 0;
@@ -354,10 +392,10 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     });
   }
 
-  // Wall pairs, grouped by particle.
+  // Wall pairs, grouped by particle (ghosts touch no wall: their owners' contacts).
   s.wall_pairs.i.clear();
   s.wall_pairs.j.clear();
-  for (size_t p = 0; p < n; ++p) {
+  for (size_t p = 0; p < n_owned; ++p) {
     if (s.attached[p] >= 0) continue;  // part of a wall: walls do not touch walls
     for (size_t w = 0; w < model.planes.size(); ++w) {
       const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[p], s.y[p], s.z[p]};
@@ -373,40 +411,40 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   // Carry histories to the new lists by particle id.
   s.pairs.history.assign(n_pairs * width, 0.0);
   s.wall_pairs.history.assign(s.wall_pairs.size() * width, 0.0);
-  if (width > 0 && (!old_pairs.empty() || !old_walls.empty())) {
+  if (width > 0 && (old_pairs.size() > 0 || old_walls.size() > 0)) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
     // Old histories bucketed by the lower new slot of the pair (CSR: no allocation per slot),
-    // then each new pair looks through its slot's bucket.
-    // A pair whose bodies swapped roles (the old i is now j) takes its odd history negated.
+    // then each new pair looks through its slot's bucket. A pair whose bodies swapped roles
+    // (the old i is now j) takes its odd history negated.
     struct Entry { std::int32_t other; size_t row; bool swapped; };
     std::vector<std::int32_t> begin(n + 1);
     std::vector<Entry> entries;
-    auto carry = [&](const std::vector<CarriedHistory>& old, bool walls, ContactList& list, const std::vector<double>& history) {
+    auto carry = [&](const HistoryRows& old, bool walls, ContactList& list) {
       std::fill(begin.begin(), begin.end(), 0);
-      std::vector<std::array<std::int32_t, 2>> keyed;  // (lower slot, other), in the order of `old`
+      std::vector<std::array<std::int32_t, 3>> keyed;  // (lower slot, other, swapped), in the order of `old`
       keyed.reserve(old.size());
-      for (const CarriedHistory& h : old) {
-        const std::int32_t a = slot_of[h.id_a];
-        const std::int32_t b = walls ? static_cast<std::int32_t>(h.other) : slot_of[h.other];
+      for (size_t q = 0; q < old.size(); ++q) {
+        const std::int64_t id_b = old.b[q];
+        const std::int32_t a = old.a[q] < s.next_id ? slot_of[old.a[q]] : -1;
+        const std::int32_t b = walls ? static_cast<std::int32_t>(id_b) : id_b < s.next_id ? slot_of[id_b] : -1;
         if (a < 0 || b < 0) {  // a particle left
-          keyed.push_back({-1, -1});
+          keyed.push_back({-1, -1, 0});
           continue;
         }
-        keyed.push_back(walls ? std::array<std::int32_t, 2>{a, b} : std::array<std::int32_t, 2>{std::min(a, b), std::max(a, b)});
+        keyed.push_back(walls || a < b ? std::array<std::int32_t, 3>{a, b, 0} : std::array<std::int32_t, 3>{b, a, 1});
         ++begin[keyed.back()[0] + 1];
       }
       for (size_t p = 0; p < n; ++p) begin[p + 1] += begin[p];
       entries.resize(static_cast<size_t>(begin[n]));
       std::vector<std::int32_t> cursor(begin.begin(), begin.end() - 1);
       for (size_t q = 0; q < old.size(); ++q)
-        if (keyed[q][0] >= 0)
-          entries[cursor[keyed[q][0]]++] = {keyed[q][1], old[q].row, !walls && slot_of[old[q].id_a] != keyed[q][0]};
+        if (keyed[q][0] >= 0) entries[cursor[keyed[q][0]]++] = {keyed[q][1], q, keyed[q][2] != 0};
       for (size_t k = 0; k < list.size(); ++k) {
         for (std::int32_t e = begin[list.i[k]]; e < begin[list.i[k] + 1]; ++e)
           if (entries[e].other == list.j[k]) {
             double* row = &list.history[k * width];
-            std::memcpy(row, &history[entries[e].row * width], width * sizeof(double));
+            std::memcpy(row, &old.rows[entries[e].row * width], width * sizeof(double));
             if (entries[e].swapped)
               for (int q = 0; q < width; ++q)
                 if (model.history_odd[q]) row[q] = -row[q];
@@ -414,8 +452,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
           }
       }
     };
-    carry(old_pairs, false, s.pairs, old_pair_history);
-    carry(old_walls, true, s.wall_pairs, old_wall_history);
+    carry(old_pairs, false, s.pairs);
+    carry(old_walls, true, s.wall_pairs);
   }
 
   find_mesh_candidates(model, s, work, reach);

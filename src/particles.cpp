@@ -259,10 +259,28 @@ State initial_state(const Model& model) {
   return state;
 }
 
-std::int64_t run_inlet(const Model& model, State& state, int k) {
+bool inlet_due(const Model& model, const State& state, int k) {
+  const Inlet& inlet = model.inlets[k];
+  const InletState& st = state.inlets[k];
+  return !(state.time < inlet.spec.start || state.time < st.next_time || state.time > inlet.spec.stop);
+}
+
+namespace {
+double inlet_margin(const Model& model, const Inlet& inlet) {
+  return 2.0 * model.radius_max + (inlet.clump >= 0 ? model.clumps[inlet.clump].bounding_radius * inlet.spec.diameter.largest() : 0);
+}
+}  // namespace
+
+void inlet_reach(const Model& model, int k, double lo[3], double hi[3]) {
+  const Inlet& inlet = model.inlets[k];
+  const double margin = inlet_margin(model, inlet);
+  for (int a = 0; a < 3; ++a) lo[a] = inlet.spec.region_min[a] - margin, hi[a] = inlet.spec.region_max[a] + margin;
+}
+
+std::int64_t run_inlet(const Model& model, State& state, int k, const std::vector<std::array<double, 4>>* others) {
   const Inlet& inlet = model.inlets[k];
   InletState& st = state.inlets[k];
-  if (state.time < inlet.spec.start || state.time < st.next_time || state.time > inlet.spec.stop) return 0;
+  if (!inlet_due(model, state, k)) return 0;
   st.next_time = state.time + inlet.interval;
   // Each batch delivers what is owed by the next insertion, so the flow starts at `start`.
   const double owed = inlet.spec.mass_rate * (std::min(st.next_time, inlet.spec.stop) - inlet.spec.start);  // [kg]
@@ -270,12 +288,14 @@ std::int64_t run_inlet(const Model& model, State& state, int k) {
   const double volume_per_d3 = inlet.clump >= 0 ? model.clumps[inlet.clump].volume : std::numbers::pi / 6.0;
   // Spheres near the region, for the overlap checks.
   PlacementGrid grid(std::max(2.0 * model.radius_max, 1e-9));
-  const double margin = 2.0 * model.radius_max + (inlet.clump >= 0 ? model.clumps[inlet.clump].bounding_radius * inlet.spec.diameter.largest() : 0);
+  const double margin = inlet_margin(model, inlet);
   const Vec3 lo = inlet.spec.region_min.array() - margin, hi = inlet.spec.region_max.array() + margin;
   for (size_t p = 0; p < state.size(); ++p) {
     const Vec3 c(state.x[p], state.y[p], state.z[p]);
     if ((c.array() >= lo.array()).all() && (c.array() <= hi.array()).all()) grid.add(c, state.radius[p]);
   }
+  if (others)
+    for (const auto& o : *others) grid.add(Vec3(o[0], o[1], o[2]), o[3]);
   Random random(st.random);
   std::int64_t inserted = 0;
   for (;;) {

@@ -2,7 +2,9 @@
 // without overlap, reproducibly from the case's seed (same seed, same packing, any machine).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include "model.h"
 #include "state.h"
@@ -28,7 +30,13 @@ State initial_state(const Model& model);
 
 /// Inserts what inlet `k` owes by its next insertion (mass rate x time since start), at random
 /// places in its region that overlap nothing. Returns the number of particles (or clumps) inserted.
-std::int64_t run_inlet(const Model& model, State& state, int k);
+/// `others`: spheres (x, y, z, r) to keep clear of besides the state's (under domain
+/// decomposition, every rank's near the region).
+std::int64_t run_inlet(const Model& model, State& state, int k, const std::vector<std::array<double, 4>>* others = nullptr);
+/// Whether inlet `k` inserts at the state's time (run_inlet does nothing otherwise).
+bool inlet_due(const Model& model, const State& state, int k);
+/// The box around inlet `k`'s region in which existing spheres matter to its overlap checks.
+void inlet_reach(const Model& model, int k, double lo[3], double hi[3]);
 
 /// Places the spheres of every body from its centre and orientation, with the body's velocity
 /// (v + w x r) and angular velocity.

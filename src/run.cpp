@@ -10,11 +10,16 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <optional>
 #include <ostream>
 #include <sstream>
 
 #include "checkpoint.h"
+#include "domain.h"
+#include "forces.h"
+#include "mesh_contacts.h"
+#include "neighbors.h"
 #include "results_hdf5.h"
 #include "step.h"
 
@@ -248,15 +253,49 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const std::string checkpoint_path = out + "/checkpoint.bin";
   const double duration = options.duration >= 0 ? options.duration : model.duration;
   const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
+  // Under domain decomposition every rank steps its share with the domain's model; the root
+  // gathers the whole state wherever a result is due and writes it as one process would.
+  Domain* domain = options.domain;
+  const bool writer = domain == nullptr || domain->root();
+  const Model& stepped = domain ? domain->local_model() : model;
+  work.domain = domain;
 
   if (options.resume) {
     state = load_checkpoint(checkpoint_path, model);
-    summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
-    fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
+    if (writer) summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
+    if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
   }
-  print_setup(model, state, log);
-  prepare(model, state, work);
-  if (!options.resume) summary.scalars.push_back(measure(model, state, work));
+  if (writer) print_setup(model, state, log);
+  EnergyWatch energy(model, state, model.energy_rise_limit);
+  if (domain) domain->distribute(state);
+  prepare(stepped, state, work);
+
+  // The whole state for results: the state itself, or (domain) the root's gathered copy with
+  // its lists rebuilt and, for the scalars, its contact forces evaluated on a second copy.
+  struct Whole {
+    State state, evaluated;
+    Workspace work;
+  };
+  std::optional<Whole> whole;
+  const State* results = &state;   // positions, counters, histories
+  const State* measured = &state;  // the same with this instant's forces
+  const Workspace* results_work = &work;
+  bool whole_fresh = false;
+  auto gather_whole = [&]() {
+    if (!domain) return;
+    State gathered = domain->gather(state);
+    if (!writer) return;
+    whole.emplace();
+    whole->state = std::move(gathered);
+    place_meshes(model, whole->state.time, whole->work);
+    rebuild_contacts(model, whole->state, whole->work);
+    whole->evaluated = whole->state;
+    compute_forces(model, whole->evaluated, whole->work);
+    results = &whole->state, measured = &whole->evaluated, results_work = &whole->work;
+    whole_fresh = true;
+  };
+  gather_whole();
+  if (!options.resume && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
 
   const std::int64_t first_step = state.step;
   std::int64_t last_step = end_step;
@@ -270,16 +309,16 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       model.output.checkpoint_every > 0 ? std::max<std::int64_t>(1, std::llround(model.output.checkpoint_every / model.dt)) : 0;
 
   std::optional<FrameWriter> frames;
-  if (options.write_files) {
+  if (options.write_files && writer) {
     write_file_atomically(out + "/run_info.yaml", run_info(model));
     frames.emplace(make_frame_writer(model, out));
     if (options.resume) frames->adopt_existing();
-    else write_frame(*frames, state);
+    else write_frame(*frames, *results);
   }
   // Trouble present from the start (particles created overlapping): told before the first step.
-  if (!options.resume) {
+  if (!options.resume && writer) {
     try {
-      check_numerics(model, state, work, model.max_overlap_ratio);
+      check_numerics(model, *results, *results_work, model.max_overlap_ratio);
     } catch (const NumericalError& e) {
       if (model.stop_on_trouble) throw;
       fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
@@ -291,13 +330,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   // Numerical trouble: checked every few steps (cheap next to a step), so it is caught within
   // a few steps of its start, not at the next row of scalars.
   const std::int64_t check_every = std::min<std::int64_t>(every, 10);
-  EnergyWatch energy(model, state, model.energy_rise_limit);
-  if (!energy.active()) fmt::print(log, "  energy check: off ({})\n", energy.source());
+  if (!energy.active() && writer) fmt::print(log, "  energy check: off ({})\n", energy.source());
   std::int64_t lost_reported = state.lost, warnings = 0;
   auto trouble = [&](const NumericalError& e) {
     if (model.stop_on_trouble) {
       // Keep what was computed: the rows so far (the last checkpoint stays as it was).
-      if (options.write_files) {
+      if (options.write_files && writer) {
         try {
           write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
         } catch (const std::exception&) {
@@ -307,7 +345,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       std::signal(SIGTERM, previous_term);
       throw e;
     }
-    if (warnings++ < 20) fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+    if (warnings++ < 20) fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
   };
 
   using Clock = std::chrono::steady_clock;
@@ -315,50 +353,63 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   auto last_progress = start;
   std::int64_t particle_steps = 0;
   while (state.step < last_step) {
-    step(model, state, work);
-    particle_steps += static_cast<std::int64_t>(state.size());
+    step(stepped, state, work);
+    particle_steps += static_cast<std::int64_t>(results->size());
     const bool last = state.step == last_step;
-    if (state.step % check_every == 0 || last) {
+    const bool check_due = state.step % check_every == 0 || last;
+    // A signal stops every rank at the same step.
+    const bool stopping = domain ? check_due && domain->any(stop_signal != 0) : stop_signal != 0;
+    const bool scalars_due = state.step % every == 0 || last;
+    const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
+    const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
+    if (domain && (scalars_due || frame_due || checkpoint_due)) gather_whole();
+    if (check_due) {
+      std::optional<NumericalError> found;
       try {
-        check_numerics(model, state, work, model.max_overlap_ratio);
-        energy.check(model, state);
+        check_numerics(stepped, state, work, model.max_overlap_ratio);
+        if (!domain) energy.check(model, state);
+        else if (writer && whole_fresh) whole_fresh = false, energy.check(model, whole->state);
       } catch (const NumericalError& e) {
-        trouble(e);
+        found = e;
       }
-      if (state.lost > lost_reported) {
-        const auto& p = state.last_lost;
+      if (domain && domain->any(found.has_value()) && !found)
+        found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
+      if (found) trouble(*found);
+      if (writer && results->lost > lost_reported) {
+        const auto& p = results->last_lost;
         // The first loss, then each tenfold: a leak is told, not repeated every step.
-        if (lost_reported == 0 || state.lost >= 10 * lost_reported)
+        if (lost_reported == 0 || results->lost >= 10 * lost_reported)
           fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; "
                           "the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. Likely "
                           "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
                           "large that particles pass through a wall\n",
-                     state.time, state.lost, p.id, p.x, p.y, p.z, p.vx, p.vy, p.vz);
-        if (lost_reported == 0 || state.lost >= 10 * lost_reported) lost_reported = state.lost;
+                     state.time, results->lost, p.id, p.x, p.y, p.z, p.vx, p.vy, p.vz);
+        if (lost_reported == 0 || results->lost >= 10 * lost_reported) lost_reported = results->lost;
       }
     }
-    if (state.step % every == 0 || last) summary.scalars.push_back(measure(model, state, work));
-    if (frames && (state.step % frame_every == 0 || last)) {
-      write_frame(*frames, state);
-      if (options.on_frame) options.on_frame(model, state, work, out, last);
+    if (scalars_due && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
+    if (frames && frame_due) {
+      write_frame(*frames, *results);
+      if (options.on_frame) options.on_frame(model, *results, *results_work, out, last);
     }
-    if (options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stop_signal)) {
-      save_checkpoint(checkpoint_path, model, state);
+    if (checkpoint_due && writer) {
+      save_checkpoint(checkpoint_path, model, *results);
       write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
     }
-    if (stop_signal) {
-      fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
-                 state.time);
+    if (stopping) {
+      if (writer)
+        fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
+                   state.time);
       break;
     }
     const auto now = Clock::now();
-    if (options.progress && std::chrono::duration<double>(now - last_progress).count() >= model.output.progress_seconds) {
+    if (writer && options.progress && std::chrono::duration<double>(now - last_progress).count() >= model.output.progress_seconds) {
       last_progress = now;
       const double elapsed = std::chrono::duration<double>(now - start).count();
       const std::int64_t done = state.step - first_step;
       const double left = elapsed / static_cast<double>(done) * static_cast<double>(last_step - state.step);
       fmt::print(log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
-                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), state.size(), particle_steps / elapsed,
+                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), results->size(), particle_steps / elapsed,
                  format_duration(left));
       log.flush();
     }
@@ -368,21 +419,23 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   summary.steps = state.step - first_step;
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
+  if (!writer) return summary;
 
+  const State& final_state = *results;
   const Scalars& final_row = summary.scalars.back();
   fmt::print(log, "  done: {} steps to t = {:.6g} s in {:.2f} s ({:.3g} particle-steps/s, {} neighbour-list rebuilds)\n",
              summary.steps, state.time, summary.wall_seconds, summary.particle_steps_per_second, work.rebuilds);
   fmt::print(log, "  end: {} particles, {} contacts, kinetic energy {:.4g} J, max overlap {:.2g} % of radius{}\n",
              final_row.particles, final_row.contacts, final_row.kinetic_translation + final_row.kinetic_rotation,
-             100 * final_row.max_overlap_ratio, state.lost ? fmt::format(", {} particles left the domain", state.lost) : "");
+             100 * final_row.max_overlap_ratio, final_state.lost ? fmt::format(", {} particles left the domain", final_state.lost) : "");
   for (size_t k = 0; k < model.inlets.size(); ++k)
-    fmt::print(log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, state.inlets[k].inserted,
-               state.inlets[k].inserted_mass,
-               state.inlets[k].failed ? fmt::format(" ({} insertions found the region full)", state.inlets[k].failed) : "");
+    fmt::print(log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, final_state.inlets[k].inserted,
+               final_state.inlets[k].inserted_mass,
+               final_state.inlets[k].failed ? fmt::format(" ({} insertions found the region full)", final_state.inlets[k].failed) : "");
   for (size_t k = 0; k < model.outlets.size(); ++k)
-    fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, state.outlets[k].removed,
-               state.outlets[k].removed_mass);
-  if (options.write_files && !model.meshes.empty()) write_mesh_records(model, state, out);
+    fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, final_state.outlets[k].removed,
+               final_state.outlets[k].removed_mass);
+  if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
   if (options.write_files) {
     write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
@@ -390,9 +443,14 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
                           run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
                                                         "  state_hash: {:016x}\n",
                                                         state.step >= last_step ? "true" : "false", state.time, state.step,
-                                                        state.size(), state_hash(state, model.history_width)));
+                                                        final_state.size(), state_hash(final_state, model.history_width)));
     fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", out,
                frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
+  }
+  if (domain) fmt::print(log, "  domain (rank 0): {}\n", domain->statistics());
+  if (domain) {  // the caller (reports, renders) gets the whole state, with this instant's forces
+    state = std::move(whole->evaluated);
+    work = std::move(whole->work);
   }
   return summary;
 }

@@ -15,6 +15,8 @@
 
 namespace dem {
 
+class Domain;
+
 struct RunOptions {
   double duration = -1;           ///< [s] overrides the case's when >= 0
   std::int64_t max_steps = -1;    ///< stop after this many steps when >= 0 (shortened runs)
@@ -25,6 +27,10 @@ struct RunOptions {
   /// Called after each particle frame is written (the app renders images here; the engine
   /// knows nothing of rendering). `last` is true for the final frame of the run.
   std::function<void(const Model&, const State&, const Workspace&, const std::string& out, bool last)> on_frame;
+  /// The ranks sharing this simulation (domain decomposition, domain.h), or null. Every rank
+  /// calls run() with the whole initial state and the same options; the root (rank 0) writes
+  /// the results and returns with the whole final state, the others with their share.
+  Domain* domain = nullptr;
 };
 
 struct RunSummary {

@@ -82,6 +82,44 @@ void State::attach(std::size_t sphere, std::size_t b, double ox, double oy, doub
   inv_mass[sphere] = 1.0 / bodies.mass[b];  // contacts see the body's mass
 }
 
+std::size_t State::record_size() const {
+  return 25 + (has_meshes ? 1 + MeshContacts::kSlots * (5 + mesh_history_width) : 0);
+}
+
+void State::pack(std::size_t p, std::vector<double>& out) const {
+  for (const auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
+                        &offset_x, &offset_y, &offset_z})
+    out.push_back((*c)[p]);
+  out.push_back(material[p]), out.push_back(static_cast<double>(id[p])), out.push_back(body[p]), out.push_back(attached[p]);
+  if (!has_meshes) return;
+  const MeshContacts& mc = mesh_contacts;
+  const size_t slots = MeshContacts::kSlots, first = p * slots;
+  out.push_back(mc.count[p]);
+  for (size_t k = first; k < first + slots; ++k)
+    out.push_back(mc.mesh[k]), out.push_back(mc.triangle[k]), out.push_back(mc.px[k]), out.push_back(mc.py[k]), out.push_back(mc.pz[k]);
+  out.insert(out.end(), mc.history.begin() + static_cast<std::ptrdiff_t>(first * mesh_history_width),
+             mc.history.begin() + static_cast<std::ptrdiff_t>((first + slots) * mesh_history_width));
+}
+
+void State::unpack(const double* in) {
+  for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
+                  &offset_x, &offset_y, &offset_z})
+    c->push_back(*in++);
+  material.push_back(static_cast<std::int32_t>(*in++));
+  id.push_back(static_cast<std::int64_t>(*in++));
+  body.push_back(static_cast<std::int32_t>(*in++));
+  attached.push_back(static_cast<std::int32_t>(*in++));
+  if (!has_meshes) return;
+  MeshContacts& mc = mesh_contacts;
+  mc.count.push_back(static_cast<std::uint8_t>(*in++));
+  for (int k = 0; k < MeshContacts::kSlots; ++k) {
+    mc.mesh.push_back(static_cast<std::int32_t>(in[0])), mc.triangle.push_back(static_cast<std::int32_t>(in[1]));
+    mc.px.push_back(in[2]), mc.py.push_back(in[3]), mc.pz.push_back(in[4]);
+    in += 5;
+  }
+  mc.history.insert(mc.history.end(), in, in + MeshContacts::kSlots * mesh_history_width);
+}
+
 void State::permute(const std::vector<std::int32_t>& order) {
   std::vector<double> scratch;
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})

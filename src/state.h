@@ -138,7 +138,13 @@ struct State {
   bool has_meshes = false;
   std::size_t mesh_history_width = 0;
 
+  /// Under domain decomposition (domain.h) the last `ghosts` slots are copies of particles other
+  /// ranks own, near this rank's subdomain: they are contact partners, never integrated, never
+  /// in a wall or mesh contact, never counted. 0 otherwise. Not part of a checkpoint.
+  std::size_t ghosts = 0;
+
   std::size_t size() const { return x.size(); }
+  std::size_t owned() const { return x.size() - ghosts; }
   /// Appends a sphere at rest state; returns its slot.
   std::size_t add_sphere(double px, double py, double pz, double r, double density, int mat);
   /// Reorders particle slots: new slot k holds old slot order[k]. Contact lists are not touched.
@@ -149,6 +155,11 @@ struct State {
   /// Appends a clump body; its spheres are added with add_sphere and `attach`ed.
   std::size_t add_body(double px, double py, double pz, const double q[4], double mass, const double principal[3]);
   void attach(std::size_t sphere, std::size_t body, double ox, double oy, double oz);
+  /// One particle's data (its columns and mesh contacts) as doubles, to move it between the
+  /// ranks of a decomposed run (ids and indices are exact in a double); unpack appends it.
+  std::size_t record_size() const;
+  void pack(std::size_t slot, std::vector<double>& out) const;
+  void unpack(const double* in);
 };
 
 }  // namespace dem

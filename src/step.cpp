@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "domain.h"
 #include "forces.h"
 #include "mesh_contacts.h"
 #include "neighbors.h"
@@ -19,7 +20,7 @@ namespace {
 /// a free sphere has moved more than half the skin since the lists were built (the same test
 /// as needs_rebuild, made while the positions are in cache).
 bool kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
-  const long n = static_cast<long>(s.size());
+  const long n = static_cast<long>(s.owned());  // ghosts are moved by their owners
   const bool check = s.x_built.size() == s.size();
   const double limit2 = 0.25 * model.skin * model.skin;
   int moved = 0;
@@ -84,6 +85,25 @@ void refresh_body_spheres(const Model& model, State& s, const Workspace& work) {
   if (s.bodies.size() > 0) place_body_spheres(model, s, work.body_begin, work.body_members);
 }
 
+/// Inlets under domain decomposition: every rank draws the same insertions (same random
+/// state) against every rank's spheres near the region, and keeps those in its own slab.
+void run_inlets_decomposed(const Model& model, State& state, Workspace& work) {
+  Domain& domain = *work.domain;
+  for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k) {
+    if (!inlet_due(model, state, k)) continue;  // the same on every rank
+    drop_ghosts(state);  // new particles go after the owned ones; ghosts come back at the rebuild
+    work.valid = false;
+    double lo[3], hi[3];
+    inlet_reach(model, k, lo, hi);
+    const std::vector<std::array<double, 4>> others = domain.particles_in(state, lo, hi);
+    const size_t before = state.size();
+    if (run_inlet(model, state, k, &others) == 0) continue;
+    std::vector<std::uint8_t> keep(state.size(), 1);
+    for (size_t p = before; p < state.size(); ++p) keep[p] = domain.owns(state.x[p], state.y[p], state.z[p]);
+    state.compact(keep);
+  }
+}
+
 }  // namespace
 
 void prepare(const Model& model, State& state, Workspace& work) {
@@ -107,9 +127,18 @@ void step(const Model& model, State& state, Workspace& work) {
   const bool free_moved = kick_drift(state, work, model, 0.5 * dt, dt);
   move_walls(model, state, dt);
   place_meshes(model, state.time + dt, work);
-  for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
-    if (run_inlet(model, state, k) > 0) work.valid = false;
-  if (free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)) rebuild_contacts(model, state, work);
+  if (work.domain) {
+    run_inlets_decomposed(model, state, work);
+    // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
+    if (work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)))
+      rebuild_contacts(model, state, work);
+    else
+      work.domain->refresh_ghosts(state);
+  } else {
+    for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
+      if (run_inlet(model, state, k) > 0) work.valid = false;
+    if (free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)) rebuild_contacts(model, state, work);
+  }
   compute_forces(model, state, work, 0.5 * dt);
   refresh_body_spheres(model, state, work);
   state.time += dt;

@@ -8,6 +8,8 @@
 
 namespace dem {
 
+class Domain;
+
 /// Forces of each listed wall or mesh contact from the last evaluation (by contact index). The
 /// force and torque on the particle were added to its totals as the contact was evaluated.
 /// Per contact: 3 doubles + 1 byte.
@@ -40,6 +42,8 @@ struct MeshSlotResults {
 };
 
 struct Workspace {
+  /// The ranks sharing this simulation (domain.h); null in a single process. Not owned.
+  Domain* domain = nullptr;
   bool valid = false;  ///< false: the next step rebuilds the lists
   std::int64_t rebuilds = 0;
 
@@ -64,8 +68,8 @@ struct Workspace {
   // Spheres of each body: body_members[body_begin[b] ... body_begin[b+1]).
   std::vector<std::int32_t> body_begin, body_members;
 
-  // Cell grid scratch.
-  std::vector<std::int32_t> cell_of, cell_start, order;
+  // Cell grid scratch; members: slots by cell (only with ghosts, which are not sorted).
+  std::vector<std::int32_t> cell_of, cell_start, order, members;
 };
 
 }  // namespace dem

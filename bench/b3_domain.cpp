@@ -1,0 +1,118 @@
+// Benchmark B3 "split box": benchmark B1 (b1_spec.h: the lattice settling in an open-top box,
+// then the dense bed) split into slabs over the ranks of `mpirun -np R` (domain decomposition,
+// app/mpi_domain.h), to measure what the decomposition costs and buys. Without mpirun it is one
+// process, the reference. Prints per phase: particle-steps/s of all ranks together, and rank 0's
+// communication time and volume per step (what the scaling model in the README is built from).
+//
+// Usage: [mpirun -np R] bench_b3_domain [--n N] [--threads T] [--phase1-steps S1] [--phase2-steps S2]
+//   N as in B1 (20000, 100000, or 2000-4000000 for the 32-layer family); one "csv," line per phase.
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "b1_spec.h"
+#include "diagnostics.h"
+#include "domain.h"
+#include "forces.h"
+#include "mesh_contacts.h"
+#include "mpi_campaign.h"
+#include "mpi_domain.h"
+#include "neighbors.h"
+#include "step.h"
+
+namespace {
+
+namespace mpi = dem::app::mpi;
+
+struct Options {
+  long n = 20000;
+  int threads = 0;
+  long phase1 = -1, phase2 = -1;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    auto value = [&]() -> const char* {
+      if (k + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++k];
+    };
+    if (a == "--n") o.n = std::atol(value());
+    else if (a == "--threads") o.threads = std::atoi(value());
+    else if (a == "--phase1-steps") o.phase1 = std::atol(value());
+    else if (a == "--phase2-steps") o.phase2 = std::atol(value());
+    else {
+      std::fprintf(stderr, "unknown option %s\nusage: [mpirun -np R] %s [--n N] [--threads T] [--phase1-steps S1] [--phase2-steps S2]\n",
+                   a.c_str(), argv[0]);
+      std::exit(2);
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  mpi::Session session(&argc, &argv);
+  const mpi::World& world = mpi::world();
+  const Options o = parse(argc, argv);
+  if (o.threads > 0) omp_set_num_threads(o.threads);
+  bench::b1::Size b = bench::b1::size_for(o.n);
+  if (o.phase1 >= 0) b.phase1 = o.phase1;
+  if (o.phase2 >= 0) b.phase2 = o.phase2;
+  dem::CaseSpec spec = dem::parse_case_text(bench::b1::case_yaml(b), "b3_domain");
+  spec.particles[0].positions = bench::b1::lattice(b);
+  spec.particles[0].count = static_cast<std::int64_t>(spec.particles[0].positions.size());
+  const dem::Model model = dem::compile(spec);
+  dem::State state = dem::initial_state(model);
+  const double total = static_cast<double>(state.size());
+  std::string note = "one process";
+  std::unique_ptr<dem::Domain> domain = world.active() ? mpi::make_domain(model, state, &note) : nullptr;
+  const dem::Model& stepped = domain ? domain->local_model() : model;
+  dem::Workspace work;
+  work.domain = domain.get();
+  if (domain) domain->distribute(state);
+  dem::prepare(stepped, state, work);
+  if (world.rank == 0)
+    fmt::print("B3 split box: B1 with N = {} on {} ranks x {} threads; {}\n", b.n(), world.size, omp_get_max_threads(), note);
+
+  auto run_phase = [&](const char* name, std::int64_t steps) {
+    if (domain) domain->any(false);  // start together
+    const auto start = std::chrono::steady_clock::now();
+    for (std::int64_t k = 0; k < steps; ++k) dem::step(stepped, state, work);
+    if (domain) domain->any(false);  // the slowest rank sets the time
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Outside the timed loop: the whole state on rank 0 for the physics check.
+    dem::State whole = domain ? domain->gather(state) : state;
+    if (world.rank != 0) return;
+    dem::Workspace w;
+    dem::place_meshes(model, whole.time, w);
+    dem::rebuild_contacts(model, whole, w);
+    dem::State evaluated = whole;
+    dem::compute_forces(model, evaluated, w);
+    const dem::Scalars sc = dem::measure(model, evaluated, w);
+    double bed = 0;
+    for (size_t p = 0; p < whole.size(); ++p) bed = std::max(bed, whole.z[p] + whole.radius[p]);
+    const double rate = total * static_cast<double>(steps) / seconds;
+    fmt::print("  {}: {} steps in {:.2f} s, {:.4g} particle-steps/s; contacts/particle {:.3f}, bed {:.4f} m, particles {}\n", name,
+               steps, seconds, rate, static_cast<double>(sc.contacts) / total, bed, whole.size());
+    if (domain) fmt::print("    rank 0: {}\n", domain->statistics());
+    fmt::print("csv,{},{},{},{},{},{:.4f},{:.6g},{:.4f},{:.5f}\n", b.n(), name, steps, world.size, omp_get_max_threads(), seconds, rate,
+               static_cast<double>(sc.contacts) / total, bed);
+    std::fflush(stdout);
+  };
+  if (world.rank == 0) fmt::print("csv,N,phase,steps,ranks,threads_per_rank,seconds,particle_steps_per_s,contacts_per_particle,bed_height_m\n");
+  run_phase("settle", b.phase1);
+  run_phase("dense", b.phase2);
+  return 0;
+}

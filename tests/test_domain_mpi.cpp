@@ -1,0 +1,178 @@
+// Domain decomposition (src/domain.h, app/mpi_domain.h), run as `mpirun -np 2 domain_mpi_tests`
+// (tests/CMakeLists.txt). Every rank runs each case twice: whole, in this process alone, and split
+// into slabs shared with the other rank. Particles and momentum must be conserved exactly (to
+// rounding), and the decomposed runs must match the single-rank runs within their run-to-run
+// spread: a split run is not bitwise the same (contacts across a face are summed in another
+// order), so its trajectories part from the single run's after a while, as two runs of one case
+// on different machines would.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "diagnostics.h"
+#include "domain.h"
+#include "model.h"
+#include "mpi_campaign.h"
+#include "mpi_domain.h"
+#include "particles.h"
+#include "run.h"
+#include "spec.h"
+
+namespace {
+
+using namespace dem;
+namespace mpi = dem::app::mpi;
+
+struct Outcome {
+  std::vector<Scalars> rows;  ///< root only
+  State whole;                ///< root: the whole final state
+  std::string note;           ///< how the domain was cut
+};
+
+Outcome simulate(const CaseSpec& spec, bool decomposed, double duration) {
+  const Model model = compile(spec);
+  Outcome out;
+  State state = initial_state(model);
+  Workspace work;
+  std::unique_ptr<Domain> domain = decomposed ? mpi::make_domain(model, state, &out.note) : nullptr;
+  RunOptions options;
+  options.write_files = false;
+  options.progress = false;
+  options.duration = duration;
+  options.domain = domain.get();
+  std::ostringstream log;
+  out.rows = run(model, state, work, options, log).scalars;
+  out.whole = std::move(state);
+  return out;
+}
+
+bool root() { return mpi::world().rank == 0; }
+
+std::array<double, 4> momentum(const State& s) {  // [kg m/s] x, y, z and the sum of |m v|
+  std::array<double, 4> p{};
+  for (size_t k = 0; k < s.size(); ++k) {
+    const double m = 1.0 / s.inv_mass[k];
+    p[0] += m * s.vx[k], p[1] += m * s.vy[k], p[2] += m * s.vz[k];
+    p[3] += m * std::sqrt(s.vx[k] * s.vx[k] + s.vy[k] * s.vy[k] + s.vz[k] * s.vz[k]);
+  }
+  return p;
+}
+
+// A frictional, dissipative gas in a box periodic along all three axes, no walls, no gravity:
+// nothing but contacts acts, so the total momentum stays what it was. The slabs run along x, the
+// long axis, with the top rank's upper neighbour rank 0 one period on: particles cross both the
+// cut and the periodic face, ghosts are sent across both.
+const char* kPeriodicGas = R"(
+title: periodic frictional gas
+simulation:
+  duration: 0.05
+  gravity: [0, 0, 0]
+  seed: 3
+  periodic: [x, y, z]
+  domain: {min: [0, 0, 0], max: [0.12, 0.03, 0.03]}
+materials:
+  beads: {density: 2500, youngs_modulus: 5.0e7, poisson_ratio: 0.25, restitution: 0.5, friction: 0.5, rolling_friction: 0.1}
+contact: {normal: hertz, damping: restitution, tangential: mindlin, rolling: epsd}
+particles:
+  - {material: beads, diameter: {distribution: uniform, min: 0.0025, max: 0.0035}, count: 900, region: {min: [0, 0, 0], max: [0.12, 0.03, 0.03]}, velocity: [1.5, 0.4, -0.2]}
+  - {material: beads, diameter: {distribution: uniform, min: 0.0025, max: 0.0035}, count: 900, region: {min: [0, 0, 0], max: [0.12, 0.03, 0.03]}, velocity: [-1.0, 0.1, 0.6]}
+)";
+
+TEST(DomainMpi, PeriodicGasConservesParticlesAndMomentumExactly) {
+  const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
+  const Model model = compile(spec);
+  const std::array<double, 4> before = momentum(initial_state(model));
+  const Outcome whole = simulate(spec, false, 0.05);
+  const Outcome split = simulate(spec, true, 0.05);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  EXPECT_NE(split.note.find("slabs along x across the period"), std::string::npos) << split.note;
+  ASSERT_EQ(split.whole.size(), 1800u) << "particles";
+  ASSERT_EQ(whole.whole.size(), 1800u);
+  const std::array<double, 4> a = momentum(whole.whole), b = momentum(split.whole);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(b[k], before[k], 1e-11 * before[3]) << "momentum component " << k << " of the split run";
+    EXPECT_NEAR(a[k], before[k], 1e-11 * before[3]) << "momentum component " << k << " of the single run";
+  }
+  // The gas cools by inelastic collisions alike (a statistical match, the runs part).
+  const double ka = whole.rows.back().kinetic_translation, kb = split.rows.back().kinetic_translation;
+  const double k0 = whole.rows.front().kinetic_translation;
+  std::printf("  kinetic energy %.5g J at the start, %.5g J single, %.5g J split; contacts %zu / %zu\n", k0, ka, kb,
+              whole.rows.back().contacts, split.rows.back().contacts);
+  EXPECT_LT(ka, 0.9 * k0) << "the gas must have collided and cooled for the test to mean anything";
+  EXPECT_NEAR(kb, ka, 0.05 * ka);
+}
+
+TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
+  // The shipped settling bed (rolling resistance, liquid bridges), 2,000 beads poured from a tall
+  // region: the slabs run along z (twice as tall as wide, so even at half weight), most beads fall
+  // from the upper rank to the lower, the cuts move with them (balance by particle count). At
+  // rest the floor carries the weight.
+  CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/settling_bed.yaml");
+  spec.particles[0].count = 2000;
+  const double duration = 0.3;
+  const Outcome whole = simulate(spec, false, duration);
+  const Outcome split = simulate(spec, true, duration);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  ASSERT_EQ(split.whole.size(), whole.whole.size());
+  double weight = 0;
+  for (size_t p = 0; p < whole.whole.size(); ++p) weight += 9.81 / whole.whole.inv_mass[p];
+  auto mean_height = [](const State& s) {
+    double z = 0;
+    for (double v : s.z) z += v;
+    return z / static_cast<double>(s.size());
+  };
+  const Scalars& a = whole.rows.back();
+  const Scalars& b = split.rows.back();
+  const double ha = mean_height(whole.whole), hb = mean_height(split.whole);
+  const double ca = 2.0 * a.contacts / whole.whole.size(), cb = 2.0 * b.contacts / split.whole.size();
+  std::printf("  floor %.5g / %.5g N (weight %.5g N), mean height %.5g / %.5g m, contacts per bead %.3f / %.3f, kinetic %.3g / %.3g J\n",
+              a.wall_normal_force[0], b.wall_normal_force[0], weight, ha, hb, ca, cb, a.kinetic_translation, b.kinetic_translation);
+  EXPECT_LT(a.kinetic_translation, 1e-3) << "the single run must have settled";
+  EXPECT_LT(b.kinetic_translation, 1e-3) << "the split run must have settled";
+  EXPECT_NEAR(b.wall_normal_force[0], weight, 0.03 * weight) << "the floor carries the weight";
+  EXPECT_NEAR(hb, ha, 0.01 * ha) << "bed height";
+  EXPECT_NEAR(cb, ca, 0.03 * ca) << "contacts per bead";
+}
+
+TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
+  // The shipped inlet-plate-outlet case: an inlet pours gravel onto a plate inclined at 40
+  // degrees, the outlet bin takes what leaves it. The slabs run along x, the flow direction, so
+  // every bead is inserted on rank 0 and migrates to rank 1 with its contacts.
+  const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/inlet_outlet.yaml");
+  const double duration = 0.6;
+  const Outcome whole = simulate(spec, false, duration);
+  const Outcome split = simulate(spec, true, duration);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  const Scalars& a = whole.rows.back();
+  const Scalars& b = split.rows.back();
+  std::printf("  inserted %.5g / %.5g kg, outlet %.5g / %.5g kg, on the plate %zu / %zu beads, plate force %.4g / %.4g N, lost %lld / %lld\n",
+              a.inserted_mass, b.inserted_mass, a.outlet_mass[0], b.outlet_mass[0], a.particles, b.particles, a.wall_normal_force[0],
+              b.wall_normal_force[0], static_cast<long long>(a.lost), static_cast<long long>(b.lost));
+  EXPECT_DOUBLE_EQ(b.inserted_mass, a.inserted_mass) << "the inlet draws the same beads whether split or not";
+  EXPECT_GT(a.outlet_mass[0], 0.3 * a.inserted_mass) << "the flow must reach the bin for the test to mean anything";
+  EXPECT_NEAR(b.outlet_mass[0], a.outlet_mass[0], 0.05 * a.outlet_mass[0]) << "mass delivered to the bin";
+  EXPECT_NEAR(static_cast<double>(b.particles), static_cast<double>(a.particles), 0.1 * a.particles) << "beads on the plate";
+  // Particles: everything inserted is on the plate, in the bin or lost.
+  EXPECT_EQ(b.lost, 0);
+  EXPECT_NEAR(b.inserted_mass, b.outlet_mass[0] + [&] {
+    double m = 0;
+    for (double inv : split.whole.inv_mass) m += 1.0 / inv;
+    return m;
+  }(), 1e-9 * b.inserted_mass) << "mass is conserved";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  mpi::Session session(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int failed = RUN_ALL_TESTS();
+  int any = 0;
+  for (const std::string& bytes : mpi::all_gather(std::to_string(failed))) any = any || std::stoi(bytes) != 0;
+  return any;
+}
