@@ -5,8 +5,8 @@
 // MPI is started only when an MPI launcher started this process (OpenMPI's mpirun sets
 // OMPI_COMM_WORLD_SIZE, PMIx launchers PMIX_RANK, MPICH's hydra and Slurm PMI_SIZE); a plain
 // `demdesign` run never touches MPI, and a build without MPI (-DDEMDESIGN_MPI=OFF) is always
-// rank 0 of 1. One simulation is not split over ranks (no domain decomposition): a case without a
-// sweep runs on rank 0 and the other ranks wait.
+// rank 0 of 1. One case without a sweep is split into slabs over the ranks instead
+// (mpi_domain.h).
 //
 // Sweep variants are handed out one at a time by rank 0 (WorkQueue): a rank with a free slot
 // asks, rank 0 answers between looking after its own variants, so a variant that fails at once

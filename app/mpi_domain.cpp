@@ -285,8 +285,11 @@ class MpiDomain final : public Domain {
 
   void sum_wall_loads(State& s) override {
     Timed timed{step_seconds_};
-    for (auto* c : {&s.walls.fx, &s.walls.fy, &s.walls.fz})
-      check(MPI_Allreduce(MPI_IN_PLACE, c->data(), static_cast<int>(c->size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+    const size_t walls = s.walls.fx.size();
+    buffer_.resize(3 * walls);
+    for (size_t w = 0; w < walls; ++w) buffer_[3 * w] = s.walls.fx[w], buffer_[3 * w + 1] = s.walls.fy[w], buffer_[3 * w + 2] = s.walls.fz[w];
+    check(MPI_Allreduce(MPI_IN_PLACE, buffer_.data(), static_cast<int>(buffer_.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+    for (size_t w = 0; w < walls; ++w) s.walls.fx[w] = buffer_[3 * w], s.walls.fy[w] = buffer_[3 * w + 1], s.walls.fz[w] = buffer_[3 * w + 2];
   }
 
   void distribute(State& s) override {

@@ -1,0 +1,42 @@
+#!/bin/sh
+# Benchmark B3 "split box" (bench/b3_domain.cpp): B1 on one process (1 and 2 OpenMP threads) and
+# split into slabs over 2 MPI ranks of 1 thread each, on this machine, alternating, REPS times.
+# Prints particle-steps/s, the speed-up of the split run over one thread, and rank 0's
+# communication figures; appends the csv lines to bench/results/b3_decomposition.csv with the machine.
+#
+# Usage: sh bench/b3_decomposition.sh [BUILD_DIR] [N] [PHASE1_STEPS] [PHASE2_STEPS] [REPS]
+set -eu
+build=${1:-build}
+n=${2:-20000}
+s1=${3:-20000}
+s2=${4:-4000}
+reps=${5:-1}
+bin="$build/bench/bench_b3_domain"
+[ -x "$bin" ] || { echo "no $bin: build with -DDEMDESIGN_MPI=ON (cmake --build $build --target bench_b3_domain)"; exit 2; }
+out=$(dirname "$0")/results/b3_decomposition.csv
+machine="$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //') x $(nproc)"
+[ -f "$out" ] || echo "date,machine,N,phase,steps,ranks,threads_per_rank,seconds,particle_steps_per_s,contacts_per_particle,bed_height_m" > "$out"
+log=$(mktemp)
+for rep in $(seq "$reps"); do
+  for config in "1 1" "1 2" "2 1"; do
+    set -- $config
+    echo "== repetition $rep: $1 rank(s) x $2 thread(s)"
+    if [ "$1" = 1 ]; then
+      OMP_NUM_THREADS=$2 "$bin" --n "$n" --threads "$2" --phase1-steps "$s1" --phase2-steps "$s2" | tee -a "$log"
+    else
+      mpirun --allow-run-as-root --oversubscribe -np "$1" -x OMP_NUM_THREADS="$2" "$bin" --n "$n" --threads "$2" \
+        --phase1-steps "$s1" --phase2-steps "$s2" | tee -a "$log"
+    fi
+  done
+done
+grep '^csv,[0-9]' "$log" | sed "s/^csv,/$(date -u +%Y-%m-%d),\"$machine\",/" >> "$out"
+echo
+echo "N = $n: median particle-steps/s per configuration and phase (speed-up over 1 rank x 1 thread)"
+for phase in settle dense; do
+  base=$(grep "^csv,[0-9]*,$phase,[0-9]*,1,1," "$log" | cut -d, -f8 | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
+  for config in "1,1" "1,2" "2,1"; do
+    rate=$(grep "^csv,[0-9]*,$phase,[0-9]*,$config," "$log" | cut -d, -f8 | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
+    echo "$phase ranks,threads=$config: $rate ($(awk -v r="$rate" -v b="$base" 'BEGIN {printf "%.2f", r / b}')x)"
+  done
+done
+rm -f "$log"
