@@ -6,6 +6,7 @@
 // order), so its trajectories part from the single run's after a while, as two runs of one case
 // on different machines would.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "diagnostics.h"
 #include "domain.h"
+#include "equipment.h"
 #include "model.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
@@ -49,6 +51,16 @@ Outcome simulate(const CaseSpec& spec, bool decomposed, double duration) {
 }
 
 bool root() { return mpi::world().rank == 0; }
+
+/// Mean of a column of the rows over [from, to] s.
+template <typename Column>
+double mean_over(const std::vector<Scalars>& rows, double from, double to, Column column) {
+  double sum = 0;
+  int count = 0;
+  for (const Scalars& r : rows)
+    if (r.time >= from && r.time <= to) sum += column(r), ++count;
+  return count ? sum / count : 0.0;
+}
 
 std::array<double, 4> momentum(const State& s) {  // [kg m/s] x, y, z and the sum of |m v|
   std::array<double, 4> p{};
@@ -154,6 +166,14 @@ TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
               a.inserted_mass, b.inserted_mass, a.outlet_mass[0], b.outlet_mass[0], a.particles, b.particles, a.wall_normal_force[0],
               b.wall_normal_force[0], static_cast<long long>(a.lost), static_cast<long long>(b.lost));
   EXPECT_DOUBLE_EQ(b.inserted_mass, a.inserted_mass) << "the inlet draws the same beads whether split or not";
+  // The plate's load and the flow's kinetic energy, averaged over the last 0.3 s.
+  const double fa = mean_over(whole.rows, 0.3, 0.6, [](const Scalars& r) { return r.wall_normal_force[0]; });
+  const double fb = mean_over(split.rows, 0.3, 0.6, [](const Scalars& r) { return r.wall_normal_force[0]; });
+  const double ka = mean_over(whole.rows, 0.3, 0.6, [](const Scalars& r) { return r.kinetic_translation; });
+  const double kb = mean_over(split.rows, 0.3, 0.6, [](const Scalars& r) { return r.kinetic_translation; });
+  std::printf("  over 0.3-0.6 s: plate force %.4g / %.4g N, kinetic energy %.4g / %.4g J\n", fa, fb, ka, kb);
+  EXPECT_NEAR(fb, fa, 0.05 * fa) << "mean plate force";
+  EXPECT_NEAR(kb, ka, 0.05 * ka) << "mean kinetic energy";
   EXPECT_GT(a.outlet_mass[0], 0.3 * a.inserted_mass) << "the flow must reach the bin for the test to mean anything";
   EXPECT_NEAR(b.outlet_mass[0], a.outlet_mass[0], 0.05 * a.outlet_mass[0]) << "mass delivered to the bin";
   EXPECT_NEAR(static_cast<double>(b.particles), static_cast<double>(a.particles), 0.1 * a.particles) << "beads on the plate";
@@ -164,6 +184,53 @@ TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
     for (double inv : split.whole.inv_mass) m += 1.0 / inv;
     return m;
   }(), 1e-9 * b.inserted_mass) << "mass is conserved";
+}
+
+TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
+  // A small silo (triangle mesh, slide gate opening at 0.3 s): 2,500 beads, discharge for 0.6 s.
+  // Mesh contacts (with their histories, per particle) migrate with the particles; the wall
+  // loads and wear records of the ranks are summed. The slabs run along x, through the orifice.
+  YAML::Node node = YAML::LoadFile(DEMDESIGN_SOURCE_DIR "/cases/silo_discharge.yaml");
+  node.remove("sweep");
+  node["equipment"]["silo"]["diameter"] = 0.1;
+  node["equipment"]["silo"]["height"] = 0.12;
+  node["equipment"]["silo"]["orifice_diameter"] = 0.035;
+  node["equipment"]["silo"]["open_at"] = 0.3;
+  node["particles"][0]["count"] = 2500;
+  node["particles"][0]["region"]["min"][0] = -0.034, node["particles"][0]["region"]["min"][1] = -0.034;
+  node["particles"][0]["region"]["max"][0] = 0.034, node["particles"][0]["region"]["max"][1] = 0.034;
+  node["particles"][0]["region"]["max"][2] = 0.25;
+  CaseSpec spec = parse_case_node(node, DEMDESIGN_SOURCE_DIR "/cases/silo_discharge.yaml");
+  equipment::expand_equipment(spec);
+  const double duration = 0.9;
+  const Outcome whole = simulate(spec, false, duration);
+  const Outcome split = simulate(spec, true, duration);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  auto rate = [](const Outcome& o) {  // [kg/s] least-squares slope of the outlet mass over 0.45-0.9 s
+    double n = 0, st = 0, sm = 0, stt = 0, stm = 0;
+    for (const Scalars& r : o.rows)
+      if (r.time >= 0.45) n += 1, st += r.time, sm += r.outlet_mass[0], stt += r.time * r.time, stm += r.time * r.outlet_mass[0];
+    return (n * stm - st * sm) / (n * stt - st * st);
+  };
+  const double ra = rate(whole), rb = rate(split);
+  const double fa = mean_over(whole.rows, 0.45, 0.9, [](const Scalars& r) { return r.mesh_force[0]; });
+  const double fb = mean_over(split.rows, 0.45, 0.9, [](const Scalars& r) { return r.mesh_force[0]; });
+  double wear_a = 0, wear_b = 0;
+  for (double w : whole.whole.records[0].shear_work) wear_a += w;
+  for (double w : split.whole.records[0].shear_work) wear_b += w;
+  std::printf("  discharge %.4g / %.4g kg/s, silo wall force %.4g / %.4g N, shear work on the silo %.4g / %.4g J, particles %zu / %zu\n",
+              ra, rb, fa, fb, wear_a, wear_b, whole.whole.size(), split.whole.size());
+  EXPECT_GT(ra, 0.05) << "the silo must discharge for the test to mean anything";
+  EXPECT_NEAR(rb, ra, 0.08 * ra) << "discharge rate";
+  EXPECT_NEAR(fb, fa, 0.03 * fa) << "mean force on the silo";
+  EXPECT_NEAR(wear_b, wear_a, 0.1 * wear_a) << "friction work on the silo (wear records summed over the ranks)";
+  const Scalars& last = split.rows.back();
+  EXPECT_EQ(static_cast<std::int64_t>(split.whole.size()) + last.lost, 2500 - [&] {
+    std::int64_t removed = 0;
+    for (const OutletState& o : split.whole.outlets) removed += o.removed;
+    return removed;
+  }()) << "every bead is in the silo, in the outlet or lost";
 }
 
 }  // namespace
