@@ -180,6 +180,10 @@ int run_case(const RunArgs& args) {
   const dem::app::mpi::World& world = dem::app::mpi::world();
   std::string domain_note;
   const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note) : nullptr;
+  if (world.active() && !domain) {  // cannot be split: rank 0 runs it alone, the others wait
+    if (world.rank != 0) return 0;
+    std::cout << fmt::format("note: {} MPI ranks, but this case runs on rank 0 alone: {}\n", world.size, domain_note);
+  }
   if (domain && threads <= 0) omp_set_num_threads(dem::app::mpi::cores_per_rank());  // the ranks share the machine's cores
   if (domain && world.rank == 0)
     std::cout << fmt::format("domain decomposition: {}, {} OpenMP threads per rank\n", domain_note, omp_get_max_threads());

@@ -48,13 +48,13 @@ class MpiDomain final : public Domain {
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     for (size_t p = 0; p < initial.size(); ++p) {
       if (initial.body[p] >= 0 || initial.attached[p] >= 0)
-        throw CaseError(fmt::format("{}: domain decomposition takes free spheres; this case has clumps or spheres glued to "
-                                    "walls: run it on one rank (or share a sweep or calibration among the ranks)",
+        throw CaseError(fmt::format("{}: the split into subdomains takes free spheres only, and this case has clumps or "
+                                    "spheres glued to walls",
                                     model.source));
     }
     for (const Inlet& inlet : model.inlets)
       if (inlet.clump >= 0)
-        throw CaseError(fmt::format("{}: inlet {} makes clumps; domain decomposition takes free spheres: run the case on one rank",
+        throw CaseError(fmt::format("{}: inlet {} makes clumps, and the split into subdomains takes free spheres only",
                                     model.source, inlet.spec.name));
     double radius_max = model.radius_max;
     for (double r : initial.radius) radius_max = std::max(radius_max, r);
@@ -81,7 +81,7 @@ class MpiDomain final : public Domain {
     const double needed = (periodic_ ? size_ : std::max(size_ - 2, 0)) * reach_;
     if (extent[axis_] < needed)
       throw CaseError(fmt::format("{}: {} ranks need a domain at least {:.4g} m long along {} (each slab one pair reach, {:.4g} m, "
-                                  "wide); it is {:.4g} m: use fewer ranks",
+                                  "wide); it is {:.4g} m, so fewer ranks would split it",
                                   model.source, size_, needed, "xyz"[axis_], reach_, extent[axis_]));
     down_ = rank_ > 0 ? rank_ - 1 : periodic_ ? size_ - 1 : MPI_PROC_NULL;
     up_ = rank_ < size_ - 1 ? rank_ + 1 : periodic_ ? 0 : MPI_PROC_NULL;
@@ -517,9 +517,14 @@ std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, st
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size < 2) return nullptr;
-  auto domain = std::make_unique<MpiDomain>(model, initial);
-  if (note) *note = domain->describe();
-  return domain;
+  try {
+    auto domain = std::make_unique<MpiDomain>(model, initial);
+    if (note) *note = domain->describe();
+    return domain;
+  } catch (const CaseError& e) {
+    if (note) *note = e.what();
+    return nullptr;
+  }
 }
 
 #else

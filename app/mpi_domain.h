@@ -14,8 +14,8 @@
 // ghost records, one histogram sum for the balance. Meshes are held whole by every rank (their
 // triangles are shared, read-only); wear records and loads are summed when results are written.
 //
-// Not decomposed: clumps and spheres glued to walls (the case runs on one rank, or as a
-// campaign); rank 0 gathers the whole state for every row of scalars, frame and checkpoint.
+// Not decomposed: clumps and spheres glued to walls (such a case runs on rank 0 alone). Rank 0
+// gathers the whole state for every row of scalars, frame and checkpoint.
 #pragma once
 
 #include <memory>
@@ -25,8 +25,9 @@
 namespace dem::app::mpi {
 
 /// The domain over all ranks of the running MPI session for `model`, whose initial particles are
-/// `initial` (the same on every rank). Throws CaseError when the case cannot be decomposed
-/// (clumps, glued spheres, a slab axis too short for the ranks). Null without MPI.
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* axis_note);
+/// `initial` (the same on every rank); `note` tells how it was cut. Null without MPI, on one
+/// rank, and when the case cannot be split (clumps, glued spheres, a slab axis too short for the
+/// ranks): then `note` says why, and the case runs on rank 0 alone.
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note);
 
 }  // namespace dem::app::mpi
