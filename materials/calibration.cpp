@@ -1,5 +1,6 @@
-// Compare, calibrate and diagnose (rules in calibration.h).
+// Compare and calibrate (rules in calibration.h); diagnosis and the ledger are in diagnosis.cpp.
 #include "calibration.h"
+#include "calibration_support.h"
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -23,34 +24,15 @@
 
 namespace dem::materials {
 
+using detail::Clock;
+using detail::join;
+using detail::Progress;
+using detail::seconds_since;
+using detail::simulate_experiments;
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string duration_text(double s) {
-  if (s < 90) return fmt::format("{:.0f} s", s);
-  if (s < 5400) return fmt::format("{:.0f} min", s / 60);
-  return fmt::format("{:.1f} h", s / 3600);
-}
-
-/// Counts simulations against a planned total and prints the time left.
-struct Progress {
-  const CalibrationOptions& options;
-  std::string what;
-  int total = 0, done = 0;
-  Clock::time_point t0 = Clock::now();
-  void step(const std::string& item) {
-    ++done;
-    if (!options.progress) return;
-    const double elapsed = seconds_since(t0);
-    const double left = done > 0 ? elapsed / done * std::max(0, total - done) : 0;
-    options.progress(fmt::format("{} {}/{}: {} ({} elapsed, about {} left)", what, done, total, item, duration_text(elapsed), duration_text(left)));
-  }
-};
-
 SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, const CalibrationOptions& options, std::uint64_t seed) {
   TestOptions t;
   t.seed = seed;
@@ -137,12 +119,11 @@ ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector
   return run;
 }
 
-/// Every experiment simulated `replicas` times (seeds options.seed, +1, ...) as one batch; any
-/// error stops the comparison (the first in experiment and replica order is thrown). A progress
-/// step, labelled prefix + id, when the last replica of an experiment is known.
-std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, const std::vector<Experiment>& experiments,
-                                                const CalibrationOptions& options, int replicas, Progress* progress,
-                                                const std::string& prefix) {
+}  // namespace
+
+std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& model, const std::vector<Experiment>& experiments,
+                                                        const CalibrationOptions& options, int replicas, Progress* progress,
+                                                        const std::string& prefix) {
   replicas = std::max(1, replicas);
   std::vector<Job> jobs;
   for (const Experiment& e : experiments)
@@ -165,6 +146,8 @@ std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, cons
   }
   return runs;
 }
+
+namespace {
 
 /// The set-up number that varies most (relative) over the experiments of one test.
 std::map<std::string, std::string> varied_keys(const MeasurementSet& measured) {
@@ -546,12 +529,6 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
   return m;
 }
 
-std::string join(const std::vector<std::string>& words, const std::string& sep = ", ") {
-  std::string out;
-  for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
-  return out;
-}
-
 }  // namespace
 
 CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
@@ -823,243 +800,6 @@ ContourMap contour_map(const CalibrationResult& result, int px, int py, int grid
       map.chi2[iy][ix] = ((v - m).array() / sg.array()).square().sum();
     }
   return map;
-}
-
-// ---- diagnosis ----------------------------------------------------------------------------
-
-double bic(double chi2, int k, int n) { return chi2 + k * std::log(static_cast<double>(std::max(n, 1))); }
-
-namespace {
-
-/// Why an effect fits the residual pattern, in words.
-std::string physics_words(const std::string& effect) {
-  if (effect == "rolling_resistance") return "heaps and drum beds stand steeper than spheres allow while single contacts fit: resistance to rolling (particle shape, roughness)";
-  if (effect == "liquid_bridges") return "strength that does not come from the load (steeper heaps, looser packing, slower or blocked discharge, a yield locus offset by a constant): cohesion (liquid bridges)";
-  if (effect == "jkr_cohesion") return "strength that does not come from the load: cohesion (van der Waals, JKR adhesion)";
-  if (effect == "clump_shape") return "interlocking of non-spherical particles (steeper heaps, higher shear strength, looser packing)";
-  return "the effect's signature matches the residuals";
-}
-
-}  // namespace
-
-Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& options) {
-  Diagnosis d;
-  if (parameters.empty()) parameters = fit_parameters(model);
-  if (options.progress) options.progress("diagnose: calibrating the model as it is");
-  d.base = calibrate(model, measured, parameters, options);
-  const Comparison& base = d.base.after;
-  const int n = base.n;
-  d.base_bic = bic(base.chi2, static_cast<int>(parameters.size()), n);
-  const bool fits = base.chi2_per_n() <= options.fits_within_noise;
-
-  // Sigma of each term (measurement and simulation noise) and the residual vector.
-  const int nt = static_cast<int>(base.terms.size());
-  Eigen::VectorXd r(nt), sig(nt);
-  for (int i = 0; i < nt; ++i) {
-    const Term& t = base.terms[i];
-    r[i] = t.residual;
-    sig[i] = t.is_outcome() ? 1.0 / options.outcome_residual : std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
-  }
-  // What the fitted parameters can already do (surrogate Jacobian, in sigma units), to take out of each signature.
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nt, static_cast<Eigen::Index>(parameters.size()));
-  {
-    Eigen::VectorXd x(parameters.size());
-    for (size_t i = 0; i < parameters.size(); ++i) x[static_cast<Eigen::Index>(i)] = d.base.value[i];
-    const Eigen::MatrixXd J = d.base.surrogate.jacobian(x);
-    for (int i = 0; i < nt; ++i) {
-      const auto it = std::find(d.base.surrogate.terms.begin(), d.base.surrogate.terms.end(), base.terms[i].name());
-      if (it != d.base.surrogate.terms.end()) A.row(i) = J.row(it - d.base.surrogate.terms.begin()) * 0.5 / sig[i];
-    }
-    for (size_t j = 0; j < parameters.size(); ++j) A.col(static_cast<Eigen::Index>(j)) *= (parameters[j].max - parameters[j].min);
-  }
-  // The candidates: every effect the model lacks, or those options.effects names.
-  std::vector<EffectCandidate> effects;
-  for (EffectCandidate& c : missing_effects(d.base.fitted))
-    if (options.effects.empty() || std::find(options.effects.begin(), options.effects.end(), c.name) != options.effects.end())
-      effects.push_back(std::move(c));
-  // The signature run of each candidate is the candidate model at its start: it serves as the
-  // "before" of its confirmation (same packing seed, the base's simulation noise).
-  std::map<std::string, Comparison> at_start;
-  Progress progress{options, "signature", static_cast<int>(effects.size() * measured.experiments.size())};
-  for (const EffectCandidate& c : effects) {
-    CandidateResult cr;
-    cr.name = c.name, cr.description = c.description;
-    for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
-    cr.k = static_cast<int>(parameters.size() + cr.adds.size());
-    MaterialModel with = d.base.fitted;
-    c.add(with);
-    for (const auto& [key, v] : c.start) set_parameter(with, key, v);
-    // Signature: the change of every term, one replica each, same packing seed as the base run's first replica.
-    const std::vector<ExperimentRun> runs = simulate_experiments(with, measured.experiments, options, 1, &progress, c.name + " ");
-    std::map<std::string, double> floor;
-    for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
-    const Comparison& changed = at_start[c.name] = compare_runs(measured, runs, options, floor);
-    Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
-    for (int i = 0; i < nt; ++i) {
-      const Term& t = base.terms[i];
-      for (const Term& u : changed.terms)
-        if (u.name() == t.name()) s[i] = (u.simulated - t.simulated) / sig[i];
-      cr.signature.push_back(s[i]);
-    }
-    // Remove what the existing parameters can do, then project the residual on what is left.
-    Eigen::VectorXd s_perp = s;
-    if (A.cols() > 0 && A.norm() > 0) s_perp = s - A * A.completeOrthogonalDecomposition().solve(s);
-    const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
-    if (ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0) {
-      const double alpha = -s_perp.dot(r) / ss;  // multiple of the added strength that best cancels r
-      cr.explained = alpha > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
-    }
-    d.candidates.push_back(std::move(cr));
-  }
-  std::sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
-
-  if (fits) {
-    d.words.push_back(fmt::format("No effect recommended: the model as it is fits within the noise after calibration (chi^2/n = {:.2f} <= {:.2g}).",
-                                  base.chi2_per_n(), options.fits_within_noise));
-  } else {
-    // Confirm the leading candidates by adding each and recalibrating.
-    // The signature is a linear screen from one step to the effect's start values; a strong,
-    // nonlinear effect (cohesion at a start far from the truth) can overshoot and show little
-    // projection. When no candidate passes the screen although the model misfits, the leading
-    // ones are confirmed anyway: recalibration, not the screen, decides.
-    const bool screen_silent = std::none_of(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
-    int confirmed = 0;
-    for (CandidateResult& cr : d.candidates) {
-      if (confirmed >= options.confirm_candidates || (cr.explained < 0.05 && !screen_silent)) break;
-      const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
-      MaterialModel with = d.base.fitted;
-      it->add(with);
-      for (const auto& [key, v] : it->start) set_parameter(with, key, v);
-      std::vector<FitParameter> params = parameters;
-      params.insert(params.end(), cr.adds.begin(), cr.adds.end());
-      if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
-      cr.fit = calibrate(with, measured, params, options, &at_start.at(cr.name));
-      cr.confirmed = true;
-      cr.chi2 = cr.fit.after.chi2;
-      cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);
-      cr.delta_bic = d.base_bic - cr.bic;
-      ++confirmed;
-    }
-    std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) {
-      if (a.confirmed != b.confirmed) return a.confirmed;
-      return a.confirmed ? a.bic < b.bic : a.explained > b.explained;
-    });
-    const CandidateResult* best = d.candidates.empty() || !d.candidates.front().confirmed ? nullptr : &d.candidates.front();
-    if (best && best->delta_bic > options.bic_margin) {
-      d.recommended = best->name;
-      // Which patterns the effect answers.
-      std::vector<std::string> misfits;
-      for (const Pattern& p : d.base.after.patterns)
-        if (p.kind != "fits") misfits.push_back(p.words);
-      d.words.push_back(fmt::format("Most likely missing: {}. {} It could explain {:.0f} % of the weighted residual of the calibrated model; "
-                                    "added and recalibrated, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} "
-                                    "(by {:.1f} > margin {:.0f}, with {} more parameter{}).",
-                                    best->name, "Why: " + physics_words(best->name) + ".", 100 * best->explained, base.chi2_per_n(),
-                                    best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
-                                    best->adds.size() == 1 ? "" : "s"));
-      if (!misfits.empty()) d.words.push_back("Where the model without it fails: " + join(misfits, " "));
-    } else {
-      d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}) but no candidate lowers BIC by more than {:.0f}{}.",
-                                    base.chi2_per_n(), options.bic_margin,
-                                    best ? fmt::format(" (best: {}, by {:.1f})", best->name, best->delta_bic) : ""));
-    }
-    if (screen_silent && !d.candidates.empty())
-      d.words.push_back("The signatures explained little of the misfit (they are a linear screen from one step to each effect's start "
-                        "values); the leading candidates were confirmed by recalibration anyway.");
-  }
-  for (CandidateResult& cr : d.candidates) {
-    cr.words = cr.confirmed ? fmt::format("{}: explains {:.0f} % of the residual; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).",
-                                          cr.name, 100 * cr.explained, cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
-                            : fmt::format("{}: explains {:.0f} % of the residual (signature only, not confirmed).", cr.name, 100 * cr.explained);
-  }
-  return d;
-}
-
-// ---- ledger -------------------------------------------------------------------------------
-
-std::vector<std::string> model_effects(const MaterialModel& model) {
-  std::vector<std::string> out;
-  for (const ContactSpec::Choice* c : {&model.contact.normal, &model.contact.damping, &model.contact.tangential, &model.contact.rolling, &model.contact.twisting})
-    if (c->model != "none") out.push_back(c->model);
-  for (const auto& c : model.contact.adhesion) out.push_back(c.model);
-  for (const auto& c : model.contact.extra) out.push_back(c.model);
-  if (!model.shape.empty()) out.push_back(fmt::format("clump (aspect {:.2f})", get_parameter(model, "clump_aspect_ratio")));
-  return out;
-}
-
-LedgerEntry ledger_entry(const MaterialModel& model, const Comparison& comparison, const std::string& label, const std::vector<std::string>& parameter_keys) {
-  LedgerEntry e;
-  e.label = label;
-  const std::time_t t = std::time(nullptr);
-  std::tm local{};
-  localtime_r(&t, &local);
-  char buffer[64];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S", &local);
-  e.time = buffer;
-  e.effects = model_effects(model);
-  for (const std::string& key : parameter_keys) e.parameters[key] = get_parameter(model, key);
-  for (const Term& term : comparison.terms) e.residuals[term.name()] = term.residual;
-  e.chi2 = comparison.chi2;
-  e.n = comparison.n;
-  return e;
-}
-
-std::vector<LedgerEntry> read_ledger(const std::string& path) {
-  std::vector<LedgerEntry> out;
-  if (!std::filesystem::exists(path)) return out;
-  try {
-    const YAML::Node root = YAML::LoadFile(path);
-    for (const YAML::Node& v : root["versions"]) {
-      LedgerEntry e;
-      e.version = v["version"].as<int>();
-      e.label = v["label"].as<std::string>("");
-      e.time = v["time"].as<std::string>("");
-      if (v["effects"])
-        for (const auto& x : v["effects"]) e.effects.push_back(x.as<std::string>());
-      if (v["parameters"])
-        for (const auto& kv : v["parameters"]) e.parameters[kv.first.as<std::string>()] = kv.second.as<double>();
-      if (v["residuals"])
-        for (const auto& kv : v["residuals"]) e.residuals[kv.first.as<std::string>()] = kv.second.as<double>();
-      e.chi2 = v["chi2"].as<double>(0);
-      e.n = v["n"].as<int>(0);
-      out.push_back(std::move(e));
-    }
-  } catch (const YAML::Exception& error) {
-    throw CaseError(fmt::format("{}:{}:{}: the error ledger cannot be read: {}", path, error.mark.line + 1, error.mark.column + 1, error.msg));
-  }
-  return out;
-}
-
-std::vector<LedgerEntry> append_ledger(const std::string& path, const std::string& material, std::vector<LedgerEntry> entries) {
-  std::vector<LedgerEntry> all = read_ledger(path);
-  int next = all.empty() ? 1 : all.back().version + 1;
-  for (LedgerEntry& e : entries) e.version = next++, all.push_back(std::move(e));
-  YAML::Emitter out;
-  out << YAML::Comment("Error ledger: every model version of this material with its normalised residual on every observation "
-                       "(simulated - measured, in sigma) and chi^2/n. Appended by demdesign calibrate and diagnose.");
-  out << YAML::BeginMap << YAML::Key << "material" << YAML::Value << material << YAML::Key << "versions" << YAML::Value << YAML::BeginSeq;
-  for (const LedgerEntry& e : all) {
-    out << YAML::BeginMap;
-    out << YAML::Key << "version" << YAML::Value << e.version;
-    out << YAML::Key << "label" << YAML::Value << e.label;
-    out << YAML::Key << "time" << YAML::Value << e.time;
-    out << YAML::Key << "effects" << YAML::Value << YAML::Flow << e.effects;
-    out << YAML::Key << "parameters" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    for (const auto& [k, v] : e.parameters) out << YAML::Key << k << YAML::Value << v;
-    out << YAML::EndMap;
-    out << YAML::Key << "chi2" << YAML::Value << e.chi2 << YAML::Key << "n" << YAML::Value << e.n;
-    out << YAML::Key << "chi2_per_n" << YAML::Value << e.chi2_per_n();
-    out << YAML::Key << "residuals" << YAML::Value << YAML::BeginMap;
-    for (const auto& [k, v] : e.residuals) out << YAML::Key << k << YAML::Value << v;
-    out << YAML::EndMap << YAML::EndMap;
-  }
-  out << YAML::EndSeq << YAML::EndMap;
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(fmt::format("{}: cannot write the error ledger", path));
-  file << out.c_str() << "\n";
-  return all;
 }
 
 }  // namespace dem::materials
