@@ -12,11 +12,7 @@ S1=${3:-20000}
 if [ "$N" = 20000 ]; then L=0.125; S2=${4:-4000}; else L=0.25; S2=${4:-1000}; fi
 BUILD=${BUILD:-build}
 HERE=$(cd "$(dirname "$0")" && pwd)
-if ! command -v liggghts >/dev/null 2>&1; then
-  echo "installing the Debian package liggghts"
-  sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
-  $sudo_cmd apt-get install -y -q liggghts openmpi-bin time >/dev/null
-fi
+. "$HERE/liggghts/ensure_installed.sh"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 "$BUILD/bench/bench_b1_settle" --n "$N" --liggghts-data "$WORK/lattice.data"

@@ -15,11 +15,7 @@ FILL=${2:-30000}
 RUN=${3:-3000}
 BUILD=${BUILD:-build}
 HERE=$(cd "$(dirname "$0")" && pwd)
-if ! command -v liggghts >/dev/null 2>&1; then
-  echo "installing the Debian package liggghts"
-  sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
-  $sudo_cmd apt-get install -y -q liggghts openmpi-bin time >/dev/null
-fi
+. "$HERE/liggghts/ensure_installed.sh"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 "$BUILD/bench/bench_b2_chute" --write-stl "$WORK/chute.stl"
