@@ -193,14 +193,3 @@ TEST(CampaignMpi, BadInputStopsEveryRankWithTheSerialError) {
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  mpi::Session session(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  // Every rank runs every test (the collectives need them all) and prints its results.
-  const int failed = RUN_ALL_TESTS();
-  // A failure on any rank fails the run.
-  int any = 0;
-  for (const std::string& bytes : mpi::all_gather(std::to_string(failed))) any = any || std::stoi(bytes) != 0;
-  return any;
-}

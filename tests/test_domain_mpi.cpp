@@ -234,12 +234,3 @@ TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
 }
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  mpi::Session session(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  for (const std::string& bytes : mpi::all_gather(std::to_string(failed))) any = any || std::stoi(bytes) != 0;
-  return any;
-}
