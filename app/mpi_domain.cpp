@@ -46,19 +46,21 @@ class MpiDomain final : public Domain {
   MpiDomain(const Model& model, const State& initial) : local_(model) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
-    for (size_t p = 0; p < initial.size(); ++p) {
-      if (initial.body[p] >= 0 || initial.attached[p] >= 0)
-        throw CaseError(fmt::format("{}: the split into subdomains takes free spheres only, and this case has clumps or "
-                                    "spheres glued to walls",
-                                    model.source));
-    }
+    if (model.has_attached)
+      throw CaseError(fmt::format("{}: the split into subdomains does not take spheres glued to walls (a shear cell)", model.source));
+    // A clump belongs to the rank of its centre; its spheres reach `sticking_out_` beyond it,
+    // so the ghost layer and the slabs are that much deeper.
+    for (size_t p = 0; p < initial.size(); ++p)
+      if (initial.body[p] >= 0)
+        sticking_out_ = std::max(sticking_out_, std::sqrt(initial.offset_x[p] * initial.offset_x[p] + initial.offset_y[p] * initial.offset_y[p] +
+                                                          initial.offset_z[p] * initial.offset_z[p]));
     for (const Inlet& inlet : model.inlets)
       if (inlet.clump >= 0)
-        throw CaseError(fmt::format("{}: inlet {} makes clumps, and the split into subdomains takes free spheres only",
-                                    model.source, inlet.spec.name));
+        sticking_out_ = std::max(sticking_out_, model.clumps[inlet.clump].bounding_radius * inlet.spec.diameter.largest());
     double radius_max = model.radius_max;
     for (double r : initial.radius) radius_max = std::max(radius_max, r);
-    reach_ = 2.0 * radius_max + model.interaction_range + model.skin;
+    reach_ = 2.0 * radius_max + model.interaction_range + model.skin + sticking_out_;
+    slab_min_ = reach_ + sticking_out_;
     // The axis on which the particles (and the domain box) spread furthest.
     double extent[3] = {0, 0, 0};
     for (int a = 0; a < 3; ++a) {
@@ -78,16 +80,16 @@ class MpiDomain final : public Domain {
     period_ = model.period[axis_];
     low_ = model.domain_min[axis_];
     if (periodic_) local_.period[axis_] = 0.0;  // the ranks carry the period across their faces
-    const double needed = (periodic_ ? size_ : std::max(size_ - 2, 0)) * reach_;
+    const double needed = (periodic_ ? size_ : std::max(size_ - 2, 0)) * slab_min_;
     if (extent[axis_] < needed)
       throw CaseError(fmt::format("{}: {} ranks need a domain at least {:.4g} m long along {} (each slab one pair reach, {:.4g} m, "
                                   "wide); it is {:.4g} m, so fewer ranks would split it",
-                                  model.source, size_, needed, "xyz"[axis_], reach_, extent[axis_]));
+                                  model.source, size_, needed, "xyz"[axis_], slab_min_, extent[axis_]));
     down_ = rank_ > 0 ? rank_ - 1 : periodic_ ? size_ - 1 : MPI_PROC_NULL;
     up_ = rank_ < size_ - 1 ? rank_ + 1 : periodic_ ? 0 : MPI_PROC_NULL;
     // First cuts from the initial particles (the same on every rank), or evenly over the box.
-    std::vector<double> coords = column(initial, axis_);
-    for (double& c : coords) c = wrapped(c);
+    std::vector<double> coords;
+    for (size_t p = 0; p < initial.size(); ++p) coords.push_back(wrapped(owner_coordinate(initial, p)));
     std::sort(coords.begin(), coords.end());
     cuts_.assign(size_ - 1, 0.0);
     double lo = periodic_ ? low_ : model.has_domain ? model.domain_min[axis_] : coords.empty() ? 0.0 : coords.front();
@@ -142,73 +144,98 @@ class MpiDomain final : public Domain {
     append(pairs, pending_pairs_, model.history_width);
     append(walls, pending_walls_, model.history_width);
     pending_pairs_ = {}, pending_walls_ = {};
+    wrap_slab_axis(s);
     rebalance(s);
     const int width = model.history_width;
-    const size_t n = s.size();
-    std::vector<double>& axis_column = column(s, axis_);
-    std::unordered_map<std::int64_t, int> leaving;  // id -> new owner
+    const size_t n = s.size(), record = s.record_size();
+    // Where each body goes (-1: stays), then free spheres and bodies with their spheres.
+    std::vector<int> body_to(s.bodies.size(), -1);
+    const std::vector<double>& centre = body_column(s, axis_);
+    for (size_t b = 0; b < s.bodies.size(); ++b)
+      if (owner(centre[b]) != rank_) body_to[b] = owner(centre[b]);
+    std::unordered_map<std::int64_t, int> leaving;  // sphere id -> new owner
     std::vector<std::uint8_t> keep(n, 1);
-    std::vector<std::vector<double>> records(size_);
-    std::vector<int> particles_to(size_, 0), pair_rows_to(size_, 0), wall_rows_to(size_, 0);
+    std::vector<std::vector<double>> spheres(size_), clumps(size_);
+    std::vector<int> spheres_to(size_, 0), bodies_to(size_, 0), pair_rows_to(size_, 0), wall_rows_to(size_, 0);
+    std::vector<std::vector<std::int32_t>> members(s.bodies.size());
     for (size_t p = 0; p < n; ++p) {
-      axis_column[p] = wrapped(axis_column[p]);
-      const int to = owner(axis_column[p]);
-      if (to == rank_) continue;
+      const std::int32_t b = s.body[p];
+      const int to = b >= 0 ? body_to[b] : owner(column(s, axis_)[p]);
+      if (to < 0 || to == rank_) continue;
       keep[p] = 0;
       leaving[s.id[p]] = to;
-      s.pack(p, records[to]);
-      ++particles_to[to];
+      if (b >= 0) {
+        members[b].push_back(static_cast<std::int32_t>(p));
+      } else {
+        s.pack(p, spheres[to]);
+        ++spheres_to[to];
+      }
     }
-    // Every history of a leaving particle goes with it (the new owner lists the pairs it now
+    for (size_t b = 0; b < s.bodies.size(); ++b) {
+      const int to = body_to[b];
+      if (to < 0) continue;
+      s.pack_body(b, clumps[to]);
+      clumps[to].push_back(static_cast<double>(members[b].size()));
+      for (const std::int32_t p : members[b]) s.pack(p, clumps[to]);
+      ++bodies_to[to];
+    }
+    // Every history of a leaving sphere goes with it (the new owner lists the pairs it now
     // evaluates and ignores the rest).
-    std::vector<std::vector<double>> histories(size_);
-    auto add_rows = [&](const HistoryRows& rows, bool wall_rows, std::vector<int>& count) {
-      for (size_t q = 0; q < rows.size(); ++q) {
+    std::vector<std::vector<double>> pair_rows(size_), wall_rows(size_);
+    auto add_rows = [&](const HistoryRows& rows, bool wall_rows_only_a, std::vector<std::vector<double>>& out, std::vector<int>& count) {
+      for (size_t q = 0; q < rows.size() && width > 0; ++q) {
         auto it = leaving.find(rows.a[q]);
-        if (it == leaving.end() && !wall_rows) it = leaving.find(rows.b[q]);
+        if (it == leaving.end() && !wall_rows_only_a) it = leaving.find(rows.b[q]);
         if (it == leaving.end()) continue;
-        std::vector<double>& out = histories[it->second];
-        out.push_back(static_cast<double>(rows.a[q]));
-        out.push_back(static_cast<double>(rows.b[q]));
-        out.insert(out.end(), rows.rows.begin() + static_cast<std::ptrdiff_t>(q * width),
-                   rows.rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
+        std::vector<double>& to = out[it->second];
+        to.push_back(static_cast<double>(rows.a[q]));
+        to.push_back(static_cast<double>(rows.b[q]));
+        to.insert(to.end(), rows.rows.begin() + static_cast<std::ptrdiff_t>(q * width), rows.rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
         ++count[it->second];
       }
     };
-    if (!leaving.empty() && width > 0) {
-      add_rows(pairs, false, pair_rows_to);
-      std::vector<std::vector<double>> pair_part(size_);
-      pair_part.swap(histories);
-      add_rows(walls, true, wall_rows_to);
-      for (int r = 0; r < size_; ++r) {
-        records[r].insert(records[r].end(), pair_part[r].begin(), pair_part[r].end());
-        records[r].insert(records[r].end(), histories[r].begin(), histories[r].end());
-      }
+    if (!leaving.empty()) {
+      add_rows(pairs, false, pair_rows, pair_rows_to);
+      add_rows(walls, true, wall_rows, wall_rows_to);
     }
-    // Counts, then the doubles, all to all.
-    std::vector<int> counts_out(3 * size_), counts_in(3 * size_);
-    for (int r = 0; r < size_; ++r) counts_out[3 * r] = particles_to[r], counts_out[3 * r + 1] = pair_rows_to[r], counts_out[3 * r + 2] = wall_rows_to[r];
-    check(MPI_Alltoall(counts_out.data(), 3, MPI_INT, counts_in.data(), 3, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
-    std::vector<int> send_sizes(size_), receive_sizes(size_);
-    const int record = static_cast<int>(s.record_size()), row = 2 + width;
-    for (int r = 0; r < size_; ++r) {
-      send_sizes[r] = static_cast<int>(records[r].size());
-      receive_sizes[r] = counts_in[3 * r] * record + (counts_in[3 * r + 1] + counts_in[3 * r + 2]) * row;
-    }
+    // Counts, then the doubles, all to all. Per destination: free spheres, clumps (body, count,
+    // spheres), pair histories, wall histories.
+    constexpr int kCounts = 5;
+    std::vector<int> counts_out(kCounts * size_), counts_in(kCounts * size_);
     std::vector<double> send;
-    for (const auto& part : records) send.insert(send.end(), part.begin(), part.end());
+    std::vector<int> send_sizes(size_), receive_sizes(size_);
+    for (int r = 0; r < size_; ++r) {
+      const size_t before = send.size();
+      for (const auto* part : {&spheres[r], &clumps[r], &pair_rows[r], &wall_rows[r]}) send.insert(send.end(), part->begin(), part->end());
+      send_sizes[r] = static_cast<int>(send.size() - before);
+      const int mine[kCounts] = {spheres_to[r], bodies_to[r], pair_rows_to[r], wall_rows_to[r], send_sizes[r]};
+      std::copy(mine, mine + kCounts, counts_out.begin() + kCounts * r);
+    }
+    check(MPI_Alltoall(counts_out.data(), kCounts, MPI_INT, counts_in.data(), kCounts, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
+    for (int r = 0; r < size_; ++r) receive_sizes[r] = counts_in[kCounts * r + 4];
     const std::vector<int> send_at = offsets_of(send_sizes), receive_at = offsets_of(receive_sizes);
     std::vector<double> received(static_cast<size_t>(receive_at.back()));
     check(MPI_Alltoallv(send.data(), send_sizes.data(), send_at.data(), MPI_DOUBLE, received.data(), receive_sizes.data(),
                         receive_at.data(), MPI_DOUBLE, MPI_COMM_WORLD),
           "MPI_Alltoallv");
-    s.compact(keep);
+    s.compact(keep);  // also drops the bodies that left with all their spheres
+    const size_t row = 2 + static_cast<size_t>(width);
     for (int r = 0; r < size_; ++r) {
       const double* in = received.data() + receive_at[r];
-      for (int k = 0; k < counts_in[3 * r]; ++k, in += record) s.unpack(in);
-      for (int k = 0; k < counts_in[3 * r + 1]; ++k, in += row)
+      const int* count = counts_in.data() + kCounts * r;
+      for (int k = 0; k < count[0]; ++k, in += record) s.unpack(in);
+      for (int k = 0; k < count[1]; ++k) {
+        const std::int32_t b = static_cast<std::int32_t>(s.unpack_body(in));
+        in += State::kBodyRecord;
+        const int spheres_in_body = static_cast<int>(*in++);
+        for (int q = 0; q < spheres_in_body; ++q, in += record) {
+          s.unpack(in);
+          s.body.back() = b;
+        }
+      }
+      for (int k = 0; k < count[2]; ++k, in += row)
         pairs.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
-      for (int k = 0; k < counts_in[3 * r + 2]; ++k, in += row)
+      for (int k = 0; k < count[3]; ++k, in += row)
         walls.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
     }
     migrated_ += static_cast<std::int64_t>(leaving.size());
@@ -240,7 +267,10 @@ class MpiDomain final : public Domain {
     check(MPI_Sendrecv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, down_, 2, in.data(), static_cast<int>(in.size()),
                        MPI_DOUBLE, up_, 2, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
           "MPI_Sendrecv");
-    for (int k = 0; k < incoming; ++k) s.unpack(in.data() + static_cast<size_t>(k) * record);
+    for (int k = 0; k < incoming; ++k) {
+      s.unpack(in.data() + static_cast<size_t>(k) * record);
+      s.body.back() = -1, s.attached.back() = -1;  // a copy: its body, if any, lives on its owner
+    }
     s.ghosts = static_cast<size_t>(incoming);
     ++rebuilds_;
     ghosts_ += incoming;
@@ -295,11 +325,8 @@ class MpiDomain final : public Domain {
   void distribute(State& s) override {
     const int width = local_.history_width;
     std::vector<std::uint8_t> keep(s.size(), 0);
-    std::vector<double>& axis_column = column(s, axis_);
-    for (size_t p = 0; p < s.size(); ++p) {
-      axis_column[p] = wrapped(axis_column[p]);
-      keep[p] = owner(axis_column[p]) == rank_;
-    }
+    wrap_slab_axis(s);
+    for (size_t p = 0; p < s.size(); ++p) keep[p] = owner(owner_coordinate(s, p)) == rank_;
     // Histories of a checkpoint: kept (by ids) for the first rebuild, where a pair with a
     // particle of another rank finds its partner among the ghosts.
     for (size_t k = 0; k < s.pairs.size() && width > 0; ++k)
@@ -336,11 +363,12 @@ class MpiDomain final : public Domain {
       if (std::any_of(row, row + width, [](double v) { return v != 0.0; })) walls.add(s.id[s.wall_pairs.i[k]], s.wall_pairs.j[k], row, width);
     }
     mine.insert(mine.end(), {static_cast<double>(owned), static_cast<double>(pairs.size()), static_cast<double>(walls.size()),
-                             static_cast<double>(s.lost), s.lost_mass});
+                             static_cast<double>(s.lost), s.lost_mass, static_cast<double>(s.bodies.size())});
     for (const OutletState& o : s.outlets) mine.insert(mine.end(), {o.removed_mass, static_cast<double>(o.removed)});
     for (const TriangleRecords& r : s.records)
       for (const auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy})
         mine.insert(mine.end(), c->begin(), c->end());
+    for (size_t b = 0; b < s.bodies.size(); ++b) s.pack_body(b, mine);
     for (size_t p = 0; p < owned; ++p) s.pack(p, mine);
     for (const HistoryRows* rows : {&pairs, &walls})
       for (size_t q = 0; q < rows->size(); ++q) {
@@ -367,12 +395,18 @@ class MpiDomain final : public Domain {
       const double* in = part.data();
       const size_t particles = static_cast<size_t>(in[0]), pair_rows = static_cast<size_t>(in[1]), wall_rows = static_cast<size_t>(in[2]);
       whole.lost += static_cast<std::int64_t>(in[3]), whole.lost_mass += in[4];
-      in += 5;
+      const size_t bodies = static_cast<size_t>(in[5]);
+      in += 6;
       for (OutletState& o : whole.outlets) o.removed_mass += in[0], o.removed += static_cast<std::int64_t>(in[1]), in += 2;
       for (TriangleRecords& r : whole.records)
         for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy})
           for (double& v : *c) v += *in++;
-      for (size_t k = 0; k < particles; ++k, in += record) whole.unpack(in);
+      const std::int32_t first_body = static_cast<std::int32_t>(whole.bodies.size());
+      for (size_t k = 0; k < bodies; ++k, in += State::kBodyRecord) whole.unpack_body(in);
+      for (size_t k = 0; k < particles; ++k, in += record) {
+        whole.unpack(in);
+        if (whole.body.back() >= 0) whole.body.back() += first_body;
+      }
       for (size_t k = 0; k < pair_rows; ++k, in += 2 + width)
         all_pairs.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
       for (size_t k = 0; k < wall_rows; ++k, in += 2 + width)
@@ -417,6 +451,22 @@ class MpiDomain final : public Domain {
   static std::vector<double>& column(State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
   static const std::vector<double>& column(const State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
 
+  static std::vector<double>& body_column(State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
+  static const std::vector<double>& body_column(const State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
+  /// Where a sphere belongs along the slab axis: its own centre, or its clump's.
+  double owner_coordinate(const State& s, size_t p) const {
+    return s.body[p] >= 0 ? body_column(s, axis_)[s.body[p]] : column(s, axis_)[p];
+  }
+  /// Free spheres and clump centres back into the period along a periodic slab axis (a clump's
+  /// spheres move with its centre).
+  void wrap_slab_axis(State& s) const {
+    if (!periodic_) return;
+    std::vector<double>& c = column(s, axis_);
+    std::vector<double>& centre = body_column(s, axis_);
+    std::vector<double> shift(centre.size());
+    for (size_t b = 0; b < centre.size(); ++b) shift[b] = wrapped(centre[b]) - centre[b], centre[b] += shift[b];
+    for (size_t p = 0; p < s.size(); ++p) c[p] = s.body[p] >= 0 ? c[p] + shift[s.body[p]] : wrapped(c[p]);
+  }
   double wrapped(double c) const { return periodic_ ? c - period_ * std::floor((c - low_) / period_) : c; }
   int owner(double c) const {
     return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), wrapped(c)) - cuts_.begin());
@@ -427,20 +477,19 @@ class MpiDomain final : public Domain {
   void keep_slabs_wide() {
     const int cuts = static_cast<int>(cuts_.size());
     if (cuts == 0) return;
-    if (periodic_) cuts_[0] = std::max(cuts_[0], low_ + reach_);
-    for (int k = 1; k < cuts; ++k) cuts_[k] = std::max(cuts_[k], cuts_[k - 1] + reach_);
-    if (periodic_) cuts_[cuts - 1] = std::min(cuts_[cuts - 1], low_ + period_ - reach_);
-    for (int k = cuts - 2; k >= 0; --k) cuts_[k] = std::min(cuts_[k], cuts_[k + 1] - reach_);
+    if (periodic_) cuts_[0] = std::max(cuts_[0], low_ + slab_min_);
+    for (int k = 1; k < cuts; ++k) cuts_[k] = std::max(cuts_[k], cuts_[k - 1] + slab_min_);
+    if (periodic_) cuts_[cuts - 1] = std::min(cuts_[cuts - 1], low_ + period_ - slab_min_);
+    for (int k = cuts - 2; k >= 0; --k) cuts_[k] = std::min(cuts_[k], cuts_[k + 1] - slab_min_);
   }
 
   /// New cuts at the quantiles of the particle count when the fullest rank holds more than
   /// kImbalance times the mean (collective).
   void rebalance(const State& s) {
-    const std::vector<double>& c = column(s, axis_);
     const size_t n = s.size();
     double stats[3] = {static_cast<double>(n), kInfinity, kInfinity};  // count, -min, max
     double lo = kInfinity, hi = -kInfinity;
-    for (size_t p = 0; p < n; ++p) lo = std::min(lo, wrapped(c[p])), hi = std::max(hi, wrapped(c[p]));
+    for (size_t p = 0; p < n; ++p) lo = std::min(lo, wrapped(owner_coordinate(s, p))), hi = std::max(hi, wrapped(owner_coordinate(s, p)));
     stats[1] = -lo, stats[2] = hi;
     double most[3];
     check(MPI_Allreduce(stats, most, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
@@ -451,7 +500,7 @@ class MpiDomain final : public Domain {
     if (!(hi > lo)) return;
     std::vector<double> histogram(kHistogramBins, 0.0), all(kHistogramBins);
     const double width = (hi - lo) / kHistogramBins;
-    for (size_t p = 0; p < n; ++p) histogram[std::clamp(static_cast<int>((wrapped(c[p]) - lo) / width), 0, kHistogramBins - 1)] += 1;
+    for (size_t p = 0; p < n; ++p) histogram[std::clamp(static_cast<int>((wrapped(owner_coordinate(s, p)) - lo) / width), 0, kHistogramBins - 1)] += 1;
     check(MPI_Allreduce(histogram.data(), all.data(), kHistogramBins, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
     double below = 0;
     int bin = 0;
@@ -499,7 +548,9 @@ class MpiDomain final : public Domain {
   int axis_ = 0;
   bool periodic_ = false;
   double period_ = 0, low_ = 0;  // [m] along the slab axis
-  double reach_ = 0;             // [m] ghost layer depth: a pair's largest listing distance
+  double reach_ = 0;             // [m] ghost layer depth: a pair's largest listing distance (+ sticking_out_)
+  double sticking_out_ = 0;      // [m] how far a clump's sphere centre lies from the clump's centre
+  double slab_min_ = 0;          // [m] narrowest slab: reach_ + sticking_out_
   std::vector<double> cuts_;     // [m] between slab r and r + 1
   int down_ = -1, up_ = -1;      // neighbour ranks (MPI_PROC_NULL: none)
   std::vector<std::int32_t> send_slots_;  ///< owned slots sent down as ghosts, in message order

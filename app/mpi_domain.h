@@ -14,8 +14,10 @@
 // ghost records, one histogram sum for the balance. Meshes are held whole by every rank (their
 // triangles are shared, read-only); wear records and loads are summed when results are written.
 //
-// Not decomposed: clumps and spheres glued to walls (such a case runs on rank 0 alone). Rank 0
-// gathers the whole state for every row of scalars, frame and checkpoint.
+// Clumps belong to the rank of their centre and move with all their spheres; the ghost layer and
+// the narrowest slab are deeper by how far a clump's spheres stick out. Not decomposed: spheres
+// glued to walls (a shear cell; such a case runs on rank 0 alone). Rank 0 gathers the whole
+// state for every row of scalars, frame and checkpoint.
 #pragma once
 
 #include <memory>

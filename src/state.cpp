@@ -120,6 +120,23 @@ void State::unpack(const double* in) {
   mc.history.insert(mc.history.end(), in, in + MeshContacts::kSlots * mesh_history_width);
 }
 
+void State::pack_body(std::size_t k, std::vector<double>& out) const {
+  const Bodies& b = bodies;
+  for (const auto* c : {&b.x, &b.y, &b.z, &b.vx, &b.vy, &b.vz, &b.qw, &b.qx, &b.qy, &b.qz, &b.lx, &b.ly, &b.lz, &b.fx, &b.fy, &b.fz,
+                        &b.tx, &b.ty, &b.tz, &b.mass, &b.ix, &b.iy, &b.iz})
+    out.push_back((*c)[k]);
+  out.push_back(static_cast<double>(b.id[k]));
+}
+
+std::size_t State::unpack_body(const double* in) {
+  Bodies& b = bodies;
+  for (auto* c : {&b.x, &b.y, &b.z, &b.vx, &b.vy, &b.vz, &b.qw, &b.qx, &b.qy, &b.qz, &b.lx, &b.ly, &b.lz, &b.fx, &b.fy, &b.fz, &b.tx,
+                  &b.ty, &b.tz, &b.mass, &b.ix, &b.iy, &b.iz})
+    c->push_back(*in++);
+  b.id.push_back(static_cast<std::int64_t>(*in));
+  return b.size() - 1;
+}
+
 void State::permute(const std::vector<std::int32_t>& order) {
   std::vector<double> scratch;
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})

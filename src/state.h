@@ -160,6 +160,11 @@ struct State {
   std::size_t record_size() const;
   void pack(std::size_t slot, std::vector<double>& out) const;
   void unpack(const double* in);
+  /// The same for a clump body (its spheres are packed one by one); unpack_body appends it and
+  /// returns its index.
+  static constexpr std::size_t kBodyRecord = 24;
+  void pack_body(std::size_t body, std::vector<double>& out) const;
+  std::size_t unpack_body(const double* in);
 };
 
 }  // namespace dem

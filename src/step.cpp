@@ -99,7 +99,10 @@ void run_inlets_decomposed(const Model& model, State& state, Workspace& work) {
     const size_t before = state.size();
     if (run_inlet(model, state, k, &others) == 0) continue;
     std::vector<std::uint8_t> keep(state.size(), 1);
-    for (size_t p = before; p < state.size(); ++p) keep[p] = domain.owns(state.x[p], state.y[p], state.z[p]);
+    for (size_t p = before; p < state.size(); ++p) {
+      const std::int32_t b = state.body[p];  // a clump belongs where its centre is
+      keep[p] = b >= 0 ? domain.owns(state.bodies.x[b], state.bodies.y[b], state.bodies.z[b]) : domain.owns(state.x[p], state.y[p], state.z[p]);
+    }
     state.compact(keep);
   }
 }

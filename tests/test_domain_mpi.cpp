@@ -186,6 +186,43 @@ TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
   }(), 1e-9 * b.inserted_mass) << "mass is conserved";
 }
 
+TEST(DomainMpi, ClumpPourMatchesTheSingleRankRun) {
+  // The shipped clump pour: 300 three-sphere clumps fall into a box and settle. A clump belongs
+  // to the rank of its centre, its spheres are ghosts like any other, the forces on them go back
+  // to the clump; clumps that cross the cut move with all their spheres.
+  const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/clump_pour.yaml");
+  const Outcome whole = simulate(spec, false, 0.3);
+  const Outcome split = simulate(spec, true, 0.3);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  ASSERT_FALSE(split.note.empty());
+  ASSERT_EQ(split.whole.bodies.size(), whole.whole.bodies.size()) << "clumps";
+  ASSERT_EQ(split.whole.size(), whole.whole.size()) << "spheres";
+  double weight = 0, za = 0, zb = 0;
+  for (size_t b = 0; b < whole.whole.bodies.size(); ++b) weight += 9.81 * whole.whole.bodies.mass[b], za += whole.whole.bodies.z[b];
+  for (size_t b = 0; b < split.whole.bodies.size(); ++b) zb += split.whole.bodies.z[b];
+  za /= static_cast<double>(whole.whole.bodies.size()), zb /= static_cast<double>(split.whole.bodies.size());
+  // Every sphere of a clump where the clump puts it (the spheres came back to their clump).
+  double worst = 0;
+  for (size_t p = 0; p < split.whole.size(); ++p) {
+    const State& s = split.whole;
+    const std::int32_t b = s.body[p];
+    ASSERT_GE(b, 0);
+    const double r = std::sqrt(s.offset_x[p] * s.offset_x[p] + s.offset_y[p] * s.offset_y[p] + s.offset_z[p] * s.offset_z[p]);
+    const double d = std::sqrt(std::pow(s.x[p] - s.bodies.x[b], 2) + std::pow(s.y[p] - s.bodies.y[b], 2) + std::pow(s.z[p] - s.bodies.z[b], 2));
+    worst = std::max(worst, std::abs(d - r));
+  }
+  const Scalars& a = whole.rows.back();
+  const Scalars& b = split.rows.back();
+  std::printf("  floor %.5g / %.5g N (weight %.5g N), mean clump height %.5g / %.5g m, kinetic %.3g / %.3g J, contacts %zu / %zu\n",
+              a.wall_normal_force[0], b.wall_normal_force[0], weight, za, zb, a.kinetic_translation, b.kinetic_translation, a.contacts,
+              b.contacts);
+  EXPECT_LT(worst, 1e-12) << "a sphere left its clump";
+  EXPECT_NEAR(b.wall_normal_force[0], weight, 0.05 * weight) << "the floor carries the clumps";
+  EXPECT_NEAR(zb, za, 0.03 * za) << "mean height of the clumps";
+  EXPECT_NEAR(static_cast<double>(b.contacts), static_cast<double>(a.contacts), 0.05 * a.contacts) << "contacts";
+}
+
 TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
   // A small silo (triangle mesh, slide gate opening at 0.3 s): 2,500 beads, discharge for 0.6 s.
   // Mesh contacts (with their histories, per particle) migrate with the particles; the wall
