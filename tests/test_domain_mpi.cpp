@@ -186,6 +186,24 @@ TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
   }(), 1e-9 * b.inserted_mass) << "mass is conserved";
 }
 
+TEST(DomainMpi, ServoWallCompressionMatchesTheSingleRankRun) {
+  // The shipped periodic compression: 400 beads, periodic in x and y, a servo wall pressing at
+  // 5 kPa from above. The wall sees the sum of every rank's contacts with it (one allreduce a
+  // step), so it settles where the single run's does.
+  const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/periodic_compression.yaml");
+  const Outcome whole = simulate(spec, false, 0.35);
+  const Outcome split = simulate(spec, true, 0.35);
+  if (!root()) return;
+  std::printf("  %s\n", split.note.c_str());
+  ASSERT_FALSE(split.note.empty());
+  const double target = 5000.0 * 0.03 * 0.03;  // [N] stress x area
+  const double za = whole.whole.walls.pz[1], zb = split.whole.walls.pz[1];
+  const double fa = whole.rows.back().wall_normal_force[1], fb = split.rows.back().wall_normal_force[1];
+  std::printf("  servo wall at %.6g / %.6g m, its force %.4g / %.4g N (target %.4g N)\n", za, zb, fa, fb, target);
+  EXPECT_NEAR(fb, target, 0.05 * target) << "the servo holds the stress";
+  EXPECT_NEAR(zb, za, 0.01 * za) << "sample height";
+}
+
 TEST(DomainMpi, ClumpPourMatchesTheSingleRankRun) {
   // The shipped clump pour: 300 three-sphere clumps fall into a box and settle. A clump belongs
   // to the rank of its centre, its spheres are ghosts like any other, the forces on them go back
