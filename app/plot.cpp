@@ -131,8 +131,7 @@ bool draw_plot(const Plot& plot, const std::string& png_path, std::string* messa
     const fs::path png = fs::absolute(png_path);
     const fs::path folder = png.parent_path();
     fs::create_directories(folder);
-    const fs::path data = fs::path(png).replace_extension(".tsv"), script_path = fs::path(png).replace_extension(".gp"),
-                   log = fs::path(png).replace_extension(".log");
+    const fs::path data = fs::path(png).replace_extension(".tsv"), script_path = fs::path(png).replace_extension(".gp");
 
     // Data: one block per series (gnuplot `index k`), blocks separated by two blank lines.
     std::vector<const Series*> drawn;
@@ -152,23 +151,31 @@ bool draw_plot(const Plot& plot, const std::string& png_path, std::string* messa
       gp << script(plot, drawn, data.filename().string(), png.filename().string());
       if (!out || !gp) return fail(fmt::format("{}: cannot write the plot's data or script", folder.string()));
     }
-    fs::remove(png);
-
-    int spawn_error = 0;
-    const int status = run_gnuplot(folder, script_path, log, &spawn_error);
-    if (status < 0 || status == 127) fs::remove(log);
-    if (status < 0) return fail(spawn_error == ENOENT ? kNotFound : fmt::format("gnuplot could not start: {}", std::strerror(spawn_error)));
-    if (status == 127) return fail(kNotFound);
-    const std::string errors = read_all(log);
-    if (errors.empty()) fs::remove(log);
-    if (status != 0 || !fs::exists(png) || fs::file_size(png) == 0)
-      return fail(fmt::format("gnuplot failed on {} (exit status {}): {}", script_path.filename().string(), status,
-                              errors.substr(0, 600)));
-    if (message) message->clear();
-    return true;
+    return run_gnuplot_script(script_path.string(), png.string(), message);
   } catch (const std::exception& e) {
     return fail(fmt::format("plot {}: {}", png_path, e.what()));
   }
+}
+
+bool run_gnuplot_script(const std::string& script, const std::string& png_path, std::string* message) {
+  auto fail = [&](const std::string& why) {
+    if (message) *message = why;
+    return false;
+  };
+  const fs::path script_path = fs::absolute(script), png = fs::absolute(png_path);
+  const fs::path folder = script_path.parent_path(), log = fs::path(png).replace_extension(".log");
+  fs::remove(png);
+  int spawn_error = 0;
+  const int status = run_gnuplot(folder, script_path, log, &spawn_error);
+  if (status < 0 || status == 127) fs::remove(log);
+  if (status < 0) return fail(spawn_error == ENOENT ? kNotFound : fmt::format("gnuplot could not start: {}", std::strerror(spawn_error)));
+  if (status == 127) return fail(kNotFound);
+  const std::string errors = read_all(log);
+  if (errors.empty()) fs::remove(log);
+  if (status != 0 || !fs::exists(png) || fs::file_size(png) == 0)
+    return fail(fmt::format("gnuplot failed on {} (exit status {}): {}", script_path.filename().string(), status, errors.substr(0, 600)));
+  if (message) message->clear();
+  return true;
 }
 
 }  // namespace dem::plot

@@ -41,6 +41,11 @@ struct Plot {
 /// found: install gnuplot-nox for the plots", or gnuplot's own error output.
 bool draw_plot(const Plot& plot, const std::string& png_path, std::string* message);
 
+/// Runs gnuplot on the script `script_path` in the script's folder (no shell; gnuplot's errors go
+/// to a .log beside the PNG, removed when empty) and checks that it drew `png_path`. Returns false
+/// with a message as draw_plot does. For plot kinds that write their own script (plot_contour.h).
+bool run_gnuplot_script(const std::string& script_path, const std::string& png_path, std::string* message);
+
 /// `text` as a gnuplot single-quoted string literal (no escapes are interpreted inside; a quote
 /// is doubled; line breaks become spaces). Labels are also set `noenhanced`, so underscores in
 /// mesh names print as they are.

@@ -1,21 +1,12 @@
 #include "plot_contour.h"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "plot.h"
-
-extern char** environ;
 
 namespace dem::plot {
 
@@ -32,12 +23,9 @@ std::string terminal(int w, int h, const std::string& png) {
       w, h, w, h, gnuplot_string(png));
 }
 
-/// Writes NAME.gp and runs gnuplot in the PNG's folder (no shell).
+/// Writes NAME.gp beside the PNG and runs gnuplot on it (plot.h).
 bool run(const std::string& script, const std::string& png_path, std::string* message) {
-  const fs::path png(png_path);
-  const fs::path folder = png.parent_path().empty() ? fs::path(".") : png.parent_path();
-  const fs::path gp = fs::path(png).replace_extension(".gp");
-  const fs::path log = fs::path(png).replace_extension(".log");
+  const fs::path gp = fs::path(png_path).replace_extension(".gp");
   {
     std::ofstream out(gp);
     if (!out) {
@@ -46,32 +34,7 @@ bool run(const std::string& script, const std::string& png_path, std::string* me
     }
     out << script;
   }
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addchdir_np(&actions, folder.c_str());
-  std::string program = "gnuplot", argument = gp.filename().string();
-  char* argv[] = {program.data(), argument.data(), nullptr};
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) {
-    if (message) *message = error == ENOENT ? "gnuplot not found: install gnuplot-nox for the plots" : std::strerror(error);
-    return false;
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) break;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !fs::exists(png)) {
-    std::ifstream in(log);
-    std::stringstream text;
-    text << in.rdbuf();
-    if (message) *message = "gnuplot failed: " + text.str();
-    return false;
-  }
-  return true;
+  return run_gnuplot_script(gp.string(), png_path, message);
 }
 
 void write_grid(const std::string& path, const std::vector<double>& x, const std::vector<double>& y, const std::vector<std::vector<double>>& z,
