@@ -141,8 +141,7 @@ class MpiDomain final : public Domain {
 
   void migrate(const Model& model, State& s, HistoryRows& pairs, HistoryRows& walls) override {
     Timed timed{rebuild_seconds_};
-    append(pairs, pending_pairs_, model.history_width);
-    append(walls, pending_walls_, model.history_width);
+    pairs.append(pending_pairs_), walls.append(pending_walls_);
     pending_pairs_ = {}, pending_walls_ = {};
     wrap_slab_axis(s);
     rebalance(s);
@@ -187,10 +186,7 @@ class MpiDomain final : public Domain {
         auto it = leaving.find(rows.a[q]);
         if (it == leaving.end() && !wall_rows_only_a) it = leaving.find(rows.b[q]);
         if (it == leaving.end()) continue;
-        std::vector<double>& to = out[it->second];
-        to.push_back(static_cast<double>(rows.a[q]));
-        to.push_back(static_cast<double>(rows.b[q]));
-        to.insert(to.end(), rows.rows.begin() + static_cast<std::ptrdiff_t>(q * width), rows.rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
+        rows.pack(q, width, out[it->second]);
         ++count[it->second];
       }
     };
@@ -219,7 +215,6 @@ class MpiDomain final : public Domain {
                         receive_at.data(), MPI_DOUBLE, MPI_COMM_WORLD),
           "MPI_Alltoallv");
     s.compact(keep);  // also drops the bodies that left with all their spheres
-    const size_t row = 2 + static_cast<size_t>(width);
     for (int r = 0; r < size_; ++r) {
       const double* in = received.data() + receive_at[r];
       const int* count = counts_in.data() + kCounts * r;
@@ -233,10 +228,8 @@ class MpiDomain final : public Domain {
           s.body.back() = b;
         }
       }
-      for (int k = 0; k < count[2]; ++k, in += row)
-        pairs.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
-      for (int k = 0; k < count[3]; ++k, in += row)
-        walls.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
+      in = pairs.unpack(in, static_cast<size_t>(count[2]), width);
+      walls.unpack(in, static_cast<size_t>(count[3]), width);
     }
     migrated_ += static_cast<std::int64_t>(leaving.size());
     bytes_ += 8.0 * static_cast<double>(send.size());
@@ -353,15 +346,7 @@ class MpiDomain final : public Domain {
     std::vector<double> mine;
     // Header: particles, pair rows, wall rows, lost, lost mass, then per outlet mass and count.
     const size_t owned = s.owned();
-    HistoryRows pairs, walls;
-    for (size_t k = 0; k < s.pairs.size() && width > 0; ++k) {
-      const double* row = &s.pairs.history[k * width];
-      if (std::any_of(row, row + width, [](double v) { return v != 0.0; })) pairs.add(s.id[s.pairs.i[k]], s.id[s.pairs.j[k]], row, width);
-    }
-    for (size_t k = 0; k < s.wall_pairs.size() && width > 0; ++k) {
-      const double* row = &s.wall_pairs.history[k * width];
-      if (std::any_of(row, row + width, [](double v) { return v != 0.0; })) walls.add(s.id[s.wall_pairs.i[k]], s.wall_pairs.j[k], row, width);
-    }
+    const HistoryRows pairs = histories_by_id(s.pairs, s, width, false), walls = histories_by_id(s.wall_pairs, s, width, true);
     mine.insert(mine.end(), {static_cast<double>(owned), static_cast<double>(pairs.size()), static_cast<double>(walls.size()),
                              static_cast<double>(s.lost), s.lost_mass, static_cast<double>(s.bodies.size())});
     for (const OutletState& o : s.outlets) mine.insert(mine.end(), {o.removed_mass, static_cast<double>(o.removed)});
@@ -371,12 +356,7 @@ class MpiDomain final : public Domain {
     for (size_t b = 0; b < s.bodies.size(); ++b) s.pack_body(b, mine);
     for (size_t p = 0; p < owned; ++p) s.pack(p, mine);
     for (const HistoryRows* rows : {&pairs, &walls})
-      for (size_t q = 0; q < rows->size(); ++q) {
-        mine.push_back(static_cast<double>(rows->a[q]));
-        mine.push_back(static_cast<double>(rows->b[q]));
-        mine.insert(mine.end(), rows->rows.begin() + static_cast<std::ptrdiff_t>(q * width),
-                    rows->rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
-      }
+      for (size_t q = 0; q < rows->size(); ++q) rows->pack(q, width, mine);
     const std::vector<std::vector<double>> parts = gather_to_root(mine);
     State whole = s;
     whole.compact(std::vector<std::uint8_t>(s.size(), 0));
@@ -407,10 +387,8 @@ class MpiDomain final : public Domain {
         whole.unpack(in);
         if (whole.body.back() >= 0) whole.body.back() += first_body;
       }
-      for (size_t k = 0; k < pair_rows; ++k, in += 2 + width)
-        all_pairs.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
-      for (size_t k = 0; k < wall_rows; ++k, in += 2 + width)
-        all_walls.add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
+      in = all_pairs.unpack(in, pair_rows, width);
+      all_walls.unpack(in, wall_rows, width);
     }
     // The lists by slot, as the engine keeps them (rebuild_contacts carries them by id).
     std::unordered_map<std::int64_t, std::int32_t> slot_of;
@@ -512,12 +490,6 @@ class MpiDomain final : public Domain {
     }
     keep_slabs_wide();
     ++rebalances_;
-  }
-
-  static void append(HistoryRows& to, const HistoryRows& from, int) {
-    to.a.insert(to.a.end(), from.a.begin(), from.a.end());
-    to.b.insert(to.b.end(), from.b.begin(), from.b.end());
-    to.rows.insert(to.rows.end(), from.rows.begin(), from.rows.end());
   }
 
   std::vector<double> all_gather(const std::vector<double>& mine) {

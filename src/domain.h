@@ -25,6 +25,7 @@
 
 #include "model.h"
 #include "state.h"
+#include "workspace.h"
 
 namespace dem {
 
@@ -38,7 +39,25 @@ struct HistoryRows {
     a.push_back(id_a), b.push_back(id_b);
     rows.insert(rows.end(), row, row + width);
   }
+  void append(const HistoryRows& more) {
+    a.insert(a.end(), more.a.begin(), more.a.end());
+    b.insert(b.end(), more.b.begin(), more.b.end());
+    rows.insert(rows.end(), more.rows.begin(), more.rows.end());
+  }
+  /// Row q as doubles (a, b, history) at the end of `out`, for a message between ranks.
+  void pack(std::size_t q, int width, std::vector<double>& out) const {
+    out.push_back(static_cast<double>(a[q])), out.push_back(static_cast<double>(b[q]));
+    out.insert(out.end(), rows.begin() + static_cast<std::ptrdiff_t>(q * width), rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
+  }
+  /// Appends `count` packed rows from `in`; returns the position after them.
+  const double* unpack(const double* in, std::size_t count, int width) {
+    for (std::size_t k = 0; k < count; ++k, in += 2 + width) add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
+    return in;
+  }
 };
+
+/// The non-zero histories of a contact list keyed by particle ids (wall contacts: b is the wall).
+HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls);
 
 class Domain {
  public:
@@ -84,5 +103,14 @@ class Domain {
 
 /// Removes the ghost slots (they are rebuilt from their owners).
 void drop_ghosts(State& state);
+
+/// A whole state gathered on the root, made ready for results: `state` with its lists rebuilt
+/// and histories carried (frames, checkpoints), `evaluated` a copy with this instant's contact
+/// forces (scalars, wall loads), `work` the lists of both.
+struct WholeState {
+  State state, evaluated;
+  Workspace work;
+};
+WholeState ready_for_results(const Model& model, State gathered);
 
 }  // namespace dem

@@ -235,10 +235,10 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 #pragma omp barrier
     }
   }
-  if (s.ghosts > 0) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
+  if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
     Batch batch;
     batch.b.count = 0;
-    for (long i = 0; i < n; ++i) particle_contacts(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+    for (const std::int32_t i : work.ghost_owners) particle_contacts(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
     if (batch.b.count) flush(model, batch, s, work);
   }
 

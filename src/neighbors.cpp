@@ -21,18 +21,6 @@ bool row_is_zero(const double* row, int width) {
   return true;
 }
 
-/// Histories worth keeping (non-zero), keyed by the ids they belong to.
-HistoryRows collect(const ContactList& list, const State& state, int width, bool walls) {
-  HistoryRows out;
-  if (width == 0) return out;
-  for (size_t k = 0; k < list.size(); ++k) {
-    const double* row = &list.history[k * width];
-    if (row_is_zero(row, width)) continue;
-    out.add(state.id[list.i[k]], walls ? list.j[k] : state.id[list.j[k]], row, width);
-  }
-  return out;
-}
-
 /// Removes spheres that left the domain (along non-periodic axes) or entered an outlet, with
 /// the whole body they belong to, and counts them.
 void remove_lost(const Model& model, State& state) {
@@ -199,6 +187,17 @@ void ContactForces::resize(std::size_t n) {
   active.assign(n, 0);
 }
 
+HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls) {
+  HistoryRows out;
+  if (width == 0) return out;
+  for (size_t k = 0; k < list.size(); ++k) {
+    const double* row = &list.history[k * width];
+    if (row_is_zero(row, width)) continue;
+    out.add(state.id[list.i[k]], walls ? list.j[k] : state.id[list.j[k]], row, width);
+  }
+  return out;
+}
+
 void drop_ghosts(State& s) {
   if (s.ghosts == 0) return;
   std::vector<std::uint8_t> keep(s.size(), 0);
@@ -220,8 +219,11 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   // (pairs with ghosts are evaluated apart, forces.cpp).
   std::int32_t span = 0;
   const std::int32_t owned = static_cast<std::int32_t>(s.owned());
-  for (size_t k = 0; k < s.pairs.size(); ++k)
+  work.ghost_owners.clear();
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
     if (s.pairs.j[k] < owned) span = std::max(span, s.pairs.j[k] - s.pairs.i[k]);
+    else if (work.ghost_owners.empty() || work.ghost_owners.back() != s.pairs.i[k]) work.ghost_owners.push_back(s.pairs.i[k]);
+  }
   work.block = std::max<std::int32_t>(span + 1, 64);
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
@@ -270,8 +272,8 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bo
 
 void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const int width = model.history_width;
-  HistoryRows old_pairs = collect(s.pairs, s, width, false);
-  HistoryRows old_walls = collect(s.wall_pairs, s, width, true);
+  HistoryRows old_pairs = histories_by_id(s.pairs, s, width, false);
+  HistoryRows old_walls = histories_by_id(s.wall_pairs, s, width, true);
   Domain* domain = work.domain;
 
   drop_ghosts(s);

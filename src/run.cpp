@@ -17,9 +17,6 @@
 
 #include "checkpoint.h"
 #include "domain.h"
-#include "forces.h"
-#include "mesh_contacts.h"
-#include "neighbors.h"
 #include "results_hdf5.h"
 #include "step.h"
 
@@ -272,11 +269,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
 
   // The whole state for results: the state itself, or (domain) the root's gathered copy with
   // its lists rebuilt and, for the scalars, its contact forces evaluated on a second copy.
-  struct Whole {
-    State state, evaluated;
-    Workspace work;
-  };
-  std::optional<Whole> whole;
+  std::optional<WholeState> whole;
   const State* results = &state;   // positions, counters, histories
   const State* measured = &state;  // the same with this instant's forces
   const Workspace* results_work = &work;
@@ -285,12 +278,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     if (!domain) return;
     State gathered = domain->gather(state);
     if (!writer) return;
-    whole.emplace();
-    whole->state = std::move(gathered);
-    place_meshes(model, whole->state.time, whole->work);
-    rebuild_contacts(model, whole->state, whole->work);
-    whole->evaluated = whole->state;
-    compute_forces(model, whole->evaluated, whole->work);
+    whole = ready_for_results(model, std::move(gathered));
     results = &whole->state, measured = &whole->evaluated, results_work = &whole->work;
     whole_fresh = true;
   };

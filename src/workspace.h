@@ -53,6 +53,8 @@ struct Workspace {
   /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
   /// (forces.cpp).
   std::int32_t block = 64;
+  /// Owned slots with a ghost partner, ascending (domain.h; empty without ghosts).
+  std::vector<std::int32_t> ghost_owners;
 
   PairForces pair_forces;
   ContactForces wall_forces;

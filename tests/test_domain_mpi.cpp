@@ -52,6 +52,17 @@ Outcome simulate(const CaseSpec& spec, bool decomposed, double duration) {
 
 bool root() { return mpi::world().rank == 0; }
 
+/// The case run whole (in this process alone) and split over the ranks; the root prints how the
+/// split was cut.
+struct Runs {
+  Outcome whole, split;
+};
+Runs whole_and_split(const CaseSpec& spec, double duration) {
+  Runs runs{simulate(spec, false, duration), simulate(spec, true, duration)};
+  if (root()) std::printf("  %s\n", runs.split.note.c_str());
+  return runs;
+}
+
 /// Mean of a column of the rows over [from, to] s.
 template <typename Column>
 double mean_over(const std::vector<Scalars>& rows, double from, double to, Column column) {
@@ -96,10 +107,9 @@ TEST(DomainMpi, PeriodicGasConservesParticlesAndMomentumExactly) {
   const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
   const Model model = compile(spec);
   const std::array<double, 4> before = momentum(initial_state(model));
-  const Outcome whole = simulate(spec, false, 0.05);
-  const Outcome split = simulate(spec, true, 0.05);
+  const Runs runs = whole_and_split(spec, 0.05);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   EXPECT_NE(split.note.find("slabs along x across the period"), std::string::npos) << split.note;
   ASSERT_EQ(split.whole.size(), 1800u) << "particles";
   ASSERT_EQ(whole.whole.size(), 1800u);
@@ -125,10 +135,9 @@ TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
   CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/settling_bed.yaml");
   spec.particles[0].count = 2000;
   const double duration = 0.3;
-  const Outcome whole = simulate(spec, false, duration);
-  const Outcome split = simulate(spec, true, duration);
+  const Runs runs = whole_and_split(spec, duration);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   ASSERT_EQ(split.whole.size(), whole.whole.size());
   double weight = 0;
   for (size_t p = 0; p < whole.whole.size(); ++p) weight += 9.81 / whole.whole.inv_mass[p];
@@ -156,10 +165,9 @@ TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
   // every bead is inserted on rank 0 and migrates to rank 1 with its contacts.
   const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/inlet_outlet.yaml");
   const double duration = 0.6;
-  const Outcome whole = simulate(spec, false, duration);
-  const Outcome split = simulate(spec, true, duration);
+  const Runs runs = whole_and_split(spec, duration);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   const Scalars& a = whole.rows.back();
   const Scalars& b = split.rows.back();
   std::printf("  inserted %.5g / %.5g kg, outlet %.5g / %.5g kg, on the plate %zu / %zu beads, plate force %.4g / %.4g N, lost %lld / %lld\n",
@@ -191,10 +199,9 @@ TEST(DomainMpi, ServoWallCompressionMatchesTheSingleRankRun) {
   // 5 kPa from above. The wall sees the sum of every rank's contacts with it (one allreduce a
   // step), so it settles where the single run's does.
   const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/periodic_compression.yaml");
-  const Outcome whole = simulate(spec, false, 0.35);
-  const Outcome split = simulate(spec, true, 0.35);
+  const Runs runs = whole_and_split(spec, 0.35);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   ASSERT_FALSE(split.note.empty());
   const double target = 5000.0 * 0.03 * 0.03;  // [N] stress x area
   const double za = whole.whole.walls.pz[1], zb = split.whole.walls.pz[1];
@@ -209,10 +216,9 @@ TEST(DomainMpi, ClumpPourMatchesTheSingleRankRun) {
   // to the rank of its centre, its spheres are ghosts like any other, the forces on them go back
   // to the clump; clumps that cross the cut move with all their spheres.
   const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/clump_pour.yaml");
-  const Outcome whole = simulate(spec, false, 0.3);
-  const Outcome split = simulate(spec, true, 0.3);
+  const Runs runs = whole_and_split(spec, 0.3);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   ASSERT_FALSE(split.note.empty());
   ASSERT_EQ(split.whole.bodies.size(), whole.whole.bodies.size()) << "clumps";
   ASSERT_EQ(split.whole.size(), whole.whole.size()) << "spheres";
@@ -258,10 +264,9 @@ TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
   CaseSpec spec = parse_case_node(node, DEMDESIGN_SOURCE_DIR "/cases/silo_discharge.yaml");
   equipment::expand_equipment(spec);
   const double duration = 0.9;
-  const Outcome whole = simulate(spec, false, duration);
-  const Outcome split = simulate(spec, true, duration);
+  const Runs runs = whole_and_split(spec, duration);
   if (!root()) return;
-  std::printf("  %s\n", split.note.c_str());
+  const Outcome &whole = runs.whole, &split = runs.split;
   auto rate = [](const Outcome& o) {  // [kg/s] least-squares slope of the outlet mass over 0.45-0.9 s
     double n = 0, st = 0, sm = 0, stt = 0, stm = 0;
     for (const Scalars& r : o.rows)
