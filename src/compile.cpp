@@ -74,6 +74,10 @@ void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, in
     model.history_width += h.width;
     model.history_odd.insert(model.history_odd.end(), h.width, h.odd ? 1 : 0);
   }
+  // Every effect of the table at once fits (tests: Effects.AllHistoriesFitABatch); a new effect
+  // with history may need kHistoryMax raised.
+  if (model.history_width > kHistoryMax)
+    throw std::logic_error(fmt::format("contact history of {} doubles exceeds kHistoryMax = {} (src/effect.h)", model.history_width, kHistoryMax));
   param_cursor += static_cast<int>(spec->params.size()) + spec->derived_count;
   model.effects.push_back(active);
 }

@@ -21,6 +21,8 @@
 #include <span>
 #include <string_view>
 
+#include "parallel.h"
+
 namespace dem {
 
 /// Order in which effects run at a contact. Later stages read what earlier ones wrote.
@@ -63,8 +65,13 @@ struct HistorySpec {
 };
 
 /// Contacts evaluated together. Columns, so kernels stream through them; 64 contacts keep a
-/// batch (about 30 doubles a contact, 15 KiB) inside L1.
+/// batch (about 45 doubles a contact, 23 KiB) inside L1.
 inline constexpr int kBatch = 64;
+/// Most doubles of history one contact can carry (all effects of a case together; compile checks).
+inline constexpr int kHistoryMax = 8;
+
+// A contact kernel is a DEM_KERNEL (parallel.h): a DEM_VECTOR_LOOP over the batch's columns (the
+// columns it writes never overlap the pair table it reads).
 
 struct ContactBatch {
   int count = 0;
@@ -81,7 +88,11 @@ struct ContactBatch {
   double m_eff[kBatch];               ///< [kg] m* = m_i m_j/(m_i + m_j), m_i for a wall
   double inertia_eff[kBatch];         ///< [kg m^2] reduced moment of inertia about the contact point
   double* history[kBatch];            ///< this contact's history row (all effects' slots)
-  // --- written by effects, in stage order ---------------------------------------------------
+  /// The history rows as columns: hist[q][c] = history[c][q]. evaluate_effects copies the rows in
+  /// before the kernels and back after them, so kernels read and write columns only.
+  double hist[kHistoryMax][kBatch];
+  // --- written by effects, in stage order. The normal stage (always present, first) sets fn,
+  // fn_elastic, kn, kt, damp_sn, damp_st and damp_shape; every other output starts at 0. -------
   double fn[kBatch];                  ///< [N] normal force on i along n (positive: repulsive)
   double fn_elastic[kBatch];          ///< [N] elastic part of fn (set by the normal stage)
   double load[kBatch];                ///< [N] normal load for friction limits, set after damping
@@ -109,7 +120,8 @@ struct EffectContext {
   /// Column 0 and 1 of every pair row: effective Young's and shear modulus.
   double youngs_eff(const ContactBatch& b, int c) const { return pair_table[b.pair_type[c] * pair_stride]; }
   double shear_eff(const ContactBatch& b, int c) const { return pair_table[b.pair_type[c] * pair_stride + 1]; }
-  double* hist(const ContactBatch& b, int c) const { return b.history[c] + history_offset; }
+  /// Column q of this effect's history (q < its width): entry c is contact c's value.
+  double* hist(ContactBatch& b, int q) const { return b.hist[history_offset + q]; }
 };
 
 using EffectKernel = void (*)(const EffectContext&, ContactBatch&);

@@ -15,6 +15,42 @@ namespace dem {
 
 namespace {
 
+/// kick_drift for the free spheres among slots [begin, end), as a loop the compiler vectorises
+/// (spheres of bodies and glued spheres keep their values: their body or wall moves them).
+/// Returns whether one has moved more than sqrt(limit2) since the lists were built.
+template <bool kCheck>
+[[gnu::always_inline]] inline bool kick_drift_loop(State& s, long begin, long end, double h, double dt, double limit2) {
+  const std::int32_t *body = s.body.data(), *attached = s.attached.data();
+  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
+  const double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
+  const double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
+  double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
+  double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
+  const double *xb = s.x_built.data(), *yb = s.y_built.data(), *zb = s.z_built.data();
+  int moved = 0;
+  DEM_VECTOR_LOOP
+  for (long p = begin; p < end; ++p) {
+    const bool free = (body[p] < 0) & (attached[p] < 0);
+    const double a = h * inv_mass[p], b = h * inv_inertia[p];
+    const double nvx = vx[p] + a * fx[p], nvy = vy[p] + a * fy[p], nvz = vz[p] + a * fz[p];
+    const double nx = x[p] + dt * nvx, ny = y[p] + dt * nvy, nz = z[p] + dt * nvz;
+    if constexpr (kCheck) {
+      const double dx = nx - xb[p], dy = ny - yb[p], dz = nz - zb[p];
+      moved |= free & (dx * dx + dy * dy + dz * dz > limit2);
+    }
+    const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
+    wx[p] = free ? nwx : wx[p], wy[p] = free ? nwy : wy[p], wz[p] = free ? nwz : wz[p];
+    vx[p] = free ? nvx : vx[p], vy[p] = free ? nvy : vy[p], vz[p] = free ? nvz : vz[p];
+    x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
+  }
+  return moved != 0;
+}
+
+DEM_KERNEL bool kick_drift_range(State& s, long begin, long end, double h, double dt, bool check, double limit2) {
+  return check ? kick_drift_loop<true>(s, begin, end, h, dt, limit2) : kick_drift_loop<false>(s, begin, end, h, dt, limit2);
+}
+
 /// The opening half kick and the drift in one pass: v += h F/m, w += h T/I, x += dt v for free
 /// spheres; bodies take the same kick and move freely, then place their spheres. Returns whether
 /// a free sphere has moved more than half the skin since the lists were built (the same test
@@ -25,19 +61,7 @@ bool kick_drift(State& s, const Workspace& work, const Model& model, double h, d
   const double limit2 = 0.25 * model.skin * model.skin;
   int moved = 0;
 #pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
-  for (long p = 0; p < n; ++p) {
-    if (s.body[p] >= 0 || s.attached[p] >= 0) continue;  // moved by its body or its wall
-    const double a = h * s.inv_mass[p], b = h * s.inv_inertia[p];
-    const double vx = s.vx[p] + a * s.fx[p], vy = s.vy[p] + a * s.fy[p], vz = s.vz[p] + a * s.fz[p];
-    s.vx[p] = vx, s.vy[p] = vy, s.vz[p] = vz;
-    s.wx[p] += b * s.tx[p], s.wy[p] += b * s.ty[p], s.wz[p] += b * s.tz[p];
-    const double x = s.x[p] + dt * vx, y = s.y[p] + dt * vy, z = s.z[p] + dt * vz;
-    s.x[p] = x, s.y[p] = y, s.z[p] = z;
-    if (check) {
-      const double dx = x - s.x_built[p], dy = y - s.y_built[p], dz = z - s.z_built[p];
-      moved |= (dx * dx + dy * dy + dz * dz > limit2);
-    }
-  }
+  for (long begin = 0; begin < n; begin += kChunk) moved |= kick_drift_range(s, begin, std::min(n, begin + kChunk), h, dt, check, limit2);
   Bodies& b = s.bodies;
   if (b.size() == 0) return moved != 0;
   for (size_t k = 0; k < b.size(); ++k) {

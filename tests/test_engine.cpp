@@ -187,6 +187,16 @@ TEST(Neighbors, ReSortingTheSlotsDoesNotChangeAnyForce) {
   EXPECT_LT(worst, 1e-9 * scale) << "largest force change " << worst << " N of forces up to " << scale << " N";
 }
 
+// The contact kernels see the history as batch columns (effect.h); every effect of the table
+// switched on at once must fit them, or compile() refuses the case.
+TEST(Effects, EveryEffectTogetherFitsTheBatchHistoryColumns) {
+  int width = 0;
+  for (const EffectSpec* e : effect_table())
+    for (const HistorySpec& h : e->history) width += h.width;
+  EXPECT_GT(width, 0);
+  EXPECT_LE(width, kHistoryMax);
+}
+
 TEST(Particles, DiscreteDistributionHonoursMassFractions) {
   SizeDistributionSpec d;
   d.kind = SizeDistributionSpec::Kind::discrete;

@@ -10,8 +10,9 @@
 namespace dem::effects {
 namespace {
 
-void hertz_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void hertz_kernel(const EffectContext& ctx, ContactBatch& b) {
   const double tsuji_shape = std::sqrt(5.0 / 6.0);
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
     const double overlap = std::max(b.overlap[c], 0.0);
     const double contact_radius = std::sqrt(b.r_eff[c] * overlap);  // [m]
@@ -23,7 +24,7 @@ void hertz_kernel(const EffectContext& ctx, ContactBatch& b) {
     b.damp_st[c] = b.kt[c];
     b.damp_shape[c] = tsuji_shape;
     b.fn_elastic[c] = b.kn[c] * overlap;
-    b.fn[c] += b.fn_elastic[c];
+    b.fn[c] = b.fn_elastic[c];
   }
 }
 

@@ -48,8 +48,9 @@ double contact_radius(double overlap, double work, double r_eff, double youngs) 
 }
 
 void jkr_kernel(const EffectContext& ctx, ContactBatch& b) {
+  double* neck_column = ctx.hist(b, 0);  // 1 while a neck joins the pair, else 0
   for (int c = 0; c < b.count; ++c) {
-    double* neck = ctx.hist(b, c);
+    double* neck = &neck_column[c];
     const double work = 2.0 * ctx.param(b, c, 0);
     if (work <= 0.0) continue;
     const double youngs = ctx.youngs_eff(b, c), r_eff = b.r_eff[c], overlap = b.overlap[c];

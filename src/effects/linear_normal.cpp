@@ -40,7 +40,7 @@ void linear_kernel(const EffectContext& ctx, ContactBatch& b) {
     b.damp_st[c] = b.kt[c];
     b.damp_shape[c] = 1.0;
     b.fn_elastic[c] = stiffness * overlap;
-    b.fn[c] += b.fn_elastic[c];
+    b.fn[c] = b.fn_elastic[c];
   }
 }
 

@@ -41,8 +41,9 @@ double bridge_volume(double liquid, double bridges, double ri, double rj) {
 }
 
 void bridge_kernel(const EffectContext& ctx, ContactBatch& b) {
+  double* formed_column = ctx.hist(b, 0);  // 1 while a bridge joins the pair, else 0
   for (int c = 0; c < b.count; ++c) {
-    double* formed = ctx.hist(b, c);
+    double* formed = &formed_column[c];
     const double liquid = ctx.param(b, c, kLiquidContent);
     if (liquid <= 0.0) continue;
     const double separation = -b.overlap[c];  // [m]

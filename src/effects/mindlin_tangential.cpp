@@ -24,50 +24,43 @@ constexpr ParamSpec kParams[] = {
 };
 constexpr HistorySpec kHistory[] = {{"tangential_spring", 3, /*odd=*/true}};
 
-void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
   const double dt = ctx.dt;
+  double* sx = ctx.hist(b, 0);  // [m] spring xi, by component
+  double* sy = ctx.hist(b, 1);
+  double* sz = ctx.hist(b, 2);
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
-    double* xi = ctx.hist(b, c);  // [m] (3)
-    if (b.overlap[c] <= 0.0 || b.kt[c] <= 0.0) {
-      xi[0] = xi[1] = xi[2] = 0.0;
-      continue;
-    }
+    const bool acting = (b.overlap[c] > 0.0) & (b.kt[c] > 0.0);  // else the spring is forgotten
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
+    double x = sx[c], y = sy[c], z = sz[c];
     // Keep the spring in the current contact plane, at constant length.
-    const double old_len2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
-    if (old_len2 > 0.0) {
-      const double along_n = xi[0] * nx + xi[1] * ny + xi[2] * nz;
-      xi[0] -= along_n * nx;
-      xi[1] -= along_n * ny;
-      xi[2] -= along_n * nz;
-      const double new_len2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
-      if (new_len2 > 0.0) {
-        const double scale = std::sqrt(old_len2 / new_len2);
-        xi[0] *= scale;
-        xi[1] *= scale;
-        xi[2] *= scale;
-      }
-    }
-    xi[0] += b.vtx[c] * dt;
-    xi[1] += b.vty[c] * dt;
-    xi[2] += b.vtz[c] * dt;
+    const double old_len2 = x * x + y * y + z * z;
+    const double along_n = x * nx + y * ny + z * nz;
+    x -= along_n * nx, y -= along_n * ny, z -= along_n * nz;
+    const double new_len2 = x * x + y * y + z * z;
+    const double ratio = std::sqrt(old_len2 / new_len2);  // (not finite when new_len2 = 0: not used)
+    const double keep = new_len2 > 0.0 ? ratio : 1.0;
+    x = x * keep + b.vtx[c] * dt;
+    y = y * keep + b.vty[c] * dt;
+    z = z * keep + b.vtz[c] * dt;
 
     const double kt = b.kt[c], gt = b.gamma_t[c];
-    double fx = -kt * xi[0] - gt * b.vtx[c];
-    double fy = -kt * xi[1] - gt * b.vty[c];
-    double fz = -kt * xi[2] - gt * b.vtz[c];
+    double fx = -kt * x - gt * b.vtx[c];
+    double fy = -kt * y - gt * b.vty[c];
+    double fz = -kt * z - gt * b.vtz[c];
     const double limit = ctx.param(b, c, kFriction) * b.load[c];
     const double magnitude2 = fx * fx + fy * fy + fz * fz;
-    if (magnitude2 > limit * limit) {
-      const double scale = magnitude2 > 0.0 ? limit / std::sqrt(magnitude2) : 0.0;
-      fx *= scale;
-      fy *= scale;
-      fz *= scale;
-      const double inv_kt = 1.0 / kt;
-      xi[0] = -fx * inv_kt;
-      xi[1] = -fy * inv_kt;
-      xi[2] = -fz * inv_kt;
-    }
+    const bool slides = magnitude2 > limit * limit;
+    const double to_limit = limit / std::sqrt(magnitude2);
+    const double scale = slides ? (magnitude2 > 0.0 ? to_limit : 0.0) : 1.0;
+    fx *= scale, fy *= scale, fz *= scale;
+    const double inv_kt = 1.0 / kt;
+    x = slides ? -fx * inv_kt : x;
+    y = slides ? -fy * inv_kt : y;
+    z = slides ? -fz * inv_kt : z;
+    sx[c] = acting ? x : 0.0, sy[c] = acting ? y : 0.0, sz[c] = acting ? z : 0.0;
+    fx = acting ? fx : 0.0, fy = acting ? fy : 0.0, fz = acting ? fz : 0.0;
     b.ftx[c] += fx;
     b.fty[c] += fy;
     b.ftz[c] += fz;

@@ -35,8 +35,9 @@ void derive_beta(double* p) {
   p[kBeta] = log_e / std::sqrt(log_e * log_e + std::numbers::pi * std::numbers::pi);
 }
 
-void restitution_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void restitution_kernel(const EffectContext& ctx, ContactBatch& b) {
   const bool clip = ctx.options[0] == 1;
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
     const double beta = ctx.param(b, c, kBeta);
     const double shape = -2.0 * b.damp_shape[c] * beta;
@@ -45,7 +46,7 @@ void restitution_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double damping_force = -b.gamma_n[c] * b.vn[c];
     b.energy_dissipated[c] += b.gamma_n[c] * b.vn[c] * b.vn[c] * ctx.dt;
     b.fn[c] += damping_force;
-    if (clip) b.fn[c] = std::max(b.fn[c], 0.0);
+    b.fn[c] = clip ? std::max(b.fn[c], 0.0) : b.fn[c];
   }
 }
 

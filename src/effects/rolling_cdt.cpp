@@ -18,20 +18,21 @@ constexpr ParamSpec kParams[] = {
      "rolling friction coefficient mu_r; lever arm of the resisting torque is mu_r R*"},
 };
 
-void cdt_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void cdt_kernel(const EffectContext& ctx, ContactBatch& b) {
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
-    if (b.overlap[c] <= 0.0) continue;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double w_n = b.wx[c] * nx + b.wy[c] * ny + b.wz[c] * nz;
     const double rx = b.wx[c] - w_n * nx, ry = b.wy[c] - w_n * ny, rz = b.wz[c] - w_n * nz;
     const double w_roll = std::sqrt(rx * rx + ry * ry + rz * rz);  // [rad/s]
-    if (w_roll <= 0.0) continue;
+    const bool acting = (b.overlap[c] > 0.0) & (w_roll > 0.0);
     const double limit = ctx.param(b, c, 0) * b.r_eff[c] * std::max(b.fn_elastic[c], 0.0);
     const double stopping = b.inertia_eff[c] * w_roll / ctx.dt;
-    const double torque = std::min(limit, stopping);
-    b.mx[c] -= torque * rx / w_roll;
-    b.my[c] -= torque * ry / w_roll;
-    b.mz[c] -= torque * rz / w_roll;
+    const double torque = acting ? std::min(limit, stopping) : 0.0;
+    const double mx = torque * rx / w_roll, my = torque * ry / w_roll, mz = torque * rz / w_roll;  // (0/0 when not acting: not used)
+    b.mx[c] -= acting ? mx : 0.0;
+    b.my[c] -= acting ? my : 0.0;
+    b.mz[c] -= acting ? mz : 0.0;
     b.energy_dissipated[c] += torque * w_roll * ctx.dt;
   }
 }

@@ -22,46 +22,45 @@ constexpr ParamSpec kParams[] = {
 };
 constexpr HistorySpec kHistory[] = {{"rolling_spring_torque", 3, /*odd=*/true}};
 
-void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
   const double dt = ctx.dt;
+  double* sx = ctx.hist(b, 0);  // [N m] spring torque, by component
+  double* sy = ctx.hist(b, 1);
+  double* sz = ctx.hist(b, 2);
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
-    double* spring = ctx.hist(b, c);  // [N m] (3)
-    if (b.overlap[c] <= 0.0) {
-      spring[0] = spring[1] = spring[2] = 0.0;
-      continue;
-    }
+    const bool acting = b.overlap[c] > 0.0;  // else the spring is forgotten
     const double mu_r = ctx.param(b, c, kRollingFriction);
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double w_n = b.wx[c] * nx + b.wy[c] * ny + b.wz[c] * nz;
     const double rx = b.wx[c] - w_n * nx, ry = b.wy[c] - w_n * ny, rz = b.wz[c] - w_n * nz;
     // Keep the spring torque in the contact plane at constant magnitude.
-    const double old2 = spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2];
-    if (old2 > 0.0) {
-      const double along_n = spring[0] * nx + spring[1] * ny + spring[2] * nz;
-      for (int k = 0; k < 3; ++k) spring[k] -= along_n * (k == 0 ? nx : k == 1 ? ny : nz);
-      const double new2 = spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2];
-      if (new2 > 0.0) {
-        const double scale = std::sqrt(old2 / new2);
-        for (int k = 0; k < 3; ++k) spring[k] *= scale;
-      }
-    }
+    double x = sx[c], y = sy[c], z = sz[c];
+    const double old2 = x * x + y * y + z * z;
+    const double along_n = x * nx + y * ny + z * nz;
+    x -= along_n * nx, y -= along_n * ny, z -= along_n * nz;
+    const double new2 = x * x + y * y + z * z;
+    const double ratio = std::sqrt(old2 / new2);  // (not finite when new2 = 0: not used)
+    const double keep = new2 > 0.0 ? ratio : 1.0;
+    x *= keep, y *= keep, z *= keep;
     const double r_eff = b.r_eff[c];
     const double k_roll = 2.25 * b.kn[c] * mu_r * mu_r * r_eff * r_eff;  // [N m/rad]
-    spring[0] -= k_roll * rx * dt;
-    spring[1] -= k_roll * ry * dt;
-    spring[2] -= k_roll * rz * dt;
+    x -= k_roll * rx * dt;
+    y -= k_roll * ry * dt;
+    z -= k_roll * rz * dt;
     const double limit = mu_r * r_eff * std::max(b.fn_elastic[c], 0.0);
-    const double magnitude2 = spring[0] * spring[0] + spring[1] * spring[1] + spring[2] * spring[2];
-    double damping = 0.0;
-    if (magnitude2 > limit * limit) {
-      const double scale = magnitude2 > 0.0 ? limit / std::sqrt(magnitude2) : 0.0;
-      for (int k = 0; k < 3; ++k) spring[k] *= scale;
-    } else {
-      damping = ctx.param(b, c, kRollingDamping) * 2.0 * std::sqrt(b.inertia_eff[c] * k_roll);
-    }
-    b.mx[c] += spring[0] - damping * rx;
-    b.my[c] += spring[1] - damping * ry;
-    b.mz[c] += spring[2] - damping * rz;
+    const double magnitude2 = x * x + y * y + z * z;
+    const bool full = magnitude2 > limit * limit;  // fully mobilised: capped, no damping
+    const double to_limit = limit / std::sqrt(magnitude2);
+    const double scale = full ? (magnitude2 > 0.0 ? to_limit : 0.0) : 1.0;
+    x *= scale, y *= scale, z *= scale;
+    const double damping_on = ctx.param(b, c, kRollingDamping) * 2.0 * std::sqrt(b.inertia_eff[c] * k_roll);
+    const double damping = full | !acting ? 0.0 : damping_on;
+    x = acting ? x : 0.0, y = acting ? y : 0.0, z = acting ? z : 0.0;
+    sx[c] = x, sy[c] = y, sz[c] = z;
+    b.mx[c] += x - damping * rx;
+    b.my[c] += y - damping * ry;
+    b.mz[c] += z - damping * rz;
     b.energy_dissipated[c] += damping * (rx * rx + ry * ry + rz * rz) * dt;
   }
 }

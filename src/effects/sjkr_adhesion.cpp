@@ -17,19 +17,17 @@ constexpr ParamSpec kParams[] = {
      "cohesion energy density k_c: attractive force per unit contact area"},
 };
 
-void sjkr_kernel(const EffectContext& ctx, ContactBatch& b) {
+DEM_KERNEL void sjkr_kernel(const EffectContext& ctx, ContactBatch& b) {
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
     const double overlap = b.overlap[c];
-    if (overlap <= 0.0) continue;
     const double ri = b.radius_i[c], rj = b.radius_j[c];
-    double a2;
-    if (rj == 0.0) {
-      a2 = 2.0 * ri * overlap - overlap * overlap;
-    } else {
-      const double d = ri + rj - overlap;
-      a2 = (d * d - (ri - rj) * (ri - rj)) * ((ri + rj) * (ri + rj) - d * d) / (4.0 * d * d);
-    }
-    b.fn[c] -= ctx.param(b, c, 0) * std::numbers::pi * std::max(a2, 0.0);
+    const double d = ri + rj - overlap;
+    const double a2_wall = 2.0 * ri * overlap - overlap * overlap;
+    const double a2_pair = (d * d - (ri - rj) * (ri - rj)) * ((ri + rj) * (ri + rj) - d * d) / (4.0 * d * d);
+    const double a2 = rj == 0.0 ? a2_wall : a2_pair;
+    const double pull = ctx.param(b, c, 0) * std::numbers::pi * std::max(a2, 0.0);
+    b.fn[c] -= overlap > 0.0 ? pull : 0.0;
   }
 }
 
