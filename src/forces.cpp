@@ -32,7 +32,6 @@
 
 #include <cmath>
 #include <algorithm>
-#include <cstring>
 
 namespace dem {
 

@@ -34,16 +34,10 @@ DEM_KERNEL void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
     const bool acting = (b.overlap[c] > 0.0) & (b.kt[c] > 0.0);  // else the spring is forgotten
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     double x = sx[c], y = sy[c], z = sz[c];
-    // Keep the spring in the current contact plane, at constant length.
-    const double old_len2 = x * x + y * y + z * z;
-    const double along_n = x * nx + y * ny + z * nz;
-    x -= along_n * nx, y -= along_n * ny, z -= along_n * nz;
-    const double new_len2 = x * x + y * y + z * z;
-    const double ratio = std::sqrt(old_len2 / new_len2);  // (not finite when new_len2 = 0: not used)
-    const double keep = new_len2 > 0.0 ? ratio : 1.0;
-    x = x * keep + b.vtx[c] * dt;
-    y = y * keep + b.vty[c] * dt;
-    z = z * keep + b.vtz[c] * dt;
+    keep_in_contact_plane(x, y, z, nx, ny, nz);
+    x += b.vtx[c] * dt;
+    y += b.vty[c] * dt;
+    z += b.vtz[c] * dt;
 
     const double kt = b.kt[c], gt = b.gamma_t[c];
     double fx = -kt * x - gt * b.vtx[c];
@@ -52,8 +46,7 @@ DEM_KERNEL void mindlin_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double limit = ctx.param(b, c, kFriction) * b.load[c];
     const double magnitude2 = fx * fx + fy * fy + fz * fz;
     const bool slides = magnitude2 > limit * limit;
-    const double to_limit = limit / std::sqrt(magnitude2);
-    const double scale = slides ? (magnitude2 > 0.0 ? to_limit : 0.0) : 1.0;
+    const double scale = cap_to_limit(magnitude2, limit);
     fx *= scale, fy *= scale, fz *= scale;
     const double inv_kt = 1.0 / kt;
     x = slides ? -fx * inv_kt : x;

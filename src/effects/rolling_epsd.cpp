@@ -36,13 +36,7 @@ DEM_KERNEL void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double rx = b.wx[c] - w_n * nx, ry = b.wy[c] - w_n * ny, rz = b.wz[c] - w_n * nz;
     // Keep the spring torque in the contact plane at constant magnitude.
     double x = sx[c], y = sy[c], z = sz[c];
-    const double old2 = x * x + y * y + z * z;
-    const double along_n = x * nx + y * ny + z * nz;
-    x -= along_n * nx, y -= along_n * ny, z -= along_n * nz;
-    const double new2 = x * x + y * y + z * z;
-    const double ratio = std::sqrt(old2 / new2);  // (not finite when new2 = 0: not used)
-    const double keep = new2 > 0.0 ? ratio : 1.0;
-    x *= keep, y *= keep, z *= keep;
+    keep_in_contact_plane(x, y, z, nx, ny, nz);
     const double r_eff = b.r_eff[c];
     const double k_roll = 2.25 * b.kn[c] * mu_r * mu_r * r_eff * r_eff;  // [N m/rad]
     x -= k_roll * rx * dt;
@@ -51,8 +45,7 @@ DEM_KERNEL void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double limit = mu_r * r_eff * std::max(b.fn_elastic[c], 0.0);
     const double magnitude2 = x * x + y * y + z * z;
     const bool full = magnitude2 > limit * limit;  // fully mobilised: capped, no damping
-    const double to_limit = limit / std::sqrt(magnitude2);
-    const double scale = full ? (magnitude2 > 0.0 ? to_limit : 0.0) : 1.0;
+    const double scale = cap_to_limit(magnitude2, limit);
     x *= scale, y *= scale, z *= scale;
     const double damping_on = ctx.param(b, c, kRollingDamping) * 2.0 * std::sqrt(b.inertia_eff[c] * k_roll);
     const double damping = full | !acting ? 0.0 : damping_on;
