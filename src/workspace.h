@@ -76,6 +76,8 @@ struct Workspace {
 
   // Cell grid scratch; members: slots by cell (only with ghosts, which are not sorted).
   std::vector<std::int32_t> cell_of, cell_start, order, members;
+  /// Partners found by each thread while the pair list is built (kept: no allocation per rebuild).
+  std::vector<std::vector<std::int32_t>> partner_scratch;
 };
 
 }  // namespace dem

@@ -150,11 +150,17 @@ TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
   const Scalars& b = split.rows.back();
   const double ha = mean_height(whole.whole), hb = mean_height(split.whole);
   const double ca = 2.0 * a.contacts / whole.whole.size(), cb = 2.0 * b.contacts / split.whole.size();
-  std::printf("  floor %.5g / %.5g N (weight %.5g N), mean height %.5g / %.5g m, contacts per bead %.3f / %.3f, kinetic %.3g / %.3g J\n",
-              a.wall_normal_force[0], b.wall_normal_force[0], weight, ha, hb, ca, cb, a.kinetic_translation, b.kinetic_translation);
+  // The floor force of the last 0.05 s, averaged: the settled bed still rings elastically, and
+  // a single row of either run can be a few percent off the weight.
+  auto floor = [](const Scalars& r) { return r.wall_normal_force[0]; };
+  const double fa = mean_over(whole.rows, duration - 0.05, duration, floor), fb = mean_over(split.rows, duration - 0.05, duration, floor);
+  std::printf("  floor %.5g / %.5g N (weight %.5g N; last row %.5g / %.5g N), mean height %.5g / %.5g m, contacts per bead %.3f / %.3f, "
+              "kinetic %.3g / %.3g J\n",
+              fa, fb, weight, a.wall_normal_force[0], b.wall_normal_force[0], ha, hb, ca, cb, a.kinetic_translation, b.kinetic_translation);
   EXPECT_LT(a.kinetic_translation, 1e-3) << "the single run must have settled";
   EXPECT_LT(b.kinetic_translation, 1e-3) << "the split run must have settled";
-  EXPECT_NEAR(b.wall_normal_force[0], weight, 0.03 * weight) << "the floor carries the weight";
+  EXPECT_NEAR(fa, weight, 0.03 * weight) << "the floor carries the weight (single run)";
+  EXPECT_NEAR(fb, weight, 0.03 * weight) << "the floor carries the weight (split run)";
   EXPECT_NEAR(hb, ha, 0.01 * ha) << "bed height";
   EXPECT_NEAR(cb, ca, 0.03 * ca) << "contacts per bead";
 }
