@@ -189,8 +189,10 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   MeshContacts& mc = s.mesh_contacts;
   if (model.meshes.empty()) return;
   MeshSlotResults& slot_results = work.mesh_slots;
-  if (work.mesh_forces.fx.size() != s.size() * kSlots) {  // slots beyond a particle's count are never read
-    work.mesh_forces.resize(s.size() * kSlots);
+  if (work.mesh_forces.fx.size() != s.size() * kSlots) {  // written below before read: no fill
+    ContactForces& f = work.mesh_forces;
+    for (auto* c : {&f.fx, &f.fy, &f.fz}) c->resize(s.size() * kSlots);
+    f.active.resize(s.size() * kSlots);
     slot_results.resize(s.size() * kSlots);
   }
   const double range = model.interaction_range;

@@ -15,14 +15,19 @@ void apply_order(std::vector<T>& column, const std::vector<std::int32_t>& order,
   for (size_t k = 0; k < order.size(); ++k) scratch[k] = column[order[k]];
   column.swap(scratch);
 }
-/// Same for columns with `stride` entries per particle.
+/// Same for the mesh-contact columns: `per_slot` entries for each of a particle's kSlots slots,
+/// of which only the first used[p] hold a contact (the rest are never read, so not copied).
 template <typename T>
-void apply_order_strided(std::vector<T>& column, const std::vector<std::int32_t>& order, size_t stride) {
+void apply_order_slots(std::vector<T>& column, const std::vector<std::int32_t>& order, const std::vector<std::uint8_t>& used,
+                       size_t per_slot, std::vector<T>& scratch) {
+  const size_t stride = MeshContacts::kSlots * per_slot;
   if (stride == 0) return;
-  std::vector<T> out(order.size() * stride);
-  for (size_t k = 0; k < order.size(); ++k)
-    std::copy_n(column.begin() + static_cast<std::ptrdiff_t>(order[k] * stride), stride, out.begin() + static_cast<std::ptrdiff_t>(k * stride));
-  column.swap(out);
+  scratch.resize(order.size() * stride);
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t from = static_cast<size_t>(order[k]);
+    std::copy_n(column.data() + from * stride, used[from] * per_slot, scratch.data() + k * stride);
+  }
+  column.swap(scratch);
 }
 template <typename T>
 void keep_only_strided(std::vector<T>& column, const std::vector<std::uint8_t>& keep, size_t stride) {
@@ -150,12 +155,11 @@ void State::permute(const std::vector<std::int32_t>& order) {
   apply_order(id, order, s64);
   MeshContacts& mc = mesh_contacts;
   if (!has_meshes) return;
+  apply_order_slots(mc.mesh, order, mc.count, 1, s32), apply_order_slots(mc.triangle, order, mc.count, 1, s32);
+  for (auto* c : {&mc.px, &mc.py, &mc.pz}) apply_order_slots(*c, order, mc.count, 1, scratch);
+  apply_order_slots(mc.history, order, mc.count, static_cast<size_t>(mesh_history_width), scratch);
   std::vector<std::uint8_t> s8;
   apply_order(mc.count, order, s8);
-  const size_t slots = MeshContacts::kSlots;
-  apply_order_strided(mc.mesh, order, slots), apply_order_strided(mc.triangle, order, slots);
-  apply_order_strided(mc.px, order, slots), apply_order_strided(mc.py, order, slots), apply_order_strided(mc.pz, order, slots);
-  apply_order_strided(mc.history, order, slots * mesh_history_width);
 }
 
 void State::compact(const std::vector<std::uint8_t>& keep) {

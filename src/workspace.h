@@ -35,9 +35,10 @@ struct MeshSlotResults {
   std::vector<double> cx, cy, cz;     // [m] contact point, world
   std::vector<double> vx, vy, vz;     // [m/s] wall velocity at the contact
   std::vector<double> impact_energy;  // [J] 1/2 m* vn^2 when the contact started this step, else -1
+  /// A slot is written before it is read (slots beyond a particle's count never are), so the
+  /// columns are not filled.
   void resize(std::size_t n) {
-    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &vx, &vy, &vz}) c->assign(n, 0.0);
-    impact_energy.assign(n, -1.0);
+    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &vx, &vy, &vz, &impact_energy}) c->resize(n);
   }
 };
 
