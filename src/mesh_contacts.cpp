@@ -159,28 +159,24 @@ void find_mesh_candidates(const Model& model, State& s, Workspace& work, double 
   s.mesh_candidates.clear();
   s.lists_built_time = work.mesh_time;
   if (model.meshes.empty()) return;
-  std::vector<std::vector<std::array<std::int32_t, 2>>> found(n);
   const long nl = static_cast<long>(n);
-#pragma omp parallel if (nl >= kParallelMin)
-  {
-    std::vector<std::int32_t> near;
-#pragma omp for schedule(static)
-    for (long p = 0; p < nl; ++p) {
-      const double x[3] = {s.x[p], s.y[p], s.z[p]};
-      for (size_t m = 0; m < model.meshes.size(); ++m) {
-        const double d[3] = {x[0] - work.mesh_translation[m][0], x[1] - work.mesh_translation[m][1], x[2] - work.mesh_translation[m][2]};
-        double local[3];
-        mul_transposed(work.mesh_rotation[m], d, local);
-        near.clear();
-        model.meshes[m].bvh->within(local, s.radius[p] + reach, near);
-        std::sort(near.begin(), near.end());
-        for (std::int32_t t : near) found[p].push_back({static_cast<std::int32_t>(m), t});
-      }
-    }
-  }
-  for (size_t p = 0; p < n; ++p) s.candidate_begin[p + 1] = s.candidate_begin[p] + static_cast<std::int32_t>(found[p].size());
-  s.mesh_candidates.reserve(s.candidate_begin[n]);
-  for (const auto& f : found) s.mesh_candidates.insert(s.mesh_candidates.end(), f.begin(), f.end());
+  fill_rows(nl, nl >= kParallelMin, work.candidate_scratch, s.candidate_begin, s.mesh_candidates,
+            [&](long p, std::vector<std::array<std::int32_t, 2>>& out, size_t k) {
+              thread_local std::vector<std::int32_t> near;  // the BVH's answer for one mesh
+              const double x[3] = {s.x[p], s.y[p], s.z[p]};
+              for (size_t m = 0; m < model.meshes.size(); ++m) {
+                const double d[3] = {x[0] - work.mesh_translation[m][0], x[1] - work.mesh_translation[m][1],
+                                     x[2] - work.mesh_translation[m][2]};
+                double local[3];
+                mul_transposed(work.mesh_rotation[m], d, local);
+                near.clear();
+                model.meshes[m].bvh->within(local, s.radius[p] + reach, near);
+                std::sort(near.begin(), near.end());
+                if (out.size() < k + near.size()) out.resize(2 * (k + near.size()));
+                for (const std::int32_t t : near) out[k++] = {static_cast<std::int32_t>(m), t};
+              }
+              return k;
+            });
 }
 
 void mesh_contact_forces(const Model& model, State& s, Workspace& work) {

@@ -11,8 +11,6 @@
 #include <limits>
 #include <optional>
 
-#include <omp.h>
-
 namespace dem {
 
 namespace {
@@ -128,7 +126,7 @@ Grid make_grid(const Model& model, const State& s, double cell) {
   // Cap the number of cells at 4 per particle, or 2^19 (2 MiB of cell starts) if more: a few
   // particles flung far away must not make the grid huge, while a thin stream in a large box
   // (a chute) keeps cells one reach wide. Larger cells stay correct, only slower (B2: cells
-  // 1.6 reaches wide under a cap of 4 per particle made the list build 2.4 times the work).
+  // 1.6 reaches wide under a cap of 4 per particle, 4 times the candidates to measure).
   // Periodic axes keep whole periods.
   const double cap = std::max(4.0 * static_cast<double>(s.size()) + 64.0, 524288.0);
   for (;;) {
@@ -274,6 +272,16 @@ struct PairFinder {
   }
 };
 
+/// Lists slots [0, n) by cell (a counting sort's scatter): cell_start holds each cell's first
+/// entry; it is used as the cursor and then restored by shifting, so nothing is allocated.
+void scatter_by_cell(const std::vector<std::int32_t>& cell_of, size_t n, std::vector<std::int32_t>& cell_start,
+                     std::vector<std::int32_t>& out) {
+  for (size_t p = 0; p < n; ++p) out[cell_start[cell_of[p]]++] = static_cast<std::int32_t>(p);
+  // Now cell_start[c] is where cell c ends, i.e. where c + 1 starts.
+  std::copy_backward(cell_start.begin(), cell_start.end() - 1, cell_start.end());
+  cell_start[0] = 0;
+}
+
 void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>& owner, size_t n) {
   begin.assign(n + 1, 0);
   for (const std::int32_t o : owner) ++begin[o + 1];
@@ -402,9 +410,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     }
     for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
     work.order.resize(owned);
-    std::vector<std::int32_t> cursor(work.cell_start.begin(), work.cell_start.end() - 1);
-    for (size_t p = 0; p < owned; ++p) work.order[cursor[work.cell_of[p]]++] = static_cast<std::int32_t>(p);
-    s.permute(work.order);
+    scatter_by_cell(work.cell_of, owned, work.cell_start, work.order);
+    s.permute(work.order, work.permute_scratch);
   }
   if (domain) domain->make_ghosts(model, s);
   const size_t n = s.size(), n_owned = s.owned();
@@ -433,43 +440,23 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     for (size_t p = 0; p < n; ++p) ++work.cell_start[work.cell_of[p] + 1];
     for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
     work.members.resize(n);
-    std::vector<std::int32_t> cursor(work.cell_start.begin(), work.cell_start.end() - 1);
-    for (size_t p = 0; p < n; ++p) work.members[cursor[work.cell_of[p]]++] = static_cast<std::int32_t>(p);
+    scatter_by_cell(work.cell_of, n, work.cell_start, work.members);
   } else {
     for (int c = 0; c < n_cells; ++c) std::fill(work.cell_of.data() + work.cell_start[c], work.cell_of.data() + work.cell_start[c + 1], c);
   }
 
-  // Particle pairs, in one pass: each thread lists the partners of a static share of the owned
-  // slots into a buffer of its own, then copies it into place. Ghosts list no pairs
-  // (ghost-ghost pairs are another rank's).
+  // Particle pairs, in one pass (fill_rows). Ghosts list no pairs (ghost-ghost pairs are
+  // another rank's).
   const PairFinder finder{model, s, grid, work.cell_of.data(), work.cell_start.data(),
                           with_ghosts ? work.members.data() : nullptr, reach};
   const long nl = static_cast<long>(n_owned);
-  const int threads = nl >= kParallelMin ? omp_get_max_threads() : 1;
-  if (static_cast<int>(work.partner_scratch.size()) < threads) work.partner_scratch.resize(static_cast<size_t>(threads));
-  work.pair_begin.assign(n + 1, 0);
-#pragma omp parallel num_threads(threads)
-  {
-    const long t = omp_get_thread_num(), nt = omp_get_num_threads();
-    const long lo = nl * t / nt, hi = nl * (t + 1) / nt;
-    std::vector<std::int32_t>& buffer = work.partner_scratch[static_cast<size_t>(t)];
-    size_t m = 0;
-    for (long i = lo; i < hi; ++i) {
-      const size_t before = m;
-      m = finder.partners(static_cast<std::int32_t>(i), buffer, m);
-      work.pair_begin[i + 1] = static_cast<std::int32_t>(m - before);
-    }
-#pragma omp barrier
-#pragma omp single
-    {
-      for (size_t p = 0; p < n; ++p) work.pair_begin[p + 1] += work.pair_begin[p];
-      s.pairs.i.resize(static_cast<size_t>(work.pair_begin[n]));
-      s.pairs.j.resize(static_cast<size_t>(work.pair_begin[n]));
-    }
-    std::copy_n(buffer.data(), m, s.pairs.j.data() + work.pair_begin[lo]);
-    for (long i = lo; i < hi; ++i)
-      std::fill(s.pairs.i.data() + work.pair_begin[i], s.pairs.i.data() + work.pair_begin[i + 1], static_cast<std::int32_t>(i));
-  }
+  fill_rows(nl, nl >= kParallelMin, work.partner_scratch, work.pair_begin, s.pairs.j,
+            [&](long i, std::vector<std::int32_t>& out, size_t m) { return finder.partners(static_cast<std::int32_t>(i), out, m); });
+  work.pair_begin.resize(n + 1, work.pair_begin[nl]);
+  s.pairs.i.resize(s.pairs.j.size());
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
+  for (long i = 0; i < nl; ++i)
+    std::fill(s.pairs.i.data() + work.pair_begin[i], s.pairs.i.data() + work.pair_begin[i + 1], static_cast<std::int32_t>(i));
   const size_t n_pairs = s.pairs.size();
 
   // Wall pairs, grouped by particle (ghosts touch no wall: their owners' contacts).

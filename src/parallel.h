@@ -1,6 +1,12 @@
 // How the engine uses the cores and their vector units.
 #pragma once
 
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
 namespace dem {
 /// OpenMP policy: loops over fewer items than this run on one thread. Opening a parallel region
 /// costs microseconds and idle OpenMP threads spin; for a handful of particles that dominates.
@@ -29,3 +35,38 @@ inline constexpr long kChunk = 1024;
 #else
 #define DEM_VECTOR_LOOP
 #endif
+
+namespace dem {
+/// Builds a list in rows (CSR: row r's entries are out[begin[r]] .. out[begin[r + 1] - 1]) in
+/// one pass over the rows: they are split evenly over the threads, each thread appends its rows
+/// to a buffer of its own (fill(r, buffer, m) appends row r's entries from index m on, growing
+/// the buffer as needed, and returns the new end), then the buffers are copied into place. Rows
+/// come out in order whatever the thread count. The buffers are kept between calls, so a
+/// rebuild allocates nothing once they have grown.
+template <typename T, typename Fill>
+void fill_rows(long rows, bool parallel, std::vector<std::vector<T>>& buffers, std::vector<std::int32_t>& begin,
+               std::vector<T>& out, Fill&& fill) {
+  const int threads = parallel ? omp_get_max_threads() : 1;
+  if (buffers.size() < static_cast<size_t>(threads)) buffers.resize(static_cast<size_t>(threads));
+  begin.assign(static_cast<size_t>(rows) + 1, 0);
+#pragma omp parallel num_threads(threads)
+  {
+    const long t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const long lo = rows * t / nt, hi = rows * (t + 1) / nt;
+    std::vector<T>& buffer = buffers[static_cast<size_t>(t)];
+    size_t m = 0;
+    for (long r = lo; r < hi; ++r) {
+      const size_t before = m;
+      m = fill(r, buffer, m);
+      begin[static_cast<size_t>(r) + 1] = static_cast<std::int32_t>(m - before);
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (long r = 0; r < rows; ++r) begin[r + 1] += begin[r];
+      out.resize(static_cast<size_t>(begin[rows]));
+    }
+    std::copy_n(buffer.data(), m, out.data() + begin[lo]);
+  }
+}
+}  // namespace dem

@@ -142,24 +142,18 @@ std::size_t State::unpack_body(const double* in) {
   return b.size() - 1;
 }
 
-void State::permute(const std::vector<std::int32_t>& order) {
-  std::vector<double> scratch;
+void State::permute(const std::vector<std::int32_t>& order, PermuteScratch& scratch) {
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
-    apply_order(*c, order, scratch);
-  for (auto* c : {&offset_x, &offset_y, &offset_z}) apply_order(*c, order, scratch);
-  std::vector<std::int32_t> s32;
-  apply_order(material, order, s32);
-  apply_order(body, order, s32);
-  apply_order(attached, order, s32);
-  std::vector<std::int64_t> s64;
-  apply_order(id, order, s64);
+    apply_order(*c, order, scratch.f64);
+  for (auto* c : {&offset_x, &offset_y, &offset_z}) apply_order(*c, order, scratch.f64);
+  for (auto* c : {&material, &body, &attached}) apply_order(*c, order, scratch.i32);
+  apply_order(id, order, scratch.i64);
   MeshContacts& mc = mesh_contacts;
   if (!has_meshes) return;
-  apply_order_slots(mc.mesh, order, mc.count, 1, s32), apply_order_slots(mc.triangle, order, mc.count, 1, s32);
-  for (auto* c : {&mc.px, &mc.py, &mc.pz}) apply_order_slots(*c, order, mc.count, 1, scratch);
-  apply_order_slots(mc.history, order, mc.count, static_cast<size_t>(mesh_history_width), scratch);
-  std::vector<std::uint8_t> s8;
-  apply_order(mc.count, order, s8);
+  for (auto* c : {&mc.mesh, &mc.triangle}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_i32);
+  for (auto* c : {&mc.px, &mc.py, &mc.pz}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_f64);
+  apply_order_slots(mc.history, order, mc.count, static_cast<size_t>(mesh_history_width), scratch.history);
+  apply_order(mc.count, order, scratch.u8);
 }
 
 void State::compact(const std::vector<std::uint8_t>& keep) {

@@ -84,6 +84,16 @@ struct MeshLoads {
   std::vector<double> power;       // [W] rate of work the mesh does on the particles
 };
 
+/// Buffers State::permute gathers columns into, one per element type and column length: a
+/// column is swapped with its buffer, so buffers shared by columns of different lengths would
+/// hand every column the capacity of the longest.
+struct PermuteScratch {
+  std::vector<double> f64, slots_f64, history;  // per particle, per mesh slot, mesh slot histories
+  std::vector<std::int32_t> i32, slots_i32;
+  std::vector<std::int64_t> i64;
+  std::vector<std::uint8_t> u8;
+};
+
 struct State {
   double time = 0.0;  // [s]
   std::int64_t step = 0;
@@ -148,7 +158,13 @@ struct State {
   /// Appends a sphere at rest state; returns its slot.
   std::size_t add_sphere(double px, double py, double pz, double r, double density, int mat);
   /// Reorders particle slots: new slot k holds old slot order[k]. Contact lists are not touched.
-  void permute(const std::vector<std::int32_t>& order);
+  /// The columns are gathered into `scratch` and swapped with it (kept by the caller between
+  /// calls: a rebuild allocates nothing once it has grown).
+  void permute(const std::vector<std::int32_t>& order, PermuteScratch& scratch);
+  void permute(const std::vector<std::int32_t>& order) {
+    PermuteScratch scratch;
+    permute(order, scratch);
+  }
   /// Keeps only slots with keep[k] != 0 (contact lists are not touched). Bodies none of whose
   /// spheres remain are removed and the others renumbered.
   void compact(const std::vector<std::uint8_t>& keep);

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "state.h"
+
 namespace dem {
 
 class Domain;
@@ -77,8 +79,11 @@ struct Workspace {
 
   // Cell grid scratch; members: slots by cell (only with ghosts, which are not sorted).
   std::vector<std::int32_t> cell_of, cell_start, order, members;
-  /// Partners found by each thread while the pair list is built (kept: no allocation per rebuild).
+  /// Partners and mesh candidates found by each thread while the lists are built, and the
+  /// buffers the particle sort gathers into (kept: a rebuild allocates nothing once grown).
   std::vector<std::vector<std::int32_t>> partner_scratch;
+  std::vector<std::vector<std::array<std::int32_t, 2>>> candidate_scratch;
+  PermuteScratch permute_scratch;
 };
 
 }  // namespace dem
