@@ -181,11 +181,13 @@ struct Run {
   void start(const CaseSpec& spec) {
     model = compile(spec);
     state = initial_state(model);
+    work.keep_pair_forces = true;  // the stress tensor is measured
     prepare(model, state, work);
   }
   void switch_to(const CaseSpec& spec) {
     model = compile(spec);
     work = Workspace();
+    work.keep_pair_forces = true;
     prepare(model, state, work);
   }
 };

@@ -123,6 +123,7 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   }
   evaluate_effects(model, b);
   PairForces& pf = work.pair_forces;
+  const bool keep_forces = work.keep_pair_forces;
   ContactForces& wf = work.wall_forces;
   for (int c = 0; c < b.count; ++c) {
     const std::int32_t k = batch.contact[c], i = batch.owner[c];
@@ -142,7 +143,7 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
       s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
       s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
       pf.active[k] = 1;
-      pf.fx[k] = fx, pf.fy[k] = fy, pf.fz[k] = fz;
+      if (keep_forces) pf.fx[k] = fx, pf.fy[k] = fy, pf.fz[k] = fz;
     } else {
       wf.active[k] = 1;
       wf.fx[k] = fx, wf.fy[k] = fy, wf.fz[k] = fz;
@@ -300,6 +301,8 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const std::int32_t owned = static_cast<std::int32_t>(n);
   const long block = work.block, blocks = (n + block - 1) / block;
   work.packed.resize(4 * static_cast<size_t>(n_all));
+  if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
+    for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
 #pragma omp parallel if (n >= kParallelMin)
   {
 #pragma omp for schedule(static)

@@ -345,7 +345,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
       if (s.body[p] >= 0) work.body_members[cursor[s.body[p]]++] = static_cast<std::int32_t>(p);
   }
   PairForces& pf = work.pair_forces;
-  for (auto* c : {&pf.fx, &pf.fy, &pf.fz}) c->assign(s.pairs.size(), 0.0);
+  for (auto* c : {&pf.fx, &pf.fy, &pf.fz}) c->assign(work.keep_pair_forces ? s.pairs.size() : 0, 0.0);
   pf.active.assign(s.pairs.size(), 0);
   work.wall_forces.resize(s.wall_pairs.size());
   // A contact with a history counts as active until it is next evaluated: the contact loop

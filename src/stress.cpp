@@ -2,11 +2,15 @@
 
 #include "neighbors.h"
 
+#include <stdexcept>
+
 namespace dem {
 
 Eigen::Matrix3d contact_stress(const Model& model, const State& s, const Workspace& work, double volume, bool with_walls) {
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();  // [N m]
   const PairForces& pf = work.pair_forces;
+  if (!work.keep_pair_forces || pf.fx.size() != s.pairs.size())
+    throw std::logic_error("contact_stress: the pair forces were not kept (set Workspace::keep_pair_forces before the step)");
   for (size_t k = 0; k < s.pairs.size(); ++k) {
     if (!pf.active[k]) continue;
     const size_t i = s.pairs.i[k], j = s.pairs.j[k];

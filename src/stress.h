@@ -15,7 +15,8 @@
 namespace dem {
 
 /// Contact stress [Pa] of all contacts (particle pairs and, if `with_walls`, wall contacts),
-/// over the sample volume `volume` [m^3]. Uses the forces of the last evaluation.
+/// over the sample volume `volume` [m^3]. Uses the forces of the last evaluation, which keeps
+/// them only when Workspace::keep_pair_forces was set before it (else std::logic_error).
 Eigen::Matrix3d contact_stress(const Model& model, const State& state, const Workspace& work, double volume,
                                bool with_walls = true);
 

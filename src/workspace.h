@@ -22,7 +22,8 @@ struct ContactForces {
 };
 
 /// Particle pairs, by pair k: whether the contact acted at the last evaluation and its force on
-/// body i (body j received minus this). Per pair: 3 doubles + 1 byte = 25 bytes.
+/// body i (body j received minus this). The forces are kept only where asked for
+/// (Workspace::keep_pair_forces): 1 byte per listed pair, else 25.
 struct PairForces {
   std::vector<std::uint8_t> active;  ///< 1 when the contact exerted a force this step
   std::vector<double> fx, fy, fz;    // [N] on body i
@@ -60,6 +61,9 @@ struct Workspace {
   std::vector<std::int32_t> ghost_owners;
 
   PairForces pair_forces;
+  /// Keep each pair's force (pair_forces.fx, fy, fz; for contact_stress): 24 bytes per listed
+  /// pair, most of them idle pairs of the skin, and written every step; off unless asked for.
+  bool keep_pair_forces = false;
   ContactForces wall_forces;
 
   // Meshes where they are at the time forces are evaluated: x_world = R x_local + T, and the
