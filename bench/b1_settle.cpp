@@ -123,11 +123,21 @@ std::size_t pair_forces_bytes(const dem::PairForces& f) {
   return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.active);
 }
 
+/// The buffers a rebuild keeps between calls: partners and mesh candidates per thread, the sort's gathers.
+std::size_t scratch_bytes(const dem::Workspace& w) {
+  std::size_t b = 0;
+  for (const auto& v : w.partner_scratch) b += bytes(v);
+  for (const auto& v : w.candidate_scratch) b += bytes(v);
+  const dem::PermuteScratch& p = w.permute_scratch;
+  return b + bytes(p.f64) + bytes(p.slots_f64) + bytes(p.history) + bytes(p.i32) + bytes(p.slots_i32) + bytes(p.i64) +
+         bytes(p.u8);
+}
+
 std::size_t workspace_bytes(const dem::Workspace& w) {
   return bytes(w.pair_begin) +
          bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order) +
-         bytes(w.members) + bytes(w.ghost_owners) + bytes(w.packed);
+         bytes(w.members) + bytes(w.ghost_owners) + bytes(w.packed) + scratch_bytes(w);
 }
 
 /// Touching particle-particle pairs (overlap > 0).
