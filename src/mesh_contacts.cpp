@@ -118,7 +118,7 @@ void flush(const Model& model, MeshBatch& mb, State& s, ContactForces& out, Mesh
     slot_results.fn[k] = b.fn[c];
     slot_results.shear_power[k] = std::abs(b.ftx[c] * b.vtx[c] + b.fty[c] * b.vty[c] + b.ftz[c] * b.vtz[c]);
     slot_results.cx[k] = mb.point[c][0], slot_results.cy[k] = mb.point[c][1], slot_results.cz[k] = mb.point[c][2];
-    slot_results.vx[k] = mb.wall_v[c][0], slot_results.vy[k] = mb.wall_v[c][1], slot_results.vz[k] = mb.wall_v[c][2];
+    slot_results.wall_power[k] = fx * mb.wall_v[c][0] + fy * mb.wall_v[c][1] + fz * mb.wall_v[c][2];
   }
   b.count = 0;
 }
@@ -358,7 +358,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
       double torque[3];
       cross(arm, force_on_mesh, torque);
       loads.tx[m] += torque[0], loads.ty[m] += torque[1], loads.tz[m] += torque[2];
-      loads.power[m] += ftx * slot_results.vx[slot] + fty * slot_results.vy[slot] + ftz * slot_results.vz[slot];
+      loads.power[m] += slot_results.wall_power[slot];
     }
   }
 }

@@ -36,12 +36,12 @@ struct MeshSlotResults {
   std::vector<double> fn;             // [N] normal force
   std::vector<double> shear_power;    // [W] |Ft . v_slip|
   std::vector<double> cx, cy, cz;     // [m] contact point, world
-  std::vector<double> vx, vy, vz;     // [m/s] wall velocity at the contact
+  std::vector<double> wall_power;     // [W] F . v_wall, F the force on the particle, v_wall the wall's velocity at the contact
   std::vector<double> impact_energy;  // [J] 1/2 m* vn^2 when the contact started this step, else -1
   /// A slot is written before it is read (slots beyond a particle's count never are), so the
   /// columns are not filled.
   void resize(std::size_t n) {
-    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &vx, &vy, &vz, &impact_energy}) c->resize(n);
+    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &wall_power, &impact_energy}) c->resize(n);
   }
 };
 
