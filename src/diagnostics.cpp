@@ -112,8 +112,8 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
   if (s.has_meshes)  // mesh contacts of the last evaluation: overlap = r - distance to the contact point
     for (size_t p = 0; p < s.size(); ++p)
       for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
-        const size_t slot = p * MeshContacts::kSlots + k;
-        const double dx = s.x[p] - work.mesh_slots.cx[slot], dy = s.y[p] - work.mesh_slots.cy[slot], dz = s.z[p] - work.mesh_slots.cz[slot];
+        const size_t at = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);  // results by candidate
+        const double dx = s.x[p] - work.mesh_slots.cx[at], dy = s.y[p] - work.mesh_slots.cy[at], dz = s.z[p] - work.mesh_slots.cz[at];
         count(s.radius[p] - std::sqrt(dx * dx + dy * dy + dz * dz), s.radius[p]);
       }
   out.mean_overlap_ratio = out.contacts ? sum / static_cast<double>(out.contacts) : 0.0;

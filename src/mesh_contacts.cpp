@@ -92,7 +92,8 @@ int resolve_contacts(const TriangleSurface& surface, std::vector<Candidate>& lis
 /// Per-thread batch of mesh contacts and where each goes.
 struct MeshBatch {
   ContactBatch b;
-  std::int32_t slot[kBatch];   // p * kSlots + k
+  std::int32_t slot[kBatch];   // p * kSlots + k: the contact's slot in State::mesh_contacts
+  std::int32_t result[kBatch]; // candidate_begin[p] + k: where its results go (Workspace::mesh_forces, mesh_slots)
   double lever[kBatch];        // [m]
   double wall_v[kBatch][3];    // [m/s] wall velocity at the contact
   double point[kBatch][3];     // [m] contact point, world
@@ -104,8 +105,8 @@ void flush(const Model& model, MeshBatch& mb, State& s, ContactForces& out, Mesh
   ContactBatch& b = mb.b;
   evaluate_effects(model, b);
   for (int c = 0; c < b.count; ++c) {
-    const std::int32_t k = mb.slot[c];
-    const std::size_t p = static_cast<std::size_t>(k) / kSlots;
+    const std::int32_t k = mb.result[c];
+    const std::size_t p = static_cast<std::size_t>(mb.slot[c]) / kSlots;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double fx = b.fn[c] * nx + b.ftx[c], fy = b.fn[c] * ny + b.fty[c], fz = b.fn[c] * nz + b.ftz[c];
     out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
@@ -185,11 +186,15 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   MeshContacts& mc = s.mesh_contacts;
   if (model.meshes.empty()) return;
   MeshSlotResults& slot_results = work.mesh_slots;
-  if (work.mesh_forces.fx.size() != s.size() * kSlots) {  // written below before read: no fill
+  // Results by candidate: contact k of particle p at candidate_begin[p] + k (a particle has no
+  // more contacts than candidates), not one row per slot: most particles touch no wall. Written
+  // below before they are read, so not filled.
+  const size_t results = s.mesh_candidates.size();
+  if (work.mesh_forces.fx.size() != results) {
     ContactForces& f = work.mesh_forces;
-    for (auto* c : {&f.fx, &f.fy, &f.fz}) c->resize(s.size() * kSlots);
-    f.active.resize(s.size() * kSlots);
-    slot_results.resize(s.size() * kSlots);
+    for (auto* c : {&f.fx, &f.fy, &f.fz}) c->resize(results);
+    f.active.resize(results);
+    slot_results.resize(results);
   }
   const double range = model.interaction_range;
   const long nl = static_cast<long>(n);
@@ -316,15 +321,16 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
           b.m_eff[e] = 1.0 / s.inv_mass[p];
           b.inertia_eff[e] = 1.4 * radius * radius / s.inv_mass[p];
           b.history[e] = width ? &mc.history[slot * width] : old_history.data();
+          const size_t at = static_cast<size_t>(first) + static_cast<size_t>(count);  // results
           mb.slot[e] = static_cast<std::int32_t>(slot);
+          mb.result[e] = static_cast<std::int32_t>(at);
           mb.lever[e] = lever;
           for (int a = 0; a < 3; ++a) mb.wall_v[e][a] = wall_v[a], mb.point[e][a] = point[a];
-          slot_results.impact_energy[slot] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
+          slot_results.impact_energy[at] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
           ++count;
         }
       }
       mc.count[p] = static_cast<std::uint8_t>(count);
-      for (int k = count; k < kSlots; ++k) work.mesh_forces.active[static_cast<size_t>(p) * kSlots + k] = 0;
     }
     if (mb.b.count) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
   }
@@ -336,29 +342,29 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   const ContactForces& f = work.mesh_forces;
   for (size_t p = 0; p < n; ++p) {
     for (int k = 0; k < mc.count[p]; ++k) {
-      const size_t slot = p * kSlots + k;
-      if (!f.active[slot]) continue;
+      const size_t slot = p * kSlots + k, at = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);
+      if (!f.active[at]) continue;
       const std::int32_t m = mc.mesh[slot], t = mc.triangle[slot];
       TriangleRecords& r = s.records[m];
       const bool record = work.mesh_time >= model.output.records_from;
-      const double fn = slot_results.fn[slot];
-      const double ftx = f.fx[slot], fty = f.fy[slot], ftz = f.fz[slot];
+      const double fn = slot_results.fn[at];
+      const double ftx = f.fx[at], fty = f.fy[at], ftz = f.fz[at];
       const double total = std::sqrt(ftx * ftx + fty * fty + ftz * ftz);
       if (record) {
         r.normal_impulse[t] += std::max(fn, 0.0) * dt;
         r.shear_impulse[t] += std::sqrt(std::max(total * total - fn * fn, 0.0)) * dt;
-        r.shear_work[t] += slot_results.shear_power[slot] * dt;
-        if (slot_results.impact_energy[slot] >= 0) r.impacts[t] += 1.0, r.impact_energy[t] += slot_results.impact_energy[slot];
+        r.shear_work[t] += slot_results.shear_power[at] * dt;
+        if (slot_results.impact_energy[at] >= 0) r.impacts[t] += 1.0, r.impact_energy[t] += slot_results.impact_energy[at];
       }
       // The particle pushes the mesh with -F; torque about the motion origin; power F . v_wall.
       loads.fx[m] -= ftx, loads.fy[m] -= fty, loads.fz[m] -= ftz;
-      const double arm[3] = {slot_results.cx[slot] - work.mesh_origin[m][0], slot_results.cy[slot] - work.mesh_origin[m][1],
-                             slot_results.cz[slot] - work.mesh_origin[m][2]};
+      const double arm[3] = {slot_results.cx[at] - work.mesh_origin[m][0], slot_results.cy[at] - work.mesh_origin[m][1],
+                             slot_results.cz[at] - work.mesh_origin[m][2]};
       const double force_on_mesh[3] = {-ftx, -fty, -ftz};
       double torque[3];
       cross(arm, force_on_mesh, torque);
       loads.tx[m] += torque[0], loads.ty[m] += torque[1], loads.tz[m] += torque[2];
-      loads.power[m] += slot_results.wall_power[slot];
+      loads.power[m] += slot_results.wall_power[at];
     }
   }
 }

@@ -31,7 +31,8 @@ struct PairForces {
   double force(std::size_t k, int axis) const { return axis == 0 ? fx[k] : axis == 1 ? fy[k] : fz[k]; }
 };
 
-/// Per mesh-contact slot, what the records of triangles and meshes need from the evaluation.
+/// Per mesh contact (indexed as Workspace::mesh_forces), what the records of triangles and
+/// meshes need from the evaluation.
 struct MeshSlotResults {
   std::vector<double> fn;             // [N] normal force
   std::vector<double> shear_power;    // [W] |Ft . v_slip|
@@ -71,7 +72,7 @@ struct Workspace {
   double mesh_time = -1;  // [s]
   std::vector<std::array<double, 9>> mesh_rotation;  // row-major R
   std::vector<std::array<double, 3>> mesh_translation, mesh_linear, mesh_angular, mesh_origin;
-  ContactForces mesh_forces;  ///< per particle slot (n x MeshContacts::kSlots)
+  ContactForces mesh_forces;  ///< contact k of particle p at State::candidate_begin[p] + k (mesh_contacts.cpp)
   MeshSlotResults mesh_slots;
 
   // Spheres of each body: body_members[body_begin[b] ... body_begin[b+1]).

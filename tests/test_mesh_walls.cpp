@@ -254,7 +254,7 @@ BedLoads settle_in_cylinder(bool faceted, std::uint64_t seed) {
   for (size_t p = 0; p < sim.state.size(); ++p) out.weight += 9.81 / sim.state.inv_mass[p];
   if (faceted) {
     for (size_t p = 0; p < sim.state.size(); ++p)
-      for (int k = 0; k < sim.state.mesh_contacts.count[p]; ++k) out.side += sim.work.mesh_slots.fn[p * MeshContacts::kSlots + k];
+      for (int k = 0; k < sim.state.mesh_contacts.count[p]; ++k) out.side += sim.work.mesh_slots.fn[static_cast<size_t>(sim.state.candidate_begin[p]) + k];
   } else {
     for (size_t k = 0; k < sim.state.wall_pairs.size(); ++k)
       if (sim.state.wall_pairs.j[k] == 1 && sim.work.wall_forces.active[k]) {
