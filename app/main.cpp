@@ -16,6 +16,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "allocator.h"
 #include "calibration_commands.h"
 #include "diagnostics.h"
 #include "equipment.h"
@@ -289,6 +290,7 @@ std::string rank_prefix() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dem::tune_allocator();
   // MPI only when mpirun (or another MPI launcher) started this process; see app/mpi_campaign.h.
   dem::app::mpi::Session mpi_session(&argc, &argv);
   const dem::app::mpi::World& world = dem::app::mpi::world();

@@ -56,6 +56,7 @@
 #include <string>
 #include <vector>
 
+#include "allocator.h"
 #include "b1_spec.h"
 #include "diagnostics.h"
 #include "peak_memory.h"
@@ -273,6 +274,7 @@ std::vector<Row> run_size(long n, std::optional<std::int64_t> phase1, std::optio
 }  // namespace
 
 int main(int argc, char** argv) {
+  dem::tune_allocator();
   std::vector<long> sizes{20000, 100000};
   std::optional<std::int64_t> phase1, phase2;
   int threads = 0;

@@ -67,6 +67,7 @@
 #include <string>
 #include <vector>
 
+#include "allocator.h"
 #include "diagnostics.h"
 #include "peak_memory.h"
 #include "mesh_health.h"
@@ -357,6 +358,7 @@ Result run(std::int64_t fill_steps, std::int64_t run_steps) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dem::tune_allocator();
   std::int64_t fill_steps = 30000, run_steps = 3000;
   int threads = 0;
   for (int a = 1; a < argc; ++a) {

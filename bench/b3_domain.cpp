@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "allocator.h"
 #include "b1_spec.h"
 #include "diagnostics.h"
 #include "domain.h"
@@ -60,6 +61,7 @@ Options parse(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dem::tune_allocator();
   mpi::Session session(&argc, &argv);
   const mpi::World& world = mpi::world();
   const Options o = parse(argc, argv);

@@ -192,8 +192,8 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
   const size_t results = s.mesh_candidates.size();
   if (work.mesh_forces.fx.size() != results) {
     ContactForces& f = work.mesh_forces;
-    for (auto* c : {&f.fx, &f.fy, &f.fz}) c->resize(results);
-    f.active.resize(results);
+    for (auto* c : {&f.fx, &f.fy, &f.fz}) resize_discarding(*c, results);
+    resize_discarding(f.active, results);
     slot_results.resize(results);
   }
   const double range = model.interaction_range;

@@ -298,6 +298,11 @@ void ContactForces::resize(std::size_t n) {
 HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls) {
   HistoryRows out;
   if (width == 0) return out;
+  // Counted first and reserved exactly: grown by doubling, these rows (tens of MiB in a large
+  // bed) would hold up to twice their size at the rebuild's peak.
+  size_t count = 0;
+  for (size_t k = 0; k < list.size(); ++k) count += !row_is_zero(&list.history[k * width], width);
+  out.a.reserve(count), out.b.reserve(count), out.rows.reserve(count * width);
   for (size_t k = 0; k < list.size(); ++k) {
     const double* row = &list.history[k * width];
     if (row_is_zero(row, width)) continue;
@@ -346,7 +351,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   }
   PairForces& pf = work.pair_forces;
   for (auto* c : {&pf.fx, &pf.fy, &pf.fz}) c->assign(work.keep_pair_forces ? s.pairs.size() : 0, 0.0);
-  pf.active.assign(s.pairs.size(), 0);
+  assign_discarding(pf.active, s.pairs.size(), std::uint8_t{0});
   work.wall_forces.resize(s.wall_pairs.size());
   // A contact with a history counts as active until it is next evaluated: the contact loop
   // clears the history of an inactive contact only when it was active (idle pairs of the skin
@@ -453,7 +458,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   fill_rows(nl, nl >= kParallelMin, work.partner_scratch, work.pair_begin, s.pairs.j,
             [&](long i, std::vector<std::int32_t>& out, size_t m) { return finder.partners(static_cast<std::int32_t>(i), out, m); });
   work.pair_begin.resize(n + 1, work.pair_begin[nl]);
-  s.pairs.i.resize(s.pairs.j.size());
+  resize_discarding(s.pairs.i, s.pairs.j.size());
 #pragma omp parallel for schedule(static) if (nl >= kParallelMin)
   for (long i = 0; i < nl; ++i)
     std::fill(s.pairs.i.data() + work.pair_begin[i], s.pairs.i.data() + work.pair_begin[i + 1], static_cast<std::int32_t>(i));
@@ -475,53 +480,38 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     }
   }
 
-  // Carry histories to the new lists by particle id.
-  s.pairs.history.assign(n_pairs * width, 0.0);
+  // Carry histories to the new lists by particle id: each old row finds its pair in the new
+  // list's row of the lower slot (a handful of partners), so the carry needs no index of its own.
+  assign_discarding(s.pairs.history, n_pairs * width, 0.0);
   s.wall_pairs.history.assign(s.wall_pairs.size() * width, 0.0);
   if (width > 0 && (old_pairs.size() > 0 || old_walls.size() > 0)) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
-    // Old histories bucketed by the lower new slot of the pair (CSR: no allocation per slot),
-    // then each new pair looks through its slot's bucket. A pair whose bodies swapped roles
-    // (the old i is now j) takes its odd history negated.
-    struct Entry { std::int32_t other; size_t row; bool swapped; };
-    std::vector<std::int32_t> begin(n + 1);
-    std::vector<Entry> entries;
-    auto carry = [&](const HistoryRows& old, bool walls, ContactList& list) {
-      std::fill(begin.begin(), begin.end(), 0);
-      std::vector<std::array<std::int32_t, 3>> keyed;  // (lower slot, other, swapped), in the order of `old`
-      keyed.reserve(old.size());
+    build_csr(work.wall_begin, s.wall_pairs.i, n);
+    auto slot = [&](std::int64_t id) { return id >= 0 && id < s.next_id ? slot_of[id] : -1; };
+    // A pair whose bodies swapped roles (the old i is now j) takes its odd history negated.
+    auto carry = [&](const HistoryRows& old, bool walls, ContactList& list, const std::vector<std::int32_t>& begin) {
       for (size_t q = 0; q < old.size(); ++q) {
-        const std::int64_t id_b = old.b[q];
-        const std::int32_t a = old.a[q] < s.next_id ? slot_of[old.a[q]] : -1;
-        const std::int32_t b = walls ? static_cast<std::int32_t>(id_b) : id_b < s.next_id ? slot_of[id_b] : -1;
-        if (a < 0 || b < 0) {  // a particle left
-          keyed.push_back({-1, -1, 0});
-          continue;
+        const std::int32_t a = slot(old.a[q]);
+        const std::int32_t b = walls ? static_cast<std::int32_t>(old.b[q]) : slot(old.b[q]);
+        if (a < 0 || b < 0) continue;  // a particle left
+        const bool swapped = !walls && b < a;
+        const std::int32_t lower = swapped ? b : a, other = swapped ? a : b;
+        for (std::int32_t k = begin[lower]; k < begin[lower + 1]; ++k) {
+          if (list.j[k] != other) continue;
+          double* row = &list.history[static_cast<size_t>(k) * width];
+          std::memcpy(row, &old.rows[q * width], width * sizeof(double));
+          if (swapped)
+            for (int h = 0; h < width; ++h)
+              if (model.history_odd[h]) row[h] = -row[h];
+          break;
         }
-        keyed.push_back(walls || a < b ? std::array<std::int32_t, 3>{a, b, 0} : std::array<std::int32_t, 3>{b, a, 1});
-        ++begin[keyed.back()[0] + 1];
-      }
-      for (size_t p = 0; p < n; ++p) begin[p + 1] += begin[p];
-      entries.resize(static_cast<size_t>(begin[n]));
-      std::vector<std::int32_t> cursor(begin.begin(), begin.end() - 1);
-      for (size_t q = 0; q < old.size(); ++q)
-        if (keyed[q][0] >= 0) entries[cursor[keyed[q][0]]++] = {keyed[q][1], q, keyed[q][2] != 0};
-      for (size_t k = 0; k < list.size(); ++k) {
-        for (std::int32_t e = begin[list.i[k]]; e < begin[list.i[k] + 1]; ++e)
-          if (entries[e].other == list.j[k]) {
-            double* row = &list.history[k * width];
-            std::memcpy(row, &old.rows[entries[e].row * width], width * sizeof(double));
-            if (entries[e].swapped)
-              for (int q = 0; q < width; ++q)
-                if (model.history_odd[q]) row[q] = -row[q];
-            break;
-          }
       }
     };
-    carry(old_pairs, false, s.pairs);
-    carry(old_walls, true, s.wall_pairs);
+    carry(old_pairs, false, s.pairs, work.pair_begin);
+    carry(old_walls, true, s.wall_pairs, work.wall_begin);
   }
+  old_pairs = {}, old_walls = {};
 
   find_mesh_candidates(model, s, work, reach);
   s.x_built = s.x;

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "allocator.h"
+
 namespace dem {
 /// OpenMP policy: loops over fewer items than this run on one thread. Opening a parallel region
 /// costs microseconds and idle OpenMP threads spin; for a handful of particles that dominates.
@@ -64,7 +66,7 @@ void fill_rows(long rows, bool parallel, std::vector<std::vector<T>>& buffers, s
 #pragma omp single
     {
       for (long r = 0; r < rows; ++r) begin[r + 1] += begin[r];
-      out.resize(static_cast<size_t>(begin[rows]));
+      resize_discarding(out, static_cast<size_t>(begin[rows]));
     }
     std::copy_n(buffer.data(), m, out.data() + begin[lo]);
   }

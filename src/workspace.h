@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "allocator.h"
 #include "state.h"
 
 namespace dem {
@@ -42,7 +43,7 @@ struct MeshSlotResults {
   /// A slot is written before it is read (slots beyond a particle's count never are), so the
   /// columns are not filled.
   void resize(std::size_t n) {
-    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &wall_power, &impact_energy}) c->resize(n);
+    for (auto* c : {&fn, &shear_power, &cx, &cy, &cz, &wall_power, &impact_energy}) resize_discarding(*c, n);
   }
 };
 
