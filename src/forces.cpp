@@ -65,7 +65,7 @@ struct Batch {
 DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
   ContactBatch& b = batch.b;
   const double* radius = s.radius.data();
-  const double* inv_mass = s.inv_mass.data();
+  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
   const double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
   const double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
   const std::int32_t* material = s.material.data();
@@ -73,7 +73,13 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
   for (int c = 0; c < b.count; ++c) {
     const std::int32_t i = batch.owner[c], j = batch.other[c];
     const double ri = radius[i], rj = radius[j];
-    const double dist = std::sqrt(batch.dist2[c]), inv_dist = 1.0 / dist;
+    const double dist = std::sqrt(batch.dist2[c]);
+    // Four reciprocals from one division (the divider is the slow unit here): 1/dist, and those
+    // of the sums of radii, inverse masses and inverse moments of inertia.
+    const double sum_r = ri + rj, sum_m = inv_mass[i] + inv_mass[j], sum_ii = inv_inertia[i] + inv_inertia[j];
+    const double dr = dist * sum_r, mi = sum_m * sum_ii;
+    const double q = 1.0 / (dr * mi);
+    const double inv_dist = q * sum_r * mi, inv_sum_r = q * dist * mi, inv_sum_m = q * dr * sum_ii, inv_sum_ii = q * dr * sum_m;
     const double nx = batch.dx[c] * inv_dist, ny = batch.dy[c] * inv_dist, nz = batch.dz[c] * inv_dist;
     const double overlap = ri + rj - dist;
     const double lever_i = ri - 0.5 * overlap, lever_j = rj - 0.5 * overlap;
@@ -94,10 +100,10 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
     b.overlap[c] = overlap;
     b.radius_i[c] = ri;
     b.radius_j[c] = rj;
-    b.r_eff[c] = ri * rj / (ri + rj);
-    b.m_eff[c] = 1.0 / (inv_mass[i] + inv_mass[j]);
-    // Moments of inertia about the contact point, 7/5 m R^2 for a sphere.
-    b.inertia_eff[c] = 1.0 / (inv_mass[i] / (1.4 * ri * ri) + inv_mass[j] / (1.4 * rj * rj));
+    b.r_eff[c] = ri * rj * inv_sum_r;
+    b.m_eff[c] = inv_sum_m;
+    // Moments of inertia about the contact point, 7/5 m R^2 = 3.5 I for a sphere (I = 2/5 m R^2).
+    b.inertia_eff[c] = 3.5 * inv_sum_ii;
     batch.lever_i[c] = lever_i;
     batch.lever_j[c] = lever_j;
   }
@@ -179,9 +185,11 @@ void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
 /// pairs act; pair_geometry does the rest for a whole batch. Every listed pair is written to the
 /// next free entry and kept by advancing the count: whether a skin pair touches is a coin toss
 /// to the branch predictor, so the loop does not branch on it.
+/// kPeriodic: the model wraps an axis (minimum image); kGhosts: partners outside [lo, hi) are
+/// skipped (without ghosts every partner is an owned slot, and the test is left out).
+template <bool kPeriodic, bool kGhosts>
 void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi) {
   const int width = model.history_width;
-  const bool periodic = model.periodic();
   const double range = model.interaction_range;
   const double* packed = work.packed.data();  // x, y, z, radius of each slot
   const double xi = packed[4 * i], yi = packed[4 * i + 1], zi = packed[4 * i + 2], ri = packed[4 * i + 3];
@@ -190,10 +198,11 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
   int c = batch.b.count, first = c;  // entries [first, c) are i's
   for (std::int32_t k = work.pair_begin[i]; k < work.pair_begin[i + 1]; ++k) {
     const std::int32_t j = partner[k];
-    if (j < lo || j >= hi) continue;
+    if constexpr (kGhosts)
+      if (j < lo || j >= hi) continue;
     const double* pj = packed + 4 * static_cast<size_t>(j);
     double d[3] = {xi - pj[0], yi - pj[1], zi - pj[2]};
-    if (periodic) minimum_image(model, d);
+    if constexpr (kPeriodic) minimum_image(model, d);
     const double dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     const double reach = ri + pj[3] + range;
     const bool acts = dist2 < reach * reach;
@@ -248,6 +257,37 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   }
 }
 
+/// The contacts of the owned slots, block by block: the even blocks, then the odd ones (see the
+/// top of this file). Called by every thread of a parallel region.
+template <bool kPeriodic, bool kGhosts>
+void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
+  const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
+  for (long parity = 0; parity < 2; ++parity) {
+#pragma omp for schedule(dynamic, 1) nowait
+    for (long b = parity; b < blocks; b += 2) {
+      const long last = std::min(n, (b + 1) * block);
+      for (long i = b * block; i < last; ++i) {
+        particle_contacts<kPeriodic, kGhosts>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
+        wall_contacts(model, s, work, batch, i);
+      }
+    }
+    flush(model, batch, s, work);
+#pragma omp barrier
+  }
+}
+
+/// Slots [begin, end): forces and torques set to zero, and x, y, z, radius copied side by side
+/// for the list scan (`packed`).
+DEM_KERNEL void clear_and_pack(State& s, double* packed, long begin, long end) {
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data(), *radius = s.radius.data();
+  DEM_VECTOR_LOOP
+  for (long p = begin; p < end; ++p) {
+    fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;
+    packed[4 * p] = x[p], packed[4 * p + 1] = y[p], packed[4 * p + 2] = z[p], packed[4 * p + 3] = radius[p];
+  }
+}
+
 /// Adds gravity to the free spheres among slots [begin, end) and gives them the closing half
 /// kick (none when kick = 0). A body carries its own weight; a glued sphere is part of its wall,
 /// which has none.
@@ -299,36 +339,25 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const long n_all = static_cast<long>(s.size());
   const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
   const std::int32_t owned = static_cast<std::int32_t>(n);
-  const long block = work.block, blocks = (n + block - 1) / block;
   work.packed.resize(4 * static_cast<size_t>(n_all));
+  const bool periodic = model.periodic();
+  const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
 #pragma omp parallel if (n >= kParallelMin)
   {
 #pragma omp for schedule(static)
-    for (long p = 0; p < n_all; ++p) {
-      s.fx[p] = s.fy[p] = s.fz[p] = 0.0;
-      s.tx[p] = s.ty[p] = s.tz[p] = 0.0;
-      double* packed = &work.packed[4 * p];
-      packed[0] = s.x[p], packed[1] = s.y[p], packed[2] = s.z[p], packed[3] = s.radius[p];
-    }
+    for (long begin = 0; begin < n_all; begin += kChunk) clear_and_pack(s, work.packed.data(), begin, std::min(n_all, begin + kChunk));
     Batch batch;
-    for (long parity = 0; parity < 2; ++parity) {
-#pragma omp for schedule(dynamic, 1) nowait
-      for (long b = parity; b < blocks; b += 2) {
-        const long last = std::min(n, (b + 1) * block);
-        for (long i = b * block; i < last; ++i) {
-          particle_contacts(model, s, work, batch, i, 0, owned);
-          wall_contacts(model, s, work, batch, i);
-        }
-      }
-      flush(model, batch, s, work);
-#pragma omp barrier
-    }
+    if (periodic)
+      ghosts ? block_pass<true, true>(model, s, work, batch) : block_pass<true, false>(model, s, work, batch);
+    else
+      ghosts ? block_pass<false, true>(model, s, work, batch) : block_pass<false, false>(model, s, work, batch);
   }
   if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
     Batch batch;
-    for (const std::int32_t i : work.ghost_owners) particle_contacts(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+    for (const std::int32_t i : work.ghost_owners)
+      (periodic ? particle_contacts<true, true> : particle_contacts<false, true>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
     flush(model, batch, s, work);
   }
 
