@@ -148,30 +148,48 @@ TEST(BulkDensity, PouredSpheresPackBetweenLooseAndCloseAndDenserWithLessFriction
 
 // Lifted cylinder: spheres without rolling resistance on a plate spread into a sheet (no_heap,
 // angle 0, as the protocol says); rolling resistance makes a heap whose angle grows with it
-// (Wensrich & Katterfeld 2012: mu_r 0.1-0.3 gives 25-40 deg for spheres).
+// (Wensrich & Katterfeld 2012: mu_r 0.1-0.3 gives 25-40 deg for spheres). One 720-sphere heap
+// is one sample of a wide spread: over 6 packings the angle was 9.6 +- 5.7 deg (mean +- s.d.)
+// at mu_r 0.1 and 24.1 +- 4.6 deg at mu_r 0.3; a change of the engine that alters only the
+// last bits moved single heaps by up to 17 deg. So the means of 4 packings are compared (s.d.
+// of a mean 2.9 and 2.3 deg): mu_r 0.3 within 18-40 deg, steeper than mu_r 0.1 by more than
+// 5 deg, and no heap below the plate's level (a sphere the lifted cylinder held up once made
+// a heap read -80 deg).
 TEST(AngleOfRepose, NoHeapWithoutRollingResistanceAndSteeperWithIt) {
-  auto angle = [](double rolling, bool& no_heap) {
+  auto angle = [](double rolling, std::uint64_t seed, bool& no_heap) {
     MaterialModel m = beads(0.5, rolling, 0.3, 0.005);
     m.particle.youngs_modulus = 2e5;
     TestOptions options;
     options.size_factor = 0.5;
+    options.seed = seed;
     const SimulatedOutcome out = run_virtual_test(
         m, setup_of("angle_of_repose_cylinder", {{"cylinder_diameter", 0.10}, {"cylinder_height", 0.10}, {"fill_height", 0.08}, {"lift_speed", 0.05}},
                     {{"base", "steel"}}),
         options);
-    print(fmt::format("angle_of_repose mu_r {}", rolling), out);
+    print(fmt::format("angle_of_repose mu_r {} packing {}", rolling, seed), out);
     no_heap = flagged(out, "no_heap");
     return out.observables.at("angle_deg");
   };
-  bool none = false, low_flag = false, high_flag = false;
-  EXPECT_EQ(angle(0.0, none), 0.0);
+  bool none = false;
+  EXPECT_EQ(angle(0.0, 1, none), 0.0);
   EXPECT_TRUE(none);
-  const double low = angle(0.1, low_flag), high = angle(0.3, high_flag);
-  EXPECT_FALSE(low_flag);
-  EXPECT_FALSE(high_flag);
-  EXPECT_GT(high, 20);
+  auto mean_angle = [&](double rolling) {
+    double sum = 0;
+    constexpr int kPackings = 4;
+    for (std::uint64_t seed = 1; seed <= kPackings; ++seed) {
+      bool flag = false;
+      const double a = angle(rolling, seed, flag);
+      EXPECT_FALSE(flag) << "mu_r " << rolling << ", packing " << seed;
+      EXPECT_GT(a, 0.0) << "mu_r " << rolling << ", packing " << seed;
+      sum += a;
+    }
+    return sum / kPackings;
+  };
+  const double low = mean_angle(0.1), high = mean_angle(0.3);
+  std::printf("mean angle of repose over 4 packings: %.1f deg at mu_r 0.1, %.1f deg at mu_r 0.3\n", low, high);
+  EXPECT_GT(high, 18);
   EXPECT_LT(high, 40);
-  EXPECT_GT(high, low + 2);
+  EXPECT_GT(high, low + 5);
 }
 
 // Rotating drum (periodic axis): a rolling bed at friction 0.5, mu_r 0.1 lies at 20-45 deg
