@@ -282,15 +282,26 @@ TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
   const double ra = rate(whole), rb = rate(split);
   const double fa = mean_over(whole.rows, 0.45, 0.9, [](const Scalars& r) { return r.mesh_force[0]; });
   const double fb = mean_over(split.rows, 0.45, 0.9, [](const Scalars& r) { return r.mesh_force[0]; });
-  double wear_a = 0, wear_b = 0;
+  double wear_a = 0, wear_b = 0, impulse_a = 0, impulse_b = 0;
   for (double w : whole.whole.records[0].shear_work) wear_a += w;
   for (double w : split.whole.records[0].shear_work) wear_b += w;
-  std::printf("  discharge %.4g / %.4g kg/s, silo wall force %.4g / %.4g N, shear work on the silo %.4g / %.4g J, particles %zu / %zu\n",
-              ra, rb, fa, fb, wear_a, wear_b, whole.whole.size(), split.whole.size());
+  for (double w : whole.whole.records[0].normal_impulse) impulse_a += w;
+  for (double w : split.whole.records[0].normal_impulse) impulse_b += w;
+  std::printf("  discharge %.4g / %.4g kg/s, silo wall force %.4g / %.4g N, normal impulse on the silo %.5g / %.5g N s, "
+              "shear work on the silo %.4g / %.4g J, particles %zu / %zu\n",
+              ra, rb, fa, fb, impulse_a, impulse_b, wear_a, wear_b, whole.whole.size(), split.whole.size());
+  // The two runs are two realisations of a chaotic flow (the sums run in another order), and
+  // this small silo (orifice 5.8 bead diameters of 6 mm) flows in fits. Measured over 10 pairs of runs
+  // (2,460-2,540 beads, two engine builds), the split run's value less the whole run's, relative:
+  // discharge rate r.m.s. 9.5 % (largest 14 %), shear work 16 % (25 %), normal impulse 2.0 %
+  // (3.9 %), mean wall force about 1 %. Tolerances are about 3 r.m.s.: the normal impulse,
+  // summed over the triangles and the ranks, is the check that every rank's records count once
+  // (a rank missing would be -50 %, counted twice +100 %).
   EXPECT_GT(ra, 0.05) << "the silo must discharge for the test to mean anything";
-  EXPECT_NEAR(rb, ra, 0.08 * ra) << "discharge rate";
+  EXPECT_NEAR(rb, ra, 0.3 * ra) << "discharge rate";
   EXPECT_NEAR(fb, fa, 0.03 * fa) << "mean force on the silo";
-  EXPECT_NEAR(wear_b, wear_a, 0.1 * wear_a) << "friction work on the silo (wear records summed over the ranks)";
+  EXPECT_NEAR(impulse_b, impulse_a, 0.06 * impulse_a) << "normal impulse on the silo (wear records summed over the ranks)";
+  EXPECT_NEAR(wear_b, wear_a, 0.5 * wear_a) << "friction work on the silo";
   const Scalars& last = split.rows.back();
   EXPECT_EQ(static_cast<std::int64_t>(split.whole.size()) + last.lost, 2500 - [&] {
     std::int64_t removed = 0;
