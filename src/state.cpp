@@ -84,7 +84,11 @@ std::size_t State::add_body(double px, double py, double pz, const double q[4], 
 void State::attach(std::size_t sphere, std::size_t b, double ox, double oy, double oz) {
   body[sphere] = static_cast<std::int32_t>(b);
   offset_x[sphere] = ox, offset_y[sphere] = oy, offset_z[sphere] = oz;
-  inv_mass[sphere] = 1.0 / bodies.mass[b];  // contacts see the body's mass
+  // Contacts see the body's mass, and a moment of inertia 2/5 m_body r^2 about the sphere's
+  // centre (the reduced inertia of rolling resistance, forces.cpp, 7/5 m r^2 about the contact
+  // point). A sphere of a body is never integrated on its own.
+  inv_mass[sphere] = 1.0 / bodies.mass[b];
+  inv_inertia[sphere] = 1.0 / (0.4 * bodies.mass[b] * radius[sphere] * radius[sphere]);
 }
 
 std::size_t State::record_size() const {
