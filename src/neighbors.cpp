@@ -21,12 +21,13 @@ bool row_is_zero(const double* row, int width) {
   return true;
 }
 
-/// Removes spheres that left the domain (along non-periodic axes) or entered an outlet, with
-/// the whole body they belong to, and counts them.
-void remove_lost(const Model& model, State& state) {
-  if (!model.has_domain && model.outlets.empty()) return;
+/// Finds the spheres that left the domain (along non-periodic axes) or entered an outlet, with
+/// the whole body they belong to, and counts them: keep[p] = 0 for each. Returns whether any
+/// left; the caller drops them (State::compact, or the cell sort's permutation).
+bool find_lost(const Model& model, State& state, std::vector<std::uint8_t>& keep) {
   const size_t n = state.size();
-  std::vector<std::uint8_t> keep(n, 1);
+  keep.assign(n, 1);
+  if (!model.has_domain && model.outlets.empty()) return false;
   std::vector<std::int32_t> body_outlet(state.bodies.size(), -2);  // -2 kept, -1 lost, k outlet
   auto inside = [](double x, double y, double z, const auto& lo, const auto& hi) {
     return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
@@ -63,7 +64,7 @@ void remove_lost(const Model& model, State& state) {
       state.last_lost = {state.id[p], state.x[p], state.y[p], state.z[p], state.vx[p], state.vy[p], state.vz[p]};
     }
   }
-  if (!any) return;
+  if (!any) return false;
   for (size_t b = 0; b < body_outlet.size(); ++b) {
     if (body_outlet[b] == -2) continue;
     if (body_outlet[b] >= 0) {
@@ -76,7 +77,7 @@ void remove_lost(const Model& model, State& state) {
   }
   for (size_t p = 0; p < n; ++p)
     if (state.body[p] >= 0 && body_outlet[state.body[p]] != -2) keep[p] = 0;
-  state.compact(keep);
+  return true;
 }
 
 /// Cells along each axis; periodic axes span exactly one period, others the particles' extent.
@@ -108,11 +109,12 @@ struct Grid {
   }
 };
 
-Grid make_grid(const Model& model, const State& s, double cell) {
+Grid make_grid(const Model& model, const State& s, double cell, const std::uint8_t* keep = nullptr) {
   double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                   std::numeric_limits<double>::infinity()};
   double hi[3] = {-lo[0], -lo[1], -lo[2]};
   for (size_t p = 0; p < s.size(); ++p) {
+    if (keep && !keep[p]) continue;
     lo[0] = std::min(lo[0], s.x[p]), hi[0] = std::max(hi[0], s.x[p]);
     lo[1] = std::min(lo[1], s.y[p]), hi[1] = std::max(hi[1], s.y[p]);
     lo[2] = std::min(lo[2], s.z[p]), hi[2] = std::max(hi[2], s.z[p]);
@@ -276,7 +278,8 @@ struct PairFinder {
 /// entry; it is used as the cursor and then restored by shifting, so nothing is allocated.
 void scatter_by_cell(const std::vector<std::int32_t>& cell_of, size_t n, std::vector<std::int32_t>& cell_start,
                      std::vector<std::int32_t>& out) {
-  for (size_t p = 0; p < n; ++p) out[cell_start[cell_of[p]]++] = static_cast<std::int32_t>(p);
+  for (size_t p = 0; p < n; ++p)
+    if (cell_of[p] >= 0) out[cell_start[cell_of[p]]++] = static_cast<std::int32_t>(p);
   // Now cell_start[c] is where cell c ends, i.e. where c + 1 starts.
   std::copy_backward(cell_start.begin(), cell_start.end() - 1, cell_start.end());
   cell_start[0] = 0;
@@ -391,9 +394,18 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
 
   drop_ghosts(s);
   // Migration first: it carries particles across a periodic face the ranks share (the local
-  // model no longer wraps that axis), which remove_lost would take for particles that left.
+  // model no longer wraps that axis), which find_lost would take for particles that left.
   if (domain) domain->migrate(model, s, old_pairs, old_walls);
-  remove_lost(model, s);
+  // Spheres that left are dropped by the cell sort below, which gathers every column anyway;
+  // with bodies (renumbered) or nothing left, by State::compact.
+  std::vector<std::uint8_t>& keep = work.keep;
+  bool dropping = find_lost(model, s, keep);
+  size_t kept = dropping ? static_cast<size_t>(std::count(keep.begin(), keep.end(), std::uint8_t{1})) : s.size();
+  if (dropping && (s.bodies.size() > 0 || kept == 0)) {
+    s.compact(keep);
+    dropping = false;
+    keep.assign(s.size(), 1), kept = s.size();
+  }
   double radius_max = model.radius_max;
   for (size_t p = 0; p < s.size(); ++p) radius_max = std::max(radius_max, s.radius[p]);
   const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
@@ -403,18 +415,18 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   wrap_into_period(model, s);
   std::optional<Grid> sorted_by;
   if (s.size() > 0) {
-    sorted_by = make_grid(model, s, cell_size);
+    sorted_by = make_grid(model, s, cell_size, dropping ? keep.data() : nullptr);
     const Grid& grid = *sorted_by;
     const size_t owned = s.size();
     const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
     work.cell_of.resize(owned);
     work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
     for (size_t p = 0; p < owned; ++p) {
-      work.cell_of[p] = grid.index(s.x[p], s.y[p], s.z[p]);
-      ++work.cell_start[work.cell_of[p] + 1];
+      work.cell_of[p] = keep[p] ? grid.index(s.x[p], s.y[p], s.z[p]) : -1;
+      if (keep[p]) ++work.cell_start[work.cell_of[p] + 1];
     }
     for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
-    work.order.resize(owned);
+    work.order.resize(kept);  // the slots kept, by cell: the permutation drops the others
     scatter_by_cell(work.cell_of, owned, work.cell_start, work.order);
     s.permute(work.order, work.permute_scratch);
   }

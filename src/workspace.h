@@ -85,6 +85,7 @@ struct Workspace {
 
   // Cell grid scratch; members: slots by cell (only with ghosts, which are not sorted).
   std::vector<std::int32_t> cell_of, cell_start, order, members;
+  std::vector<std::uint8_t> keep;  ///< slots kept at a rebuild (0: left the domain or entered an outlet)
   /// Partners and mesh candidates found by each thread while the lists are built, and the
   /// buffers the particle sort gathers into (kept: a rebuild allocates nothing once grown).
   std::vector<std::vector<std::int32_t>> partner_scratch;
