@@ -268,7 +268,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
       const long last = std::min(n, (b + 1) * block);
       for (long i = b * block; i < last; ++i) {
         particle_contacts<kPeriodic, kGhosts>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
-        wall_contacts(model, s, work, batch, i);
+        if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
       }
     }
     flush(model, batch, s, work);

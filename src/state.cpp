@@ -1,5 +1,8 @@
 #include "state.h"
 
+#include "allocator.h"
+#include "parallel.h"
+
 #include <algorithm>
 #include <cstddef>
 #include <numbers>
@@ -9,10 +12,16 @@ using std::size_t;
 namespace dem {
 
 namespace {
+// The gathers are called by every thread of a parallel region (State::permute): each gathers
+// its share of the slots, then one thread swaps the column with the scratch it was gathered into.
 template <typename T>
 void apply_order(std::vector<T>& column, const std::vector<std::int32_t>& order, std::vector<T>& scratch) {
-  scratch.resize(order.size());
-  for (size_t k = 0; k < order.size(); ++k) scratch[k] = column[order[k]];
+#pragma omp single
+  resize_discarding(scratch, order.size());
+  const long n = static_cast<long>(order.size());
+#pragma omp for schedule(static)
+  for (long k = 0; k < n; ++k) scratch[k] = column[order[k]];
+#pragma omp single
   column.swap(scratch);
 }
 /// Same for the mesh-contact columns: `per_slot` entries for each of a particle's kSlots slots,
@@ -22,11 +31,15 @@ void apply_order_slots(std::vector<T>& column, const std::vector<std::int32_t>& 
                        size_t per_slot, std::vector<T>& scratch) {
   const size_t stride = MeshContacts::kSlots * per_slot;
   if (stride == 0) return;
-  scratch.resize(order.size() * stride);
-  for (size_t k = 0; k < order.size(); ++k) {
+#pragma omp single
+  resize_discarding(scratch, order.size() * stride);
+  const long n = static_cast<long>(order.size());
+#pragma omp for schedule(static)
+  for (long k = 0; k < n; ++k) {
     const size_t from = static_cast<size_t>(order[k]);
     std::copy_n(column.data() + from * stride, used[from] * per_slot, scratch.data() + k * stride);
   }
+#pragma omp single
   column.swap(scratch);
 }
 template <typename T>
@@ -147,17 +160,21 @@ std::size_t State::unpack_body(const double* in) {
 }
 
 void State::permute(const std::vector<std::int32_t>& order, PermuteScratch& scratch) {
-  for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
-    apply_order(*c, order, scratch.f64);
-  for (auto* c : {&offset_x, &offset_y, &offset_z}) apply_order(*c, order, scratch.f64);
-  for (auto* c : {&material, &body, &attached}) apply_order(*c, order, scratch.i32);
-  apply_order(id, order, scratch.i64);
   MeshContacts& mc = mesh_contacts;
-  if (!has_meshes) return;
-  for (auto* c : {&mc.mesh, &mc.triangle}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_i32);
-  for (auto* c : {&mc.px, &mc.py, &mc.pz}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_f64);
-  apply_order_slots(mc.history, order, mc.count, static_cast<size_t>(mesh_history_width), scratch.history);
-  apply_order(mc.count, order, scratch.u8);
+#pragma omp parallel if (static_cast<long>(order.size()) >= kParallelMin)
+  {
+    for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
+      apply_order(*c, order, scratch.f64);
+    for (auto* c : {&offset_x, &offset_y, &offset_z}) apply_order(*c, order, scratch.f64);
+    for (auto* c : {&material, &body, &attached}) apply_order(*c, order, scratch.i32);
+    apply_order(id, order, scratch.i64);
+    if (has_meshes) {
+      for (auto* c : {&mc.mesh, &mc.triangle}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_i32);
+      for (auto* c : {&mc.px, &mc.py, &mc.pz}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_f64);
+      apply_order_slots(mc.history, order, mc.count, static_cast<size_t>(mesh_history_width), scratch.history);
+      apply_order(mc.count, order, scratch.u8);
+    }
+  }
 }
 
 void State::compact(const std::vector<std::uint8_t>& keep) {
