@@ -236,6 +236,12 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
         for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
           const std::int32_t t = s.mesh_candidates[q][1];
           const auto& tri = surface.triangles[t];
+          // The plane's distance bounds the triangle's from below: most candidates of a sphere
+          // moving over a surface are out of reach of its plane, and cost a dot product.
+          const double* v0 = surface.vertices[tri[0]].data();
+          const double* normal = surface.normals[t].data();
+          const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
+          if (above * above >= reach2) continue;
           const ClosestPoint cp = closest_point_on_triangle(local, surface.vertices[tri[0]].data(), surface.vertices[tri[1]].data(),
                                                             surface.vertices[tri[2]].data());
           if (cp.distance2 < reach2) list.push_back({t, cp});
