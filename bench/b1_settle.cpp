@@ -138,7 +138,7 @@ std::size_t workspace_bytes(const dem::Workspace& w) {
   return bytes(w.pair_begin) +
          bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order) +
-         bytes(w.members) + bytes(w.ghost_owners) + bytes(w.packed) + scratch_bytes(w);
+         bytes(w.members) + bytes(w.ghost_owners) + scratch_bytes(w);
 }
 
 /// Touching particle-particle pairs (overlap > 0).

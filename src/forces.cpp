@@ -15,9 +15,10 @@
 //
 // A contact passes three stages (measured with perf on B1; each change kept the results
 // bitwise the same):
-//   1. the list scan (particle_contacts): distance of every listed pair, from `packed` copies of
-//      x, y, z and radius (one cache line per partner instead of four; +5 %). Every pair is written
-//      to the next batch entry and kept by advancing the count, with no branch on whether it
+//   1. the list scan (particle_contacts): distance of every listed pair, from the x, y, z and
+//      radius columns (a copy of the four side by side, one cache line per partner, was 5 % faster
+//      when the contact pass was slower; after it became faster, the copy's pass cost more than it
+//      saved: B1 +3 %, B2 +3 % without). Every pair is written to the next batch entry and kept by advancing the count, with no branch on whether it
 //      touches: for the pairs of the skin that is a coin toss the branch predictor loses (+4 %);
 //   2. pair_geometry over the whole batch, vectorised (normal, overlap, relative motion, reduced
 //      radius, mass and inertia: the square roots and divisions of a contact);
@@ -191,8 +192,8 @@ template <bool kPeriodic, bool kGhosts>
 void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi) {
   const int width = model.history_width;
   const double range = model.interaction_range;
-  const double* packed = work.packed.data();  // x, y, z, radius of each slot
-  const double xi = packed[4 * i], yi = packed[4 * i + 1], zi = packed[4 * i + 2], ri = packed[4 * i + 3];
+  const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
+  const double xi = px[i], yi = py[i], zi = pz[i], ri = pr[i];
   const std::int32_t* partner = s.pairs.j.data();
   std::uint8_t* active = work.pair_forces.active.data();
   int c = batch.b.count, first = c;  // entries [first, c) are i's
@@ -200,11 +201,10 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     const std::int32_t j = partner[k];
     if constexpr (kGhosts)
       if (j < lo || j >= hi) continue;
-    const double* pj = packed + 4 * static_cast<size_t>(j);
-    double d[3] = {xi - pj[0], yi - pj[1], zi - pj[2]};
+    double d[3] = {xi - px[j], yi - py[j], zi - pz[j]};
     if constexpr (kPeriodic) minimum_image(model, d);
     const double dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    const double reach = ri + pj[3] + range;
+    const double reach = ri + pr[j] + range;
     const bool acts = dist2 < reach * reach;
     batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
     batch.contact[c] = k;
@@ -276,16 +276,11 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
   }
 }
 
-/// Slots [begin, end): forces and torques set to zero, and x, y, z, radius copied side by side
-/// for the list scan (`packed`).
-DEM_KERNEL void clear_and_pack(State& s, double* packed, long begin, long end) {
+/// Slots [begin, end): forces and torques set to zero.
+DEM_KERNEL void clear_loads(State& s, long begin, long end) {
   double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
-  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data(), *radius = s.radius.data();
   DEM_VECTOR_LOOP
-  for (long p = begin; p < end; ++p) {
-    fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;
-    packed[4 * p] = x[p], packed[4 * p + 1] = y[p], packed[4 * p + 2] = z[p], packed[4 * p + 3] = radius[p];
-  }
+  for (long p = begin; p < end; ++p) fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;
 }
 
 /// Adds gravity to the free spheres among slots [begin, end) and gives them the closing half
@@ -339,7 +334,6 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const long n_all = static_cast<long>(s.size());
   const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
   const std::int32_t owned = static_cast<std::int32_t>(n);
-  work.packed.resize(4 * static_cast<size_t>(n_all));
   const bool periodic = model.periodic();
   const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
@@ -347,7 +341,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 #pragma omp parallel if (n >= kParallelMin)
   {
 #pragma omp for schedule(static)
-    for (long begin = 0; begin < n_all; begin += kChunk) clear_and_pack(s, work.packed.data(), begin, std::min(n_all, begin + kChunk));
+    for (long begin = 0; begin < n_all; begin += kChunk) clear_loads(s, begin, std::min(n_all, begin + kChunk));
     Batch batch;
     if (periodic)
       ghosts ? block_pass<true, true>(model, s, work, batch) : block_pass<true, false>(model, s, work, batch);

@@ -79,10 +79,6 @@ struct Workspace {
   // Spheres of each body: body_members[body_begin[b] ... body_begin[b+1]).
   std::vector<std::int32_t> body_begin, body_members;
 
-  /// x, y, z and radius of each slot side by side [m], written at the start of every force
-  /// evaluation: the partner of a listed pair is then one cache line, not four.
-  std::vector<double> packed;
-
   // Cell grid scratch; members: slots by cell (only with ghosts, which are not sorted).
   std::vector<std::int32_t> cell_of, cell_start, order, members;
   std::vector<std::uint8_t> keep;  ///< slots kept at a rebuild (0: left the domain or entered an outlet)
