@@ -178,7 +178,8 @@ void set_load(ContactBatch& b) {
 void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
   if (!active) return;
   active = 0;
-  std::fill_n(&list.history[k * width], width, 0.0);
+  double* row = &list.history[k * width];
+  for (int q = 0; q < width; ++q) row[q] = 0.0;
 }
 
 /// The pairs of slot i with partners j in [lo, hi): owned partners in the parallel block pass,
