@@ -14,12 +14,13 @@
 // closing half kick of the step runs in the pass that adds gravity.
 //
 // A contact passes three stages (measured with perf on B1; each change kept the results
-// bitwise the same):
+// bitwise the same, except the one-division pair geometry, which changed the last bits):
 //   1. the list scan (particle_contacts): distance of every listed pair, from the x, y, z and
-//      radius columns (a copy of the four side by side, one cache line per partner, was 5 % faster
-//      when the contact pass was slower; after it became faster, the copy's pass cost more than it
-//      saved: B1 +3 %, B2 +3 % without). Every pair is written to the next batch entry and kept by advancing the count, with no branch on whether it
-//      touches: for the pairs of the skin that is a coin toss the branch predictor loses (+4 %);
+//      radius columns (a copy of the four side by side, one cache line per partner, was 5 %
+//      faster while the contact pass was slower; later its pass cost more than it saved: B1 and
+//      B2 +3 % without it). Every pair is written to the next batch entry and kept by advancing
+//      the count, with no branch on whether it touches: for the pairs of the skin that is a coin
+//      toss the branch predictor loses (+4 %);
 //   2. pair_geometry over the whole batch, vectorised (normal, overlap, relative motion, reduced
 //      radius, mass and inertia: the square roots and divisions of a contact);
 //   3. the effects' kernels over the batch columns (vectorised, effect.h), then the loads added to
@@ -178,8 +179,7 @@ void set_load(ContactBatch& b) {
 void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
   if (!active) return;
   active = 0;
-  double* row = &list.history[k * width];
-  for (int q = 0; q < width; ++q) row[q] = 0.0;
+  std::fill_n(&list.history[k * width], width, 0.0);
 }
 
 /// The pairs of slot i with partners j in [lo, hi): owned partners in the parallel block pass,

@@ -242,8 +242,7 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
           const double* normal = surface.normals[t].data();
           const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
           if (above * above >= reach2) continue;
-          const ClosestPoint cp = closest_point_on_triangle(local, surface.vertices[tri[0]].data(), surface.vertices[tri[1]].data(),
-                                                            surface.vertices[tri[2]].data());
+          const ClosestPoint cp = closest_point_on_triangle(local, v0, surface.vertices[tri[1]].data(), surface.vertices[tri[2]].data());
           if (cp.distance2 < reach2) list.push_back({t, cp});
         }
         const int kept = resolve_contacts(surface, list, radius);

@@ -399,13 +399,11 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   // Spheres that left are dropped by the cell sort below, which gathers every column anyway;
   // with bodies (renumbered) or nothing left, by State::compact.
   std::vector<std::uint8_t>& keep = work.keep;
-  bool dropping = find_lost(model, s, keep);
-  size_t kept = dropping ? static_cast<size_t>(std::count(keep.begin(), keep.end(), std::uint8_t{1})) : s.size();
-  if (dropping && (s.bodies.size() > 0 || kept == 0)) {
+  if (find_lost(model, s, keep) && (s.bodies.size() > 0 || std::find(keep.begin(), keep.end(), 1) == keep.end())) {
     s.compact(keep);
-    dropping = false;
-    keep.assign(s.size(), 1), kept = s.size();
+    keep.assign(s.size(), 1);
   }
+  const size_t kept = static_cast<size_t>(std::count(keep.begin(), keep.end(), 1));
   double radius_max = model.radius_max;
   for (size_t p = 0; p < s.size(); ++p) radius_max = std::max(radius_max, s.radius[p]);
   const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
@@ -415,7 +413,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   wrap_into_period(model, s);
   std::optional<Grid> sorted_by;
   if (s.size() > 0) {
-    sorted_by = make_grid(model, s, cell_size, dropping ? keep.data() : nullptr);
+    sorted_by = make_grid(model, s, cell_size, keep.data());
     const Grid& grid = *sorted_by;
     const size_t owned = s.size();
     const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
