@@ -15,12 +15,14 @@
 //
 // A contact passes three stages (measured with perf on B1; each change kept the results
 // bitwise the same, except the one-division pair geometry, which changed the last bits):
-//   1. the list scan (particle_contacts): distance of every listed pair, from the x, y, z and
+//   1. the list scan (particle_contacts): distance of every pair read, from the x, y, z and
 //      radius columns (a copy of the four side by side, one cache line per partner, was 5 %
 //      faster while the contact pass was slower; later its pass cost more than it saved: B1 and
 //      B2 +3 % without it). Every pair is written to the next batch entry and kept by advancing
 //      the count, with no branch on whether it touches: for the pairs of the skin that is a coin
-//      toss the branch predictor loses (+4 %);
+//      toss the branch predictor loses (+4 %). Most steps read only the near pairs (gap under a
+//      tenth of the skin at the last full scan; Workspace::NearPairs): B1 dense +15-25 %,
+//      settle +8-10 %, B2 unchanged (its spheres move a tenth of the skin in a few steps);
 //   2. pair_geometry over the whole batch, vectorised (normal, overlap, relative motion, reduced
 //      radius, mass and inertia: the square roots and divisions of a contact);
 //   3. the effects' kernels over the batch columns (vectorised, effect.h), then the loads added to
@@ -182,24 +184,39 @@ void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
   std::fill_n(&list.history[k * width], width, 0.0);
 }
 
+/// How the contact pass reads the pair list (Workspace::NearPairs):
+///   kAll      every listed pair (the pairs with ghosts);
+///   kRefresh  every listed pair, and slot i's near pairs and position written as it goes;
+///   kNear     slot i's near pairs only (step() found no free sphere moved margin/2 since).
+/// The pairs left out of the near rows cannot touch before the next full scan, and any of them
+/// that was active was cleared by that scan, so the three read the same batches.
+enum class Scan { kAll, kRefresh, kNear };
+
 /// The pairs of slot i with partners j in [lo, hi): owned partners in the parallel block pass,
 /// ghosts in a pass of their own (a ghost may touch spheres of several blocks). Only finds which
-/// pairs act; pair_geometry does the rest for a whole batch. Every listed pair is written to the
+/// pairs act; pair_geometry does the rest for a whole batch. Every pair read is written to the
 /// next free entry and kept by advancing the count: whether a skin pair touches is a coin toss
 /// to the branch predictor, so the loop does not branch on it.
 /// kPeriodic: the model wraps an axis (minimum image); kGhosts: partners outside [lo, hi) are
 /// skipped (without ghosts every partner is an owned slot, and the test is left out).
-template <bool kPeriodic, bool kGhosts>
+template <bool kPeriodic, bool kGhosts, Scan kScan>
 void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi) {
   const int width = model.history_width;
   const double range = model.interaction_range;
   const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
   const double xi = px[i], yi = py[i], zi = pz[i], ri = pr[i];
-  const std::int32_t* partner = s.pairs.j.data();
+  Workspace::NearPairs& near = work.near;
+  const std::int32_t* partner = kScan == Scan::kNear ? near.j.data() : s.pairs.j.data();
+  const std::int32_t first_k = work.pair_begin[i], end_k = kScan == Scan::kNear ? near.end[i] : work.pair_begin[i + 1];
   std::uint8_t* active = work.pair_forces.active.data();
+  // kRefresh: a pair is kept when its gap is under the margin, or either sphere is not free.
+  std::int32_t kept = first_k;
+  [[maybe_unused]] const std::int32_t *body = s.body.data(), *attached = s.attached.data();
+  [[maybe_unused]] const bool i_free = (body[i] < 0) & (attached[i] < 0);
   int c = batch.b.count, first = c;  // entries [first, c) are i's
-  for (std::int32_t k = work.pair_begin[i]; k < work.pair_begin[i + 1]; ++k) {
-    const std::int32_t j = partner[k];
+  for (std::int32_t e = first_k; e < end_k; ++e) {
+    const std::int32_t j = partner[e];
+    const std::int32_t k = kScan == Scan::kNear ? near.k[e] : e;
     if constexpr (kGhosts)
       if (j < lo || j >= hi) continue;
     double d[3] = {xi - px[j], yi - py[j], zi - pz[j]};
@@ -210,15 +227,22 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
     batch.contact[c] = k;
     batch.other[c] = j;
+    if constexpr (kScan == Scan::kRefresh) {
+      const double keep_reach = reach + near.margin;
+      const bool keep = (dist2 < keep_reach * keep_reach) | !i_free | (body[j] >= 0) | (attached[j] >= 0);
+      near.k[kept] = k, near.j[kept] = j;
+      kept += keep;
+    }
     if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
     c += acts;
     if (c == kBatch) {
-      for (int e = first; e < c; ++e) batch.owner[e] = static_cast<std::int32_t>(i), batch.pair[e] = true;
+      for (int e2 = first; e2 < c; ++e2) batch.owner[e2] = static_cast<std::int32_t>(i), batch.pair[e2] = true;
       batch.b.count = c;
       flush(model, batch, s, work);
       c = first = 0;
     }
   }
+  if constexpr (kScan == Scan::kRefresh) near.end[i] = kept, near.x[i] = xi, near.y[i] = yi, near.z[i] = zi;
   for (int e = first; e < c; ++e) batch.owner[e] = static_cast<std::int32_t>(i), batch.pair[e] = true;
   batch.b.count = c;
 }
@@ -260,7 +284,7 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
 
 /// The contacts of the owned slots, block by block: the even blocks, then the odd ones (see the
 /// top of this file). Called by every thread of a parallel region.
-template <bool kPeriodic, bool kGhosts>
+template <bool kPeriodic, bool kGhosts, Scan kScan>
 void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
   const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
   for (long parity = 0; parity < 2; ++parity) {
@@ -268,7 +292,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
     for (long b = parity; b < blocks; b += 2) {
       const long last = std::min(n, (b + 1) * block);
       for (long i = b * block; i < last; ++i) {
-        particle_contacts<kPeriodic, kGhosts>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
+        particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
         if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
       }
     }
@@ -276,6 +300,12 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
 #pragma omp barrier
   }
 }
+
+/// The block pass for each case, by [periodic][ghosts].
+using BlockPass = void (*)(const Model&, State&, Workspace&, Batch&);
+template <Scan kScan>
+constexpr BlockPass pass[2][2] = {{block_pass<false, false, kScan>, block_pass<false, true, kScan>},
+                                  {block_pass<true, false, kScan>, block_pass<true, true, kScan>}};
 
 /// Slots [begin, end): forces and torques set to zero.
 DEM_KERNEL void clear_loads(State& s, long begin, long end) {
@@ -337,6 +367,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const std::int32_t owned = static_cast<std::int32_t>(n);
   const bool periodic = model.periodic();
   const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
+  const bool near = work.near.valid && work.near.trusted;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
 #pragma omp parallel if (n >= kParallelMin)
@@ -344,15 +375,14 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 #pragma omp for schedule(static)
     for (long begin = 0; begin < n_all; begin += kChunk) clear_loads(s, begin, std::min(n_all, begin + kChunk));
     Batch batch;
-    if (periodic)
-      ghosts ? block_pass<true, true>(model, s, work, batch) : block_pass<true, false>(model, s, work, batch);
-    else
-      ghosts ? block_pass<false, true>(model, s, work, batch) : block_pass<false, false>(model, s, work, batch);
+    (near ? pass<Scan::kNear> : pass<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch);
   }
+  work.near.valid = true, work.near.trusted = false;
+  work.near_refreshes += !near;
   if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
     Batch batch;
     for (const std::int32_t i : work.ghost_owners)
-      (periodic ? particle_contacts<true, true> : particle_contacts<false, true>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+      (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
     flush(model, batch, s, work);
   }
 

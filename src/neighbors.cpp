@@ -356,6 +356,12 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   for (auto* c : {&pf.fx, &pf.fy, &pf.fz}) c->assign(work.keep_pair_forces ? s.pairs.size() : 0, 0.0);
   assign_discarding(pf.active, s.pairs.size(), std::uint8_t{0});
   work.wall_forces.resize(s.wall_pairs.size());
+  Workspace::NearPairs& near = work.near;
+  resize_discarding(near.k, s.pairs.size()), resize_discarding(near.j, s.pairs.size());
+  for (auto* c : {&near.x, &near.y, &near.z}) resize_discarding(*c, s.owned());
+  resize_discarding(near.end, s.owned());
+  near.margin = 0.1 * model.skin;
+  near.valid = near.trusted = false;  // the next contact pass scans the whole list
   // A contact with a history counts as active until it is next evaluated: the contact loop
   // clears the history of an inactive contact only when it was active (idle pairs of the skin
   // are then read, never written, and their history rows not touched at all).

@@ -15,11 +15,17 @@ namespace dem {
 
 namespace {
 
+/// What kick_drift found: a free sphere moved more than half the skin since the lists were
+/// built (kRebuild), or more than half the near margin since the last full scan (kRescan).
+enum Moved : int { kRebuild = 1, kRescan = 2 };
+
 /// kick_drift for the free spheres among slots [begin, end), as a loop the compiler vectorises
 /// (spheres of bodies and glued spheres keep their values: their body or wall moves them).
-/// Returns whether one has moved more than sqrt(limit2) since the lists were built.
-template <bool kCheck>
-[[gnu::always_inline]] inline bool kick_drift_loop(State& s, long begin, long end, double h, double dt, double limit2) {
+/// Returns the Moved flags: kRebuild checked when kCheck (lists built for these slots), kRescan
+/// when kNear (near pairs valid); each flag is set when it is not checked.
+template <bool kCheck, bool kNear>
+[[gnu::always_inline]] inline int kick_drift_loop(State& s, const Workspace& work, long begin, long end, double h, double dt,
+                                                  double limit2, double near2) {
   const std::int32_t *body = s.body.data(), *attached = s.attached.data();
   const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
   const double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
@@ -28,7 +34,8 @@ template <bool kCheck>
   double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
   double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
   const double *xb = s.x_built.data(), *yb = s.y_built.data(), *zb = s.z_built.data();
-  int moved = 0;
+  const double *xn = work.near.x.data(), *yn = work.near.y.data(), *zn = work.near.z.data();
+  int moved = (kCheck ? 0 : kRebuild) | (kNear ? 0 : kRescan);
   DEM_VECTOR_LOOP
   for (long p = begin; p < end; ++p) {
     const bool free = (body[p] < 0) & (attached[p] < 0);
@@ -37,33 +44,42 @@ template <bool kCheck>
     const double nx = x[p] + dt * nvx, ny = y[p] + dt * nvy, nz = z[p] + dt * nvz;
     if constexpr (kCheck) {
       const double dx = nx - xb[p], dy = ny - yb[p], dz = nz - zb[p];
-      moved |= free & (dx * dx + dy * dy + dz * dz > limit2);
+      moved |= (free & (dx * dx + dy * dy + dz * dz > limit2)) * kRebuild;
+    }
+    if constexpr (kNear) {
+      const double ex = nx - xn[p], ey = ny - yn[p], ez = nz - zn[p];
+      moved |= (free & (ex * ex + ey * ey + ez * ez > near2)) * kRescan;
     }
     const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
     wx[p] = free ? nwx : wx[p], wy[p] = free ? nwy : wy[p], wz[p] = free ? nwz : wz[p];
     vx[p] = free ? nvx : vx[p], vy[p] = free ? nvy : vy[p], vz[p] = free ? nvz : vz[p];
     x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
   }
-  return moved != 0;
+  return moved;
 }
 
-DEM_KERNEL bool kick_drift_range(State& s, long begin, long end, double h, double dt, bool check, double limit2) {
-  return check ? kick_drift_loop<true>(s, begin, end, h, dt, limit2) : kick_drift_loop<false>(s, begin, end, h, dt, limit2);
+DEM_KERNEL int kick_drift_range(State& s, const Workspace& work, long begin, long end, double h, double dt, bool check, bool near,
+                                double limit2, double near2) {
+  if (check) return near ? kick_drift_loop<true, true>(s, work, begin, end, h, dt, limit2, near2)
+                         : kick_drift_loop<true, false>(s, work, begin, end, h, dt, limit2, near2);
+  return kick_drift_loop<false, false>(s, work, begin, end, h, dt, limit2, near2);
 }
 
 /// The opening half kick and the drift in one pass: v += h F/m, w += h T/I, x += dt v for free
-/// spheres; bodies take the same kick and move freely, then place their spheres. Returns whether
-/// a free sphere has moved more than half the skin since the lists were built (the same test
-/// as needs_rebuild, made while the positions are in cache).
-bool kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
+/// spheres; bodies take the same kick and move freely, then place their spheres. Returns the
+/// Moved flags of the free spheres (the test of needs_rebuild, and that of the near pairs, made
+/// while the positions are in cache).
+int kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
   const long n = static_cast<long>(s.owned());  // ghosts are moved by their owners
   const bool check = s.x_built.size() == s.size();
-  const double limit2 = 0.25 * model.skin * model.skin;
-  int moved = 0;
+  const bool near = check && work.near.valid && work.near.x.size() == static_cast<size_t>(n);
+  const double limit2 = 0.25 * model.skin * model.skin, near2 = 0.25 * work.near.margin * work.near.margin;
+  int moved = (check ? 0 : kRebuild) | (near ? 0 : kRescan);
 #pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
-  for (long begin = 0; begin < n; begin += kChunk) moved |= kick_drift_range(s, begin, std::min(n, begin + kChunk), h, dt, check, limit2);
+  for (long begin = 0; begin < n; begin += kChunk)
+    moved |= kick_drift_range(s, work, begin, std::min(n, begin + kChunk), h, dt, check, near, limit2, near2);
   Bodies& b = s.bodies;
-  if (b.size() == 0) return moved != 0;
+  if (b.size() == 0) return moved;
   for (size_t k = 0; k < b.size(); ++k) {
     const double a = h / b.mass[k];
     b.vx[k] += a * b.fx[k], b.vy[k] += a * b.fy[k], b.vz[k] += a * b.fz[k];
@@ -74,7 +90,7 @@ bool kick_drift(State& s, const Workspace& work, const Model& model, double h, d
     b.qw[k] = q.w, b.qx[k] = q.x, b.qy[k] = q.y, b.qz[k] = q.z;
   }
   place_body_spheres(model, s, work.body_begin, work.body_members);
-  return moved != 0;
+  return moved;
 }
 
 /// Walls move at their set velocity; servo walls add the normal speed that drives their
@@ -151,7 +167,8 @@ void prepare(const Model& model, State& state, Workspace& work) {
 
 void step(const Model& model, State& state, Workspace& work) {
   const double dt = model.dt;
-  const bool free_moved = kick_drift(state, work, model, 0.5 * dt, dt);
+  const int moved = kick_drift(state, work, model, 0.5 * dt, dt);
+  const bool free_moved = moved & kRebuild;
   move_walls(model, state, dt);
   place_meshes(model, state.time + dt, work);
   if (work.domain) {
@@ -166,6 +183,9 @@ void step(const Model& model, State& state, Workspace& work) {
       if (run_inlet(model, state, k) > 0) work.valid = false;
     if (free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)) rebuild_contacts(model, state, work);
   }
+  // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
+  // clears near.valid) and no free sphere moved half the margin since the last full scan.
+  work.near.trusted = !(moved & kRescan);
   compute_forces(model, state, work, 0.5 * dt);
   refresh_body_spheres(model, state, work);
   state.time += dt;

@@ -62,6 +62,22 @@ struct Workspace {
   /// Owned slots with a ghost partner, ascending (domain.h; empty without ghosts).
   std::vector<std::int32_t> ghost_owners;
 
+  /// The pairs of the list that can act before the spheres move another margin/2: those whose
+  /// gap was under `margin` when the list was last scanned in full (plus every pair with a
+  /// sphere of a body or a glued one, whose motion the drift does not check). Stored in the
+  /// pair list's own rows: slot p's near pairs are k[pair_begin[p] .. end[p]), in list order,
+  /// with their partners j, so a contact pass over them forms the same batches in the same
+  /// order as one over the whole list, for a fraction of the distance tests (forces.cpp).
+  struct NearPairs {
+    std::vector<std::int32_t> k, j;  ///< pair index and partner, by row of the pair list
+    std::vector<std::int32_t> end;   ///< end of slot p's near pairs (owned slots)
+    std::vector<double> x, y, z;     ///< [m] positions at the last full scan
+    double margin = 0.0;             ///< [m] gap below which a pair is kept (Model::skin / 10)
+    bool valid = false;              ///< rows and positions are those of the current list
+    bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since
+  } near;
+  std::int64_t near_refreshes = 0;   ///< full scans of the pair list
+
   PairForces pair_forces;
   /// Keep each pair's force (pair_forces.fx, fy, fz; for contact_stress): 24 bytes per listed
   /// pair, most of them idle pairs of the skin, and written every step; off unless asked for.
