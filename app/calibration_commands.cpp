@@ -124,7 +124,10 @@ int CalibrationCommands::run_test() {
   if (render_) options.on_final = [&](const Model& m, const State& s) { render_(m, s, png); };
   const SimulatedOutcome out = run_virtual_test(model, setup, options);
   std::cout << fmt::format("{} on {} ({} particles, {:.3g} s simulated, {:.1f} s wall)\n", test_name_, model.name, out.particles, out.simulated_seconds, out.wall_seconds);
-  for (const auto& [k, v] : out.observables) std::cout << fmt::format("  {} = {:.6g}\n", k, v);
+  for (const auto& [k, v] : out.observables) {
+    const auto u = out.uncertainty.find(k);
+    std::cout << fmt::format("  {} = {:.6g}{}\n", k, v, u == out.uncertainty.end() ? "" : fmt::format(" +- {:.2g} (this run's extraction)", u->second));
+  }
   for (const auto& f : out.flags) std::cout << "  outcome: " << f << "\n";
   for (const auto& n : out.notes) std::cout << "  note: " << n << "\n";
   if (render_ && fs::exists(png)) std::cout << "  render: " << png << "\n";

@@ -100,9 +100,11 @@ ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector
   run.test = experiment.setup.test;
   run.replicas = static_cast<int>(replicas.size());
   std::map<std::string, int> flags;
+  std::map<std::string, std::vector<double>> extraction;  // observable -> each replica's own standard error
   for (size_t r = 0; r < replicas.size(); ++r) {
     const SimulatedOutcome& out = *replicas[r];
     for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
+    for (const auto& [key, u] : out.uncertainty) extraction[key].push_back(u);
     for (const std::string& f : out.flags) ++flags[f];
     if (r == 0) run.notes = out.notes, run.particles = out.particles;
     run.wall_seconds += out.wall_seconds;
@@ -114,6 +116,14 @@ ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector
     for (double v : list) ss += (v - mean) * (v - mean);
     run.mean[key] = mean;
     run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+    // Two replicas that happen to agree must not make the mean look surer than each run's own
+    // extraction says: the standard error is at least that of the runs' errors, averaged.
+    const auto e = extraction.find(key);
+    if (e != extraction.end() && e->second.size() == list.size()) {
+      double uu = 0;
+      for (double u : e->second) uu += u * u;
+      run.sigma[key] = std::max(run.sigma[key], std::sqrt(uu / n / n));
+    }
   }
   for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
   return run;
@@ -226,7 +236,7 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
       t.sigma_simulated = run.sigma.at(obs);
       if (run.replicas < 2) {
         const auto f = sigma_floor.find(t.name());
-        if (f != sigma_floor.end()) t.sigma_simulated = f->second;
+        if (f != sigma_floor.end()) t.sigma_simulated = std::max(t.sigma_simulated, f->second);
       }
       t.residual = (t.simulated - t.measured) / std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
       c.terms.push_back(t);

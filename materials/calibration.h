@@ -3,7 +3,10 @@
 //   compare    simulates every experiment with replicas (different seeds, so different packings)
 //              and forms one normalised residual per observation,
 //                r = (simulated mean - measured) / sqrt(sigma_measured^2 + sigma_simulated^2),
-//              sigma_simulated being the standard error of the replica mean. Outcomes (blocked,
+//              sigma_simulated being the standard error of the replica mean, and at least the
+//              runs' own extraction errors (SimulatedOutcome::uncertainty: the fitted heap angle's)
+//              divided by sqrt(replicas): two replicas that agree by chance do not make a noisy
+//              observable look sure. Outcomes (blocked,
 //              no_heap, slipping) are observations: a mismatch is a residual of
 //              outcome_residual x |measured fraction - simulated fraction| (3 sigma by default).
 //              Residuals of one test are regressed on the set-up quantity varied across its
@@ -80,6 +83,10 @@ struct CalibrationOptions {
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise
   double bic_margin = 10.0;         ///< an effect is recommended when it lowers BIC by more than this
+  /// A confirmed runner-up whose BIC is within this of the recommended effect's is named as a
+  /// rival the data cannot rule out (a BIC difference under 6 is not strong evidence: Kass &
+  /// Raftery 1995).
+  double rival_margin = 6.0;
   int confirm_candidates = 2;       ///< leading candidates confirmed by recalibration
   /// Effects diagnose considers (names of missing_effects); empty: every effect the model lacks.
   std::vector<std::string> effects;
@@ -95,7 +102,7 @@ struct CalibrationOptions {
 struct ExperimentRun {
   std::string id, test;
   std::map<std::string, double> mean;                  ///< observable -> mean over replicas
-  std::map<std::string, double> sigma;                 ///< observable -> standard error of the mean (0 with one replica)
+  std::map<std::string, double> sigma;                 ///< observable -> standard error of the mean (with one replica: the run's extraction error, else 0)
   std::map<std::string, std::vector<double>> values;   ///< observable -> per replica
   std::map<std::string, double> flag_fraction;         ///< outcome flag -> fraction of replicas
   std::vector<std::string> notes;
@@ -249,6 +256,7 @@ struct Diagnosis {
   double base_bic = 0;
   std::vector<CandidateResult> candidates;  ///< ranked: confirmed by BIC, then by explained fraction
   std::string recommended;                  ///< candidate name, "" for none
+  std::vector<std::string> rivals;          ///< confirmed candidates the data cannot tell from the recommended one
   std::vector<std::string> words;
 };
 

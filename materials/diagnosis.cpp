@@ -154,6 +154,14 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                     best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
                                     best->adds.size() == 1 ? "" : "s"));
       if (!misfits.empty()) d.words.push_back("Where the model without it fails: " + join(misfits, " "));
+      for (const CandidateResult& c : d.candidates)
+        if (&c != best && c.confirmed && c.delta_bic > options.bic_margin && c.bic - best->bic < options.rival_margin) {
+          d.rivals.push_back(c.name);
+          d.words.push_back(fmt::format("These data do not tell {} from {}: added instead and recalibrated, {} reaches BIC {:.1f}, only "
+                                        "{:.1f} above (< {:.0f}, no strong evidence). Measure where the two act differently to decide ({}: {}; {}: {}).",
+                                        best->name, c.name, c.name, c.bic, c.bic - best->bic, options.rival_margin, best->name,
+                                        physics_words(best->name), c.name, physics_words(c.name)));
+        }
     } else {
       d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}) but no candidate lowers BIC by more than {:.0f}{}.",
                                     base.chi2_per_n(), options.bic_margin,

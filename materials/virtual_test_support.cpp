@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <numeric>
 #include <numbers>
 
 #include "clump_geometry.h"
@@ -234,6 +235,18 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
   if (x.size() < 2 || den == 0) return {n > 0 ? sy / n : 0.0, 0.0};
   const double b = (n * sxy - sx * sy) / den;
   return {(sy - b * sx) / n, b};
+}
+
+double slope_standard_error(const std::vector<double>& x, const std::vector<double>& y, std::pair<double, double> line) {
+  const size_t n = x.size();
+  if (n < 3) return 0.0;
+  const double mean_x = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(n);
+  double srr = 0, sxx = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const double r = y[k] - line.first - line.second * x[k];
+    srr += r * r, sxx += (x[k] - mean_x) * (x[k] - mean_x);
+  }
+  return sxx > 0 ? std::sqrt(srr / static_cast<double>(n - 2) / sxx) : 0.0;
 }
 
 void finish(SimulatedOutcome& out, const Runner& run, const Clock& clock, std::int64_t particles, const TestOptions& options) {

@@ -98,6 +98,9 @@ struct Runner {
 
 /// Least-squares line y = a + b x; returns {a, b}. Needs two distinct x.
 std::pair<double, double> fit_line(const std::vector<double>& x, const std::vector<double>& y);
+/// Standard error of the slope b of that line, from its residuals: sqrt(S_rr / (n - 2) / S_xx).
+/// Needs three points (two fit any line exactly: 0 is returned, the error unknown).
+double slope_standard_error(const std::vector<double>& x, const std::vector<double>& y, std::pair<double, double> line);
 
 /// Wall clock of a test, and what every test reports at its end.
 struct Clock {

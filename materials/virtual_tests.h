@@ -48,6 +48,10 @@ struct TestSetup {
 /// What a virtual test observed.
 struct SimulatedOutcome {
   std::map<std::string, double> observables;  ///< by the measurement file's observable names
+  /// Observable -> standard error of its extraction in this one run, where the test can tell it
+  /// (angle_deg: the heap line's fitted slope). A small apparatus gives a few bins to fit, and
+  /// the calibration must not trust that angle more than the fit does (calibration.h).
+  std::map<std::string, double> uncertainty;
   std::vector<std::string> flags;             ///< outcomes: no_heap, blocked, slipping
   std::int64_t particles = 0;
   double simulated_seconds = 0, wall_seconds = 0;

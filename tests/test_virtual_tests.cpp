@@ -12,6 +12,7 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
+#include <numeric>
 
 #include "virtual_tests.h"
 
@@ -156,7 +157,8 @@ TEST(BulkDensity, PouredSpheresPackBetweenLooseAndCloseAndDenserWithLessFriction
 // 5 deg, and no heap below the plate's level (a sphere the lifted cylinder held up once made
 // a heap read -80 deg).
 TEST(AngleOfRepose, NoHeapWithoutRollingResistanceAndSteeperWithIt) {
-  auto angle = [](double rolling, std::uint64_t seed, bool& no_heap) {
+  std::vector<double> errors;  // each heap's own standard error of the fitted angle [deg]
+  auto angle = [&errors](double rolling, std::uint64_t seed, bool& no_heap) {
     MaterialModel m = beads(0.5, rolling, 0.3, 0.005);
     m.particle.youngs_modulus = 2e5;
     TestOptions options;
@@ -168,28 +170,43 @@ TEST(AngleOfRepose, NoHeapWithoutRollingResistanceAndSteeperWithIt) {
         options);
     print(fmt::format("angle_of_repose mu_r {} packing {}", rolling, seed), out);
     no_heap = flagged(out, "no_heap");
+    if (!no_heap) errors.push_back(out.uncertainty.at("angle_deg"));
     return out.observables.at("angle_deg");
   };
   bool none = false;
   EXPECT_EQ(angle(0.0, 1, none), 0.0);
   EXPECT_TRUE(none);
+  constexpr int kPackings = 4;
+  double squares = 0;  // sum of squared deviations from each rolling resistance's mean
   auto mean_angle = [&](double rolling) {
-    double sum = 0;
-    constexpr int kPackings = 4;
-    for (std::uint64_t seed = 1; seed <= kPackings; ++seed) {
+    std::vector<double> a(kPackings);
+    for (int k = 0; k < kPackings; ++k) {
       bool flag = false;
-      const double a = angle(rolling, seed, flag);
-      EXPECT_FALSE(flag) << "mu_r " << rolling << ", packing " << seed;
-      EXPECT_GT(a, 0.0) << "mu_r " << rolling << ", packing " << seed;
-      sum += a;
+      a[k] = angle(rolling, k + 1, flag);
+      EXPECT_FALSE(flag) << "mu_r " << rolling << ", packing " << k + 1;
+      EXPECT_GT(a[k], 0.0) << "mu_r " << rolling << ", packing " << k + 1;
     }
-    return sum / kPackings;
+    const double mean = std::accumulate(a.begin(), a.end(), 0.0) / kPackings;
+    for (double v : a) squares += (v - mean) * (v - mean);
+    return mean;
   };
   const double low = mean_angle(0.1), high = mean_angle(0.3);
-  std::printf("mean angle of repose over 4 packings: %.1f deg at mu_r 0.1, %.1f deg at mu_r 0.3\n", low, high);
+  const double scatter = std::sqrt(squares / (2 * (kPackings - 1)));  // pooled s.d. between packings
+  double uu = 0;
+  for (double u : errors) uu += u * u;
+  const double reported = std::sqrt(uu / static_cast<double>(errors.size()));
+  std::printf("mean angle of repose over 4 packings: %.1f deg at mu_r 0.1, %.1f deg at mu_r 0.3; scatter between packings %.2f deg, "
+              "the fits' own standard error %.2f deg (r.m.s.)\n",
+              low, high, scatter, reported);
   EXPECT_GT(high, 18);
   EXPECT_LT(high, 40);
   EXPECT_GT(high, low + 5);
+  // The error each heap reports for its angle must be of the size of the scatter between
+  // packings (the calibration weighs the angle by it). Pooled over 6 degrees of freedom the
+  // scatter is known to about 30 %; a factor 2.5 either way is 3 of those.
+  ASSERT_EQ(errors.size(), 2u * kPackings);
+  EXPECT_GT(reported, scatter / 2.5);
+  EXPECT_LT(reported, scatter * 2.5);
 }
 
 // Rotating drum (periodic axis): a rolling bed at friction 0.5, mu_r 0.1 lies at 20-45 deg
