@@ -28,8 +28,8 @@ template <bool kCheck, bool kNear>
                                                   double limit2, double near2) {
   const std::int32_t *body = s.body.data(), *attached = s.attached.data();
   const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
-  const double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
-  const double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
+  double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
   double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
   double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
   double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
@@ -54,6 +54,7 @@ template <bool kCheck, bool kNear>
     wx[p] = free ? nwx : wx[p], wy[p] = free ? nwy : wy[p], wz[p] = free ? nwz : wz[p];
     vx[p] = free ? nvx : vx[p], vy[p] = free ? nvy : vy[p], vz[p] = free ? nvz : vz[p];
     x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
+    fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;  // used: the contact pass sums anew (Workspace::loads_cleared)
   }
   return moved;
 }
@@ -66,7 +67,8 @@ DEM_KERNEL int kick_drift_range(State& s, const Workspace& work, long begin, lon
 }
 
 /// The opening half kick and the drift in one pass: v += h F/m, w += h T/I, x += dt v for free
-/// spheres; bodies take the same kick and move freely, then place their spheres. Returns the
+/// spheres, and every owned slot's F and T set to zero once used; bodies take the same kick
+/// (from their own totals) and move freely, then place their spheres. Returns the
 /// Moved flags of the free spheres (the test of needs_rebuild, and that of the near pairs, made
 /// while the positions are in cache).
 int kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
@@ -171,18 +173,22 @@ void step(const Model& model, State& state, Workspace& work) {
   const bool free_moved = moved & kRebuild;
   move_walls(model, state, dt);
   place_meshes(model, state.time + dt, work);
+  bool rebuilt = false;  // a rebuild may add slots (inlets, migration) whose loads are not zero
   if (work.domain) {
     run_inlets_decomposed(model, state, work);
     // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
-    if (work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)))
+    rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
+    if (rebuilt)
       rebuild_contacts(model, state, work);
     else
       work.domain->refresh_ghosts(state);
   } else {
     for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
       if (run_inlet(model, state, k) > 0) work.valid = false;
-    if (free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true)) rebuild_contacts(model, state, work);
+    rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
+    if (rebuilt) rebuild_contacts(model, state, work);
   }
+  work.loads_cleared = !rebuilt;
   // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
   // clears near.valid) and no free sphere moved half the margin since the last full scan.
   work.near.trusted = !(moved & kRescan);

@@ -77,6 +77,10 @@ struct Workspace {
     bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since
   } near;
   std::int64_t near_refreshes = 0;   ///< full scans of the pair list
+  /// Set by step() when the kick-drift pass zeroed the owned slots' forces and torques after
+  /// using them and no rebuild moved or added slots since: compute_forces then clears only the
+  /// ghosts' (one pass over 6 columns less per step). Cleared by compute_forces.
+  bool loads_cleared = false;
 
   PairForces pair_forces;
   /// Keep each pair's force (pair_forces.fx, fy, fz; for contact_stress): 24 bytes per listed
