@@ -1,11 +1,14 @@
 // What compare, calibrate and diagnose share inside the library (not part of its interface):
-// progress with the time left, and joining words.
+// progress with the time left, joining words, and running simulations as batches.
 #pragma once
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,8 @@
 namespace dem::materials::detail {
 
 using Clock = std::chrono::steady_clock;
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -43,6 +48,24 @@ inline std::string join(const std::vector<std::string>& words, const std::string
   for (const auto& w : words) out += (out.empty() ? "" : sep) + w;
   return out;
 }
+
+/// One simulation of a batch: which model, set-up and packing seed.
+struct Job {
+  const MaterialModel* model;
+  const TestSetup* setup;
+  std::uint64_t seed;
+};
+
+/// Runs the jobs as one batch through options.batch (or one after the other here). A job's
+/// exception becomes its outcome's error (a runner must not throw mid-batch: under MPI every rank
+/// has to reach the gather); `done` is called as each outcome is known, and a `fatal` one stops
+/// a serial batch.
+std::vector<BatchOutcome> run_batch(const std::vector<Job>& jobs, const CalibrationOptions& options,
+                                    const std::function<void(size_t, const BatchOutcome&)>& done,
+                                    const std::function<bool(const BatchOutcome&)>& fatal);
+
+/// The error of a batch outcome thrown again, with its kind.
+[[noreturn]] void rethrow(const BatchOutcome& b);
 
 /// Every experiment simulated `replicas` times (seeds options.seed, +1, ...) as one batch; any
 /// error stops the comparison (the first in experiment and replica order is thrown). A progress

@@ -1,0 +1,136 @@
+// The simulations of compare and calibrate, run as batches (one after the other, or shared out by
+// options.batch, e.g. over MPI ranks), and the replicas of an experiment summarised.
+#include "calibration.h"
+#include "calibration_support.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "diagnostics.h"
+
+namespace dem::materials {
+
+using detail::Job;
+
+namespace {
+
+SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, const CalibrationOptions& options, std::uint64_t seed) {
+  TestOptions t;
+  t.seed = seed;
+  t.threads = options.threads;
+  t.size_factor = options.size_factor;
+  if (options.on_final) t.on_final = options.on_final;
+  return options.simulator ? options.simulator(model, setup, t) : run_virtual_test(model, setup, t);
+}
+
+/// Runs one job; an exception becomes the outcome's error (a runner must not throw mid-batch:
+/// under MPI every rank has to reach the gather).
+BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
+  BatchOutcome b;
+  try {
+    b.outcome = run_one(*job.model, *job.setup, options, job.seed);
+    b.error = BatchOutcome::Error::none;
+  } catch (const CaseError& e) {
+    b.error = BatchOutcome::Error::input, b.message = e.what();
+  } catch (const NumericalError& e) {
+    b.error = BatchOutcome::Error::numerical, b.message = e.what();
+  } catch (const std::exception& e) {
+    b.error = BatchOutcome::Error::other, b.message = e.what();
+  }
+  return b;
+}
+
+/// The run of one experiment from the outcomes of its replicas (in seed order).
+ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector<const SimulatedOutcome*>& replicas) {
+  ExperimentRun run;
+  run.id = experiment.id;
+  run.test = experiment.setup.test;
+  run.replicas = static_cast<int>(replicas.size());
+  std::map<std::string, int> flags;
+  std::map<std::string, std::vector<double>> extraction;  // observable -> each replica's own standard error
+  for (size_t r = 0; r < replicas.size(); ++r) {
+    const SimulatedOutcome& out = *replicas[r];
+    for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
+    for (const auto& [key, u] : out.uncertainty) extraction[key].push_back(u);
+    for (const std::string& f : out.flags) ++flags[f];
+    if (r == 0) run.notes = out.notes, run.particles = out.particles;
+    run.wall_seconds += out.wall_seconds;
+  }
+  for (const auto& [key, list] : run.values) {
+    const double n = static_cast<double>(list.size());
+    const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
+    double ss = 0;
+    for (double v : list) ss += (v - mean) * (v - mean);
+    run.mean[key] = mean;
+    run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+    // Two replicas that happen to agree must not make the mean look surer than each run's own
+    // extraction says: the standard error is at least that of the runs' errors, averaged.
+    const auto e = extraction.find(key);
+    if (e != extraction.end() && e->second.size() == list.size()) {
+      double uu = 0;
+      for (double u : e->second) uu += u * u;
+      run.sigma[key] = std::max(run.sigma[key], std::sqrt(uu / n / n));
+    }
+  }
+  for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
+  return run;
+}
+
+}  // namespace
+
+[[noreturn]] void detail::rethrow(const BatchOutcome& b) {
+  if (b.error == BatchOutcome::Error::input) throw CaseError(b.message);
+  if (b.error == BatchOutcome::Error::numerical) throw NumericalError(b.message);
+  throw std::runtime_error(b.message);
+}
+
+std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const CalibrationOptions& options,
+                                            const std::function<void(size_t, const BatchOutcome&)>& done,
+                                            const std::function<bool(const BatchOutcome&)>& fatal) {
+  const auto simulate = [&](size_t k) { return run_caught(jobs[k], options); };
+  if (options.batch) {
+    std::vector<BatchOutcome> out = options.batch(jobs.size(), simulate, done, fatal);
+    if (out.size() != jobs.size())
+      throw std::logic_error(fmt::format("calibration: the batch runner returned {} outcomes for {} simulations", out.size(), jobs.size()));
+    return out;
+  }
+  std::vector<BatchOutcome> out(jobs.size());
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    out[k] = simulate(k);
+    done(k, out[k]);
+    if (fatal(out[k])) break;
+  }
+  return out;
+}
+
+std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& model, const std::vector<Experiment>& experiments,
+                                                        const CalibrationOptions& options, int replicas, Progress* progress,
+                                                        const std::string& prefix) {
+  replicas = std::max(1, replicas);
+  std::vector<Job> jobs;
+  for (const Experiment& e : experiments)
+    for (int r = 0; r < replicas; ++r) jobs.push_back({&model, &e.setup, options.seed + static_cast<std::uint64_t>(r)});
+  std::vector<int> known(experiments.size(), 0);
+  const std::vector<BatchOutcome> outcomes = run_batch(
+      jobs, options,
+      [&](size_t k, const BatchOutcome& b) {
+        const size_t e = k / static_cast<size_t>(replicas);
+        if (b.error == BatchOutcome::Error::none && ++known[e] == replicas && progress) progress->step(prefix + experiments[e].id);
+      },
+      [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
+  for (const BatchOutcome& b : outcomes)
+    if (b.error != BatchOutcome::Error::none) rethrow(b);
+  std::vector<ExperimentRun> runs;
+  for (size_t e = 0; e < experiments.size(); ++e) {
+    std::vector<const SimulatedOutcome*> list;
+    for (int r = 0; r < replicas; ++r) list.push_back(&outcomes[e * replicas + r].outcome);
+    runs.push_back(summarise_replicas(experiments[e], list));
+  }
+  return runs;
+}
+
+}  // namespace dem::materials
