@@ -414,12 +414,17 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   }
 }
 
+/// The dry spheres with liquid bridges of this liquid content, at friction 0.5.
+MaterialModel wet_spheres(double liquid_content) {
+  MaterialModel m = dry_spheres();
+  missing_effects(m)[1].add(m);  // liquid bridges
+  set_parameter(m, "liquid_content", liquid_content), set_parameter(m, "friction", 0.5);
+  return m;
+}
+
 TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
   const Analytic sim;
-  const MaterialModel start = dry_spheres();
-  MaterialModel truth = start;
-  missing_effects(truth)[1].add(truth);  // liquid bridges
-  set_parameter(truth, "liquid_content", 0.01), set_parameter(truth, "friction", 0.5);
+  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.01);
   MeasurementSet set;
   add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
   add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
@@ -442,10 +447,7 @@ TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
   // both as the bridges did, but any effect that moves them in another direction, with friction,
   // fits two numbers exactly: the runner-up is as good, and the diagnosis must say so.
   const Analytic sim;
-  const MaterialModel start = dry_spheres();
-  MaterialModel truth = start;
-  missing_effects(truth)[1].add(truth);  // liquid bridges
-  set_parameter(truth, "liquid_content", 0.03), set_parameter(truth, "friction", 0.5);
+  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.03);
   MeasurementSet set;
   add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
   add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
