@@ -23,8 +23,8 @@
 //      B2 +3 % without it). Every pair is written to the next batch entry and kept by advancing
 //      the count, with no branch on whether it touches: for the pairs of the skin that is a coin
 //      toss the branch predictor loses (+4 %). Most steps read only the near pairs (gap under a
-//      tenth of the skin at the last full scan; Workspace::NearPairs): B1 dense +15-25 %,
-//      settle +8-10 %, B2 unchanged (its spheres move a tenth of the skin in a few steps);
+//      margin of 0.05-0.5 skin at the last full scan, adapted below; Workspace::NearPairs): B1
+//      dense +15-25 %, settle +8-10 %, B2 +2-3 % (its spheres cross the margin in a few steps);
 //   2. pair_geometry over the whole batch, vectorised (normal, overlap, relative motion, reduced
 //      radius, mass and inertia: the square roots and divisions of a contact);
 //   3. the effects' kernels over the batch columns (vectorised, effect.h), then the loads added to
@@ -370,6 +370,15 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const bool periodic = model.periodic();
   const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
   const bool near = work.near.valid && work.near.trusted;
+  if (!near && work.near.valid) {
+    // A full scan because spheres moved half the margin: the margin follows the motion, so that
+    // the near pairs last 4-16 steps (a rebuild's scan leaves it as it is). Its size changes the
+    // speed only: the contacts found are the same.
+    Workspace::NearPairs& pairs = work.near;
+    if (pairs.age < 4) pairs.margin = std::min(1.5 * pairs.margin, 0.5 * model.skin);
+    else if (pairs.age > 16) pairs.margin = std::max(pairs.margin / 1.5, 0.05 * model.skin);
+  }
+  work.near.age = near ? work.near.age + 1 : 0;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
 #pragma omp parallel if (n >= kParallelMin)

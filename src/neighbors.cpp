@@ -360,7 +360,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   resize_discarding(near.k, s.pairs.size()), resize_discarding(near.j, s.pairs.size());
   for (auto* c : {&near.x, &near.y, &near.z}) resize_discarding(*c, s.owned());
   resize_discarding(near.end, s.owned());
-  near.margin = 0.1 * model.skin;
+  near.margin = near.margin > 0 ? std::clamp(near.margin, 0.05 * model.skin, 0.5 * model.skin) : 0.1 * model.skin;
   near.valid = near.trusted = false;  // the next contact pass scans the whole list
   // A contact with a history counts as active until it is next evaluated: the contact loop
   // clears the history of an inactive contact only when it was active (idle pairs of the skin

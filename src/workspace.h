@@ -72,7 +72,8 @@ struct Workspace {
     std::vector<std::int32_t> k, j;  ///< pair index and partner, by row of the pair list
     std::vector<std::int32_t> end;   ///< end of slot p's near pairs (owned slots)
     std::vector<double> x, y, z;     ///< [m] positions at the last full scan
-    double margin = 0.0;             ///< [m] gap below which a pair is kept (Model::skin / 10)
+    double margin = 0.0;             ///< [m] gap below which a pair is kept (0.05-0.5 Model::skin, adapted: forces.cpp)
+    int age = 0;                     ///< contact passes over the near pairs since the last full scan
     bool valid = false;              ///< rows and positions are those of the current list
     bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since
   } near;
