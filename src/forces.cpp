@@ -1,11 +1,11 @@
 // Determinism without atomics or per-contact reaction buffers: the slots (spatially sorted) are
 // cut into blocks such that every pair (i, j) has j in i's block or the next (Workspace::block).
-// The even blocks are evaluated first, in parallel, then the odd ones: a block's thread adds each
-// contact's force to both bodies directly, and no two blocks evaluated at the same time touch the
-// same particle. Every particle's sum therefore runs in a fixed order (its own block's pairs in
-// list order, and the pairs of the block before it, first or second by the parity of its block)
-// that depends on the data only, so the result is bitwise the same for any thread count and
-// schedule. Rejected alternatives: atomics or thread-private force arrays (the summation order,
+// A block's thread adds each contact's force to both bodies directly; blocks evaluated at the
+// same time touch no common particle when they are all even or all odd, and an odd block waits
+// for the even blocks on either side (block_pass; which thread takes which block: balance.h).
+// Every particle's sum therefore runs in a fixed order (the pairs of the even block among its
+// own and the one before it, in list order, then those of the odd one) that depends on the data
+// only, so the result is bitwise the same for any thread count and schedule. Rejected alternatives: atomics or thread-private force arrays (the summation order,
 // and so the last bits of every trajectory, would depend on the number of threads); a buffer
 // slot per contact summed afterwards (what this engine did first: 48 bytes more per pair each
 // step, 1.3x slower on B1).
@@ -32,12 +32,17 @@
 #include "parallel.h"
 #include "forces.h"
 
+#include "balance.h"
 #include "domain.h"
 #include "mesh_contacts.h"
 #include "neighbors.h"
 
-#include <cmath>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+#include <utility>
 
 namespace dem {
 
@@ -284,23 +289,51 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   }
 }
 
-/// The contacts of the owned slots, block by block: the even blocks, then the odd ones (see the
-/// top of this file). Called by every thread of a parallel region.
+/// Waits until block b's contacts of this pass are summed (Workspace::block_done).
+void wait_for_block(Workspace& work, long b) {
+  const std::atomic_ref<std::uint32_t> done(work.block_done[b]);
+  for (int spins = 0; done.load(std::memory_order_acquire) != work.pass_epoch; ++spins) {
+#if defined(__x86_64__)
+    __builtin_ia32_pause();
+#endif
+    if (spins > 4096) std::this_thread::yield();  // more threads than cores
+  }
+}
+
+/// The contacts of the owned slots, block by block (see the top of this file). Each thread takes
+/// its run of blocks (balance.h) and evaluates its even blocks, then its odd ones. An odd block
+/// waits only for the even blocks next to it, and those of another thread are evaluated first,
+/// so a thread hardly waits, and there is no barrier between the two halves. Called by every
+/// thread of a parallel region.
 template <bool kPeriodic, bool kGhosts, Scan kScan>
 void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
   const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
-  for (long parity = 0; parity < 2; ++parity) {
-#pragma omp for schedule(dynamic, 1) nowait
-    for (long b = parity; b < blocks; b += 2) {
-      const long last = std::min(n, (b + 1) * block);
-      for (long i = b * block; i < last; ++i) {
-        particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
-        if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
-      }
+  const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
+  const auto evaluate = [&](long b) {
+    const auto start = std::chrono::steady_clock::now();
+    for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
+      particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
+      if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
     }
     flush(model, batch, s, work);
-#pragma omp barrier
-  }
+    std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
+    add_block_time(work, b, start);
+  };
+  // Even blocks first: those at the ends of the run (a neighbour's odd block may wait for them).
+  const long first_even = lo + (lo & 1), last_even = (hi - 1) - ((hi - 1) & 1);
+  if (first_even < hi) evaluate(first_even);
+  if (last_even > first_even) evaluate(last_even);
+  for (long b = first_even + 2; b < last_even; b += 2) evaluate(b);
+  // Then the odd ones, those at the ends last (they may wait for a neighbour's even block).
+  const long first_odd = lo + 1 - (lo & 1), last_odd = (hi - 1) - 1 + ((hi - 1) & 1);
+  for (long b = first_odd + 2; b < last_odd; b += 2) evaluate(b);
+  const auto evaluate_edge = [&](long b) {
+    if (b - 1 < lo) wait_for_block(work, b - 1);
+    if (b + 1 < blocks && b + 1 >= hi) wait_for_block(work, b + 1);
+    evaluate(b);
+  };
+  if (first_odd < hi) evaluate_edge(first_odd);
+  if (last_odd > first_odd) evaluate_edge(last_odd);
 }
 
 /// The block pass for each case, by [periodic][ghosts].
@@ -381,6 +414,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   work.near.age = near ? work.near.age + 1 : 0;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
+  share_blocks(work, n);
 #pragma omp parallel if (n >= kParallelMin)
   {
     const long clear_from = work.loads_cleared ? n : 0;  // owned slots zeroed by the kick-drift pass
@@ -402,8 +436,8 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   if (work.domain) work.domain->return_ghost_loads(s);
 
   // Gravity, and the closing half kick of free spheres.
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (long begin = 0; begin < n; begin += kChunk) gravity_kick_range(model.gravity.data(), s, begin, std::min(n, begin + kChunk), kick);
+#pragma omp parallel if (n >= kParallelMin)
+  for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick); });
 
   // Bodies: force and torque about the centre of mass from their spheres, plus weight.
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];

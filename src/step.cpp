@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "balance.h"
 #include "domain.h"
 #include "forces.h"
 #include "mesh_contacts.h"
@@ -71,15 +72,16 @@ DEM_KERNEL int kick_drift_range(State& s, const Workspace& work, long begin, lon
 /// (from their own totals) and move freely, then place their spheres. Returns the
 /// Moved flags of the free spheres (the test of needs_rebuild, and that of the near pairs, made
 /// while the positions are in cache).
-int kick_drift(State& s, const Workspace& work, const Model& model, double h, double dt) {
+int kick_drift(State& s, Workspace& work, const Model& model, double h, double dt) {
   const long n = static_cast<long>(s.owned());  // ghosts are moved by their owners
   const bool check = s.x_built.size() == s.size();
   const bool near = check && work.near.valid && work.near.x.size() == static_cast<size_t>(n);
   const double limit2 = 0.25 * model.skin * model.skin, near2 = 0.25 * work.near.margin * work.near.margin;
   int moved = (check ? 0 : kRebuild) | (near ? 0 : kRescan);
-#pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
-  for (long begin = 0; begin < n; begin += kChunk)
-    moved |= kick_drift_range(s, work, begin, std::min(n, begin + kChunk), h, dt, check, near, limit2, near2);
+#pragma omp parallel reduction(| : moved) if (n >= kParallelMin)
+  for_own_blocks(work, n, [&](long begin, long end) {
+    moved |= kick_drift_range(s, work, begin, end, h, dt, check, near, limit2, near2);
+  });
   Bodies& b = s.bodies;
   if (b.size() == 0) return moved;
   for (size_t k = 0; k < b.size(); ++k) {

@@ -59,6 +59,13 @@ struct Workspace {
   /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
   /// (forces.cpp).
   std::int32_t block = 64;
+  /// Per block (balance.h): its work (seconds of its passes per step, averaged; pairs listed
+  /// until first measured), the time its passes took this step, the running sum of the work
+  /// over the blocks, and the number of the last contact pass that summed its contacts.
+  std::vector<double> block_work, block_time, block_prefix;
+  std::vector<std::uint32_t> block_done;
+  std::uint32_t pass_epoch = 0;
+  bool block_timed = false;  ///< block_work holds measured seconds
   /// Owned slots with a ghost partner, ascending (domain.h; empty without ghosts).
   std::vector<std::int32_t> ghost_owners;
 
