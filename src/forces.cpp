@@ -41,6 +41,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -289,66 +290,6 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   }
 }
 
-/// Waits until block b's contacts of this pass are summed (Workspace::block_done).
-void wait_for_block(Workspace& work, long b) {
-  const std::atomic_ref<std::uint32_t> done(work.block_done[b]);
-  for (int spins = 0; done.load(std::memory_order_acquire) != work.pass_epoch; ++spins) {
-#if defined(__x86_64__)
-    __builtin_ia32_pause();
-#endif
-    if (spins > 4096) std::this_thread::yield();  // more threads than cores
-  }
-}
-
-/// The contacts of the owned slots, block by block (see the top of this file). Each thread takes
-/// its run of blocks (balance.h) and evaluates its even blocks, then its odd ones. An odd block
-/// waits only for the even blocks next to it, and those of another thread are evaluated first,
-/// so a thread hardly waits, and there is no barrier between the two halves. Called by every
-/// thread of a parallel region.
-template <bool kPeriodic, bool kGhosts, Scan kScan>
-void block_pass(const Model& model, State& s, Workspace& work, Batch& batch) {
-  const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
-  const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
-  const auto evaluate = [&](long b) {
-    const auto start = std::chrono::steady_clock::now();
-    for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
-      particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
-      if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
-    }
-    flush(model, batch, s, work);
-    std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
-    add_block_time(work, b, start);
-  };
-  // Even blocks first: those at the ends of the run (a neighbour's odd block may wait for them).
-  const long first_even = lo + (lo & 1), last_even = (hi - 1) - ((hi - 1) & 1);
-  if (first_even < hi) evaluate(first_even);
-  if (last_even > first_even) evaluate(last_even);
-  for (long b = first_even + 2; b < last_even; b += 2) evaluate(b);
-  // Then the odd ones, those at the ends last (they may wait for a neighbour's even block).
-  const long first_odd = lo + 1 - (lo & 1), last_odd = (hi - 1) - 1 + ((hi - 1) & 1);
-  for (long b = first_odd + 2; b < last_odd; b += 2) evaluate(b);
-  const auto evaluate_edge = [&](long b) {
-    if (b - 1 < lo) wait_for_block(work, b - 1);
-    if (b + 1 < blocks && b + 1 >= hi) wait_for_block(work, b + 1);
-    evaluate(b);
-  };
-  if (first_odd < hi) evaluate_edge(first_odd);
-  if (last_odd > first_odd) evaluate_edge(last_odd);
-}
-
-/// The block pass for each case, by [periodic][ghosts].
-using BlockPass = void (*)(const Model&, State&, Workspace&, Batch&);
-template <Scan kScan>
-constexpr BlockPass pass[2][2] = {{block_pass<false, false, kScan>, block_pass<false, true, kScan>},
-                                  {block_pass<true, false, kScan>, block_pass<true, true, kScan>}};
-
-/// Slots [begin, end): forces and torques set to zero.
-DEM_KERNEL void clear_loads(State& s, long begin, long end) {
-  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
-  DEM_VECTOR_LOOP
-  for (long p = begin; p < end; ++p) fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;
-}
-
 /// Adds gravity to the free spheres among slots [begin, end) and gives them the closing half
 /// kick (none when kick = 0). A body carries its own weight; a glued sphere is part of its wall,
 /// which has none.
@@ -375,6 +316,86 @@ DEM_KERNEL void gravity_kick_range(const double* gravity, State& s, long begin, 
     vx[p] = kicked ? nvx : vx[p], vy[p] = kicked ? nvy : vy[p], vz[p] = kicked ? nvz : vz[p];
     wx[p] = kicked ? nwx : wx[p], wy[p] = kicked ? nwy : wy[p], wz[p] = kicked ? nwz : wz[p];
   }
+}
+
+/// What is left of a sphere's step once its contacts with other spheres are summed: its mesh
+/// contacts, then gravity and the closing half kick. The block pass does it block by block when
+/// nothing else is to be added (no pairs with ghosts, no loads returned by other ranks).
+struct Finish {
+  MeshContactPass* meshes;  ///< this thread's; null without meshes
+  double kick;              ///< [s] closing half kick (0: none)
+};
+
+/// Waits until block b's contacts of this pass are summed (Workspace::block_done).
+void wait_for_block(Workspace& work, long b) {
+  const std::atomic_ref<std::uint32_t> done(work.block_done[b]);
+  for (int spins = 0; done.load(std::memory_order_acquire) != work.pass_epoch; ++spins) {
+#if defined(__x86_64__)
+    __builtin_ia32_pause();
+#endif
+    if (spins > 4096) std::this_thread::yield();  // more threads than cores
+  }
+}
+
+/// The contacts of the owned slots, block by block (see the top of this file). Each thread takes
+/// its run of blocks (balance.h) and evaluates its even blocks, then its odd ones. An odd block
+/// waits only for the even blocks next to it, and those of another thread are evaluated first,
+/// so a thread hardly waits, and there is no barrier between the two halves. Called by every
+/// thread of a parallel region.
+template <bool kPeriodic, bool kGhosts, Scan kScan>
+void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, const Finish* finish) {
+  const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
+  const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
+  const auto evaluate = [&](long b) {
+    const auto start = std::chrono::steady_clock::now();
+    for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
+      particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
+      if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
+    }
+    flush(model, batch, s, work);
+    std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
+    add_block_time(work, b, start);
+  };
+  // A block's spheres have all their pair contacts once it and the block before it are summed:
+  // block 0 after itself, an odd block and the one after it after the odd one.
+  const auto complete = [&](long b) {
+    if (!finish || b >= blocks) return;
+    const auto start = std::chrono::steady_clock::now();
+    const long first = b * block, last = std::min(n, (b + 1) * block);
+    if (finish->meshes) finish->meshes->run(first, last);
+    gravity_kick_range(model.gravity.data(), s, first, last, finish->kick);
+    add_block_time(work, b, start);
+  };
+  const auto evaluate_odd = [&](long b) { evaluate(b), complete(b), complete(b + 1); };
+  // Even blocks first: those at the ends of the run (a neighbour's odd block may wait for them).
+  const long first_even = lo + (lo & 1), last_even = (hi - 1) - ((hi - 1) & 1);
+  if (first_even < hi) evaluate(first_even);
+  if (last_even > first_even) evaluate(last_even);
+  for (long b = first_even + 2; b < last_even; b += 2) evaluate(b);
+  if (lo == 0 && hi > 0) complete(0);
+  // Then the odd ones, those at the ends last (they may wait for a neighbour's even block).
+  const long first_odd = lo + 1 - (lo & 1), last_odd = (hi - 1) - 1 + ((hi - 1) & 1);
+  for (long b = first_odd + 2; b < last_odd; b += 2) evaluate_odd(b);
+  const auto evaluate_edge = [&](long b) {
+    if (b - 1 < lo) wait_for_block(work, b - 1);
+    if (b + 1 < blocks && b + 1 >= hi) wait_for_block(work, b + 1);
+    evaluate_odd(b);
+  };
+  if (first_odd < hi) evaluate_edge(first_odd);
+  if (last_odd > first_odd) evaluate_edge(last_odd);
+}
+
+/// The block pass for each case, by [periodic][ghosts].
+using BlockPass = void (*)(const Model&, State&, Workspace&, Batch&, const Finish*);
+template <Scan kScan>
+constexpr BlockPass pass[2][2] = {{block_pass<false, false, kScan>, block_pass<false, true, kScan>},
+                                  {block_pass<true, false, kScan>, block_pass<true, true, kScan>}};
+
+/// Slots [begin, end): forces and torques set to zero.
+DEM_KERNEL void clear_loads(State& s, long begin, long end) {
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  DEM_VECTOR_LOOP
+  for (long p = begin; p < end; ++p) fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;
 }
 
 }  // namespace
@@ -414,6 +435,10 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   work.near.age = near ? work.near.age + 1 : 0;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
+  // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
+  // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
+  const bool finish_in_pass = !ghosts && !work.domain;
+  prepare_mesh_contacts(model, s, work);
   share_blocks(work, n);
 #pragma omp parallel if (n >= kParallelMin)
   {
@@ -421,23 +446,28 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
 #pragma omp for schedule(static)
     for (long begin = clear_from; begin < n_all; begin += kChunk) clear_loads(s, begin, std::min(n_all, begin + kChunk));
     Batch batch;
-    (near ? pass<Scan::kNear> : pass<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch);
+    std::optional<MeshContactPass> meshes;
+    if (finish_in_pass && !model.meshes.empty()) meshes.emplace(model, s, work);
+    const Finish finish{meshes ? &*meshes : nullptr, kick};
+    (near ? pass<Scan::kNear> : pass<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
   }
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
   work.near_refreshes += !near;
-  if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
-    Batch batch;
-    for (const std::int32_t i : work.ghost_owners)
-      (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
-    flush(model, batch, s, work);
-  }
-
-  mesh_contact_forces(model, s, work);
-  if (work.domain) work.domain->return_ghost_loads(s);
-
-  // Gravity, and the closing half kick of free spheres.
+  if (finish_in_pass) {
+    sum_mesh_records(model, s, work);
+  } else {
+    if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
+      Batch batch;
+      for (const std::int32_t i : work.ghost_owners)
+        (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+      flush(model, batch, s, work);
+    }
+    mesh_contact_forces(model, s, work);
+    if (work.domain) work.domain->return_ghost_loads(s);
+    // Gravity, and the closing half kick of free spheres.
 #pragma omp parallel if (n >= kParallelMin)
-  for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick); });
+    for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick); });
+  }
 
   // Bodies: force and torque about the centre of mass from their spheres, plus weight.
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];

@@ -1,8 +1,11 @@
 #include "mesh_contacts.h"
 
+#include "balance.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 
 #include "forces.h"
 #include "parallel.h"
@@ -180,166 +183,187 @@ void find_mesh_candidates(const Model& model, State& s, Workspace& work, double 
             });
 }
 
-void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
-  const size_t n = s.owned();  // ghosts touch no wall
-  const int width = model.history_width;
-  MeshContacts& mc = s.mesh_contacts;
+/// One thread's scratch for the mesh contacts: the batch and the contacts of the last step.
+struct MeshContactPass::Scratch {
+  MeshBatch mb;
+  std::vector<Candidate> list;
+  std::vector<double> old_history;
+};
+
+void prepare_mesh_contacts(const Model& model, const State& s, Workspace& work) {
   if (model.meshes.empty()) return;
-  MeshSlotResults& slot_results = work.mesh_slots;
   // Results by candidate: contact k of particle p at candidate_begin[p] + k (a particle has no
   // more contacts than candidates), not one row per slot: most particles touch no wall. Written
-  // below before they are read, so not filled.
+  // by the pass before they are read, so not filled.
   const size_t results = s.mesh_candidates.size();
   if (work.mesh_forces.fx.size() != results) {
     ContactForces& f = work.mesh_forces;
     for (auto* c : {&f.fx, &f.fy, &f.fz}) resize_discarding(*c, results);
     resize_discarding(f.active, results);
-    slot_results.resize(results);
+    work.mesh_slots.resize(results);
   }
-  const double range = model.interaction_range;
-  const long nl = static_cast<long>(n);
-#pragma omp parallel if (nl >= kParallelMin)
-  {
-    MeshBatch mb;
-    mb.b.count = 0;
-    std::vector<Candidate> list;
-    std::vector<double> old_history(static_cast<size_t>(kSlots) * std::max(width, 1));
-#pragma omp for schedule(static)
-    for (long p = 0; p < nl; ++p) {
-      const std::int32_t first = s.candidate_begin[p], last = s.candidate_begin[p + 1];
-      if (first == last && mc.count[p] == 0) continue;
-      // The contacts of the last step, to carry their history.
-      const int old_count = mc.count[p];
-      std::int32_t old_mesh[kSlots];
-      double old_point[kSlots][3];
-      bool old_used[kSlots] = {};
-      for (int k = 0; k < old_count; ++k) {
-        const size_t slot = static_cast<size_t>(p) * kSlots + k;
-        old_mesh[k] = mc.mesh[slot];
-        old_point[k][0] = mc.px[slot], old_point[k][1] = mc.py[slot], old_point[k][2] = mc.pz[slot];
-        if (width) std::memcpy(&old_history[k * width], &mc.history[slot * width], width * sizeof(double));
-      }
-      if (mb.b.count + kSlots > kBatch) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
-      const double radius = s.radius[p];
-      int count = 0;
-      for (std::int32_t q = first; q < last;) {
-        const std::int32_t m = s.mesh_candidates[q][0];
-        const MeshWall& mesh = model.meshes[m];
-        const TriangleSurface& surface = *mesh.surface;
-        const auto& rot = work.mesh_rotation[m];
-        const double d[3] = {s.x[p] - work.mesh_translation[m][0], s.y[p] - work.mesh_translation[m][1], s.z[p] - work.mesh_translation[m][2]};
-        double local[3];
-        mul_transposed(rot, d, local);
-        // Closest points of this mesh's candidate triangles within reach.
-        list.clear();
-        const double reach2 = (radius + range) * (radius + range);
-        for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
-          const std::int32_t t = s.mesh_candidates[q][1];
-          const auto& tri = surface.triangles[t];
-          // The plane's distance bounds the triangle's from below: most candidates of a sphere
-          // moving over a surface are out of reach of its plane, and cost a dot product.
-          const double* v0 = surface.vertices[tri[0]].data();
-          const double* normal = surface.normals[t].data();
-          const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
-          if (above * above >= reach2) continue;
-          const ClosestPoint cp = closest_point_on_triangle(local, v0, surface.vertices[tri[1]].data(), surface.vertices[tri[2]].data());
-          if (cp.distance2 < reach2) list.push_back({t, cp});
-        }
-        const int kept = resolve_contacts(surface, list, radius);
-        for (int k = 0; k < kept && count < kSlots; ++k) {
-          const Candidate& c = list[k];
-          // Separate meshes meeting at an edge (chute parts) give the same contact twice.
-          double world_point[3];
-          mul(rot, c.closest.point, world_point);
-          bool seen = false;
-          for (int e = mb.b.count - count; e < mb.b.count && !seen; ++e) {
-            const double dx = mb.point[e][0] - world_point[0] - work.mesh_translation[m][0];
-            const double dy = mb.point[e][1] - world_point[1] - work.mesh_translation[m][1];
-            const double dz = mb.point[e][2] - world_point[2] - work.mesh_translation[m][2];
-            seen = dx * dx + dy * dy + dz * dz <= 1e-12 * radius * radius;
-          }
-          if (seen) continue;
-          const double dist = std::sqrt(c.closest.distance2);
-          double normal_local[3];
-          if (dist > 1e-12 * radius) {
-            for (int a = 0; a < 3; ++a) normal_local[a] = (local[a] - c.closest.point[a]) / dist;
-          } else {
-            for (int a = 0; a < 3; ++a) normal_local[a] = surface.normals[c.triangle][a];
-          }
-          double normal[3], point[3];
-          mul(rot, normal_local, normal);
-          mul(rot, c.closest.point, point);
-          for (int a = 0; a < 3; ++a) point[a] += work.mesh_translation[m][a];
-          // Wall velocity at the contact: rigid motion plus the surface's own (belts, pulleys).
-          double arm[3] = {point[0] - work.mesh_origin[m][0], point[1] - work.mesh_origin[m][1], point[2] - work.mesh_origin[m][2]};
-          double wall_v[3];
-          cross(work.mesh_angular[m].data(), arm, wall_v);
-          for (int a = 0; a < 3; ++a) wall_v[a] += work.mesh_linear[m][a];
-          double wall_w[3] = {work.mesh_angular[m][0], work.mesh_angular[m][1], work.mesh_angular[m][2]};
-          const SurfaceVelocitySpec& sv = mesh.surface_velocity;
-          if (sv.kind == SurfaceVelocitySpec::Kind::linear) {
-            double tri_normal[3];
-            mul(rot, surface.normals[c.triangle].data(), tri_normal);
-            const double along = sv.velocity.x() * tri_normal[0] + sv.velocity.y() * tri_normal[1] + sv.velocity.z() * tri_normal[2];
-            for (int a = 0; a < 3; ++a) wall_v[a] += sv.velocity[a] - along * tri_normal[a];
-          } else if (sv.kind == SurfaceVelocitySpec::Kind::rotation) {
-            const double w[3] = {sv.axis.x() * sv.angular_speed, sv.axis.y() * sv.angular_speed, sv.axis.z() * sv.angular_speed};
-            const double r[3] = {point[0] - sv.point.x(), point[1] - sv.point.y(), point[2] - sv.point.z()};
-            double v[3];
-            cross(w, r, v);
-            for (int a = 0; a < 3; ++a) wall_v[a] += v[a], wall_w[a] += w[a];
-          }
-          // The same contact as last step: same mesh, nearest point within a radius.
-          const size_t slot = static_cast<size_t>(p) * kSlots + count;
-          int match = -1;
-          double best = radius * radius;
-          for (int o = 0; o < old_count; ++o) {
-            if (old_used[o] || old_mesh[o] != m) continue;
-            const double dx = old_point[o][0] - c.closest.point[0], dy = old_point[o][1] - c.closest.point[1],
-                         dz = old_point[o][2] - c.closest.point[2];
-            const double d2 = dx * dx + dy * dy + dz * dz;
-            if (d2 < best) best = d2, match = o;
-          }
-          if (width) {
-            if (match >= 0) std::memcpy(&mc.history[slot * width], &old_history[match * width], width * sizeof(double));
-            else std::fill_n(&mc.history[slot * width], width, 0.0);
-          }
-          if (match >= 0) old_used[match] = true;
-          mc.mesh[slot] = m, mc.triangle[slot] = c.triangle;
-          mc.px[slot] = c.closest.point[0], mc.py[slot] = c.closest.point[1], mc.pz[slot] = c.closest.point[2];
-          // Geometry and motion for the effects; a wall is flat (infinite radius).
-          ContactBatch& b = mb.b;
-          const int e = b.count++;
-          const double lever = dist;
-          const double vix = s.vx[p] - lever * (s.wy[p] * normal[2] - s.wz[p] * normal[1]);
-          const double viy = s.vy[p] - lever * (s.wz[p] * normal[0] - s.wx[p] * normal[2]);
-          const double viz = s.vz[p] - lever * (s.wx[p] * normal[1] - s.wy[p] * normal[0]);
-          const double rx = vix - wall_v[0], ry = viy - wall_v[1], rz = viz - wall_v[2];
-          const double vn = rx * normal[0] + ry * normal[1] + rz * normal[2];
-          b.nx[e] = normal[0], b.ny[e] = normal[1], b.nz[e] = normal[2];
-          b.vn[e] = vn;
-          b.vtx[e] = rx - vn * normal[0], b.vty[e] = ry - vn * normal[1], b.vtz[e] = rz - vn * normal[2];
-          b.wx[e] = s.wx[p] - wall_w[0], b.wy[e] = s.wy[p] - wall_w[1], b.wz[e] = s.wz[p] - wall_w[2];
-          b.pair_type[e] = model.pair_type(s.material[p], mesh.material);
-          b.overlap[e] = radius - dist;
-          b.radius_i[e] = radius, b.radius_j[e] = 0.0, b.r_eff[e] = radius;
-          b.m_eff[e] = 1.0 / s.inv_mass[p];
-          b.inertia_eff[e] = 1.4 * radius * radius / s.inv_mass[p];
-          b.history[e] = width ? &mc.history[slot * width] : old_history.data();
-          const size_t at = static_cast<size_t>(first) + static_cast<size_t>(count);  // results
-          mb.slot[e] = static_cast<std::int32_t>(slot);
-          mb.result[e] = static_cast<std::int32_t>(at);
-          mb.lever[e] = lever;
-          for (int a = 0; a < 3; ++a) mb.wall_v[e][a] = wall_v[a], mb.point[e][a] = point[a];
-          slot_results.impact_energy[at] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
-          ++count;
-        }
-      }
-      mc.count[p] = static_cast<std::uint8_t>(count);
-    }
-    if (mb.b.count) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
-  }
+}
 
+MeshContactPass::MeshContactPass(const Model& model, State& state, Workspace& work)
+    : model_(model), s_(state), work_(work), scratch_(std::make_unique<Scratch>()) {
+  scratch_->mb.b.count = 0;
+  scratch_->old_history.resize(static_cast<size_t>(kSlots) * std::max(model.history_width, 1));
+}
+
+MeshContactPass::~MeshContactPass() = default;
+
+void MeshContactPass::run(long begin, long end) {
+  const Model& model = model_;
+  State& s = s_;
+  Workspace& work = work_;
+  if (model.meshes.empty()) return;
+  const int width = model.history_width;
+  MeshContacts& mc = s.mesh_contacts;
+  MeshSlotResults& slot_results = work.mesh_slots;
+  const double range = model.interaction_range;
+  MeshBatch& mb = scratch_->mb;
+  std::vector<Candidate>& list = scratch_->list;
+  std::vector<double>& old_history = scratch_->old_history;
+  for (long p = begin; p < end; ++p) {
+    const std::int32_t first = s.candidate_begin[p], last = s.candidate_begin[p + 1];
+    if (first == last && mc.count[p] == 0) continue;
+    // The contacts of the last step, to carry their history.
+    const int old_count = mc.count[p];
+    std::int32_t old_mesh[kSlots];
+    double old_point[kSlots][3];
+    bool old_used[kSlots] = {};
+    for (int k = 0; k < old_count; ++k) {
+      const size_t slot = static_cast<size_t>(p) * kSlots + k;
+      old_mesh[k] = mc.mesh[slot];
+      old_point[k][0] = mc.px[slot], old_point[k][1] = mc.py[slot], old_point[k][2] = mc.pz[slot];
+      if (width) std::memcpy(&old_history[k * width], &mc.history[slot * width], width * sizeof(double));
+    }
+    if (mb.b.count + kSlots > kBatch) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
+    const double radius = s.radius[p];
+    int count = 0;
+    for (std::int32_t q = first; q < last;) {
+      const std::int32_t m = s.mesh_candidates[q][0];
+      const MeshWall& mesh = model.meshes[m];
+      const TriangleSurface& surface = *mesh.surface;
+      const auto& rot = work.mesh_rotation[m];
+      const double d[3] = {s.x[p] - work.mesh_translation[m][0], s.y[p] - work.mesh_translation[m][1], s.z[p] - work.mesh_translation[m][2]};
+      double local[3];
+      mul_transposed(rot, d, local);
+      // Closest points of this mesh's candidate triangles within reach.
+      list.clear();
+      const double reach2 = (radius + range) * (radius + range);
+      for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
+        const std::int32_t t = s.mesh_candidates[q][1];
+        const auto& tri = surface.triangles[t];
+        // The plane's distance bounds the triangle's from below: most candidates of a sphere
+        // moving over a surface are out of reach of its plane, and cost a dot product.
+        const double* v0 = surface.vertices[tri[0]].data();
+        const double* normal = surface.normals[t].data();
+        const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
+        if (above * above >= reach2) continue;
+        const ClosestPoint cp = closest_point_on_triangle(local, v0, surface.vertices[tri[1]].data(), surface.vertices[tri[2]].data());
+        if (cp.distance2 < reach2) list.push_back({t, cp});
+      }
+      const int kept = resolve_contacts(surface, list, radius);
+      for (int k = 0; k < kept && count < kSlots; ++k) {
+        const Candidate& c = list[k];
+        // Separate meshes meeting at an edge (chute parts) give the same contact twice.
+        double world_point[3];
+        mul(rot, c.closest.point, world_point);
+        bool seen = false;
+        for (int e = mb.b.count - count; e < mb.b.count && !seen; ++e) {
+          const double dx = mb.point[e][0] - world_point[0] - work.mesh_translation[m][0];
+          const double dy = mb.point[e][1] - world_point[1] - work.mesh_translation[m][1];
+          const double dz = mb.point[e][2] - world_point[2] - work.mesh_translation[m][2];
+          seen = dx * dx + dy * dy + dz * dz <= 1e-12 * radius * radius;
+        }
+        if (seen) continue;
+        const double dist = std::sqrt(c.closest.distance2);
+        double normal_local[3];
+        if (dist > 1e-12 * radius) {
+          for (int a = 0; a < 3; ++a) normal_local[a] = (local[a] - c.closest.point[a]) / dist;
+        } else {
+          for (int a = 0; a < 3; ++a) normal_local[a] = surface.normals[c.triangle][a];
+        }
+        double normal[3], point[3];
+        mul(rot, normal_local, normal);
+        mul(rot, c.closest.point, point);
+        for (int a = 0; a < 3; ++a) point[a] += work.mesh_translation[m][a];
+        // Wall velocity at the contact: rigid motion plus the surface's own (belts, pulleys).
+        double arm[3] = {point[0] - work.mesh_origin[m][0], point[1] - work.mesh_origin[m][1], point[2] - work.mesh_origin[m][2]};
+        double wall_v[3];
+        cross(work.mesh_angular[m].data(), arm, wall_v);
+        for (int a = 0; a < 3; ++a) wall_v[a] += work.mesh_linear[m][a];
+        double wall_w[3] = {work.mesh_angular[m][0], work.mesh_angular[m][1], work.mesh_angular[m][2]};
+        const SurfaceVelocitySpec& sv = mesh.surface_velocity;
+        if (sv.kind == SurfaceVelocitySpec::Kind::linear) {
+          double tri_normal[3];
+          mul(rot, surface.normals[c.triangle].data(), tri_normal);
+          const double along = sv.velocity.x() * tri_normal[0] + sv.velocity.y() * tri_normal[1] + sv.velocity.z() * tri_normal[2];
+          for (int a = 0; a < 3; ++a) wall_v[a] += sv.velocity[a] - along * tri_normal[a];
+        } else if (sv.kind == SurfaceVelocitySpec::Kind::rotation) {
+          const double w[3] = {sv.axis.x() * sv.angular_speed, sv.axis.y() * sv.angular_speed, sv.axis.z() * sv.angular_speed};
+          const double r[3] = {point[0] - sv.point.x(), point[1] - sv.point.y(), point[2] - sv.point.z()};
+          double v[3];
+          cross(w, r, v);
+          for (int a = 0; a < 3; ++a) wall_v[a] += v[a], wall_w[a] += w[a];
+        }
+        // The same contact as last step: same mesh, nearest point within a radius.
+        const size_t slot = static_cast<size_t>(p) * kSlots + count;
+        int match = -1;
+        double best = radius * radius;
+        for (int o = 0; o < old_count; ++o) {
+          if (old_used[o] || old_mesh[o] != m) continue;
+          const double dx = old_point[o][0] - c.closest.point[0], dy = old_point[o][1] - c.closest.point[1],
+                       dz = old_point[o][2] - c.closest.point[2];
+          const double d2 = dx * dx + dy * dy + dz * dz;
+          if (d2 < best) best = d2, match = o;
+        }
+        if (width) {
+          if (match >= 0) std::memcpy(&mc.history[slot * width], &old_history[match * width], width * sizeof(double));
+          else std::fill_n(&mc.history[slot * width], width, 0.0);
+        }
+        if (match >= 0) old_used[match] = true;
+        mc.mesh[slot] = m, mc.triangle[slot] = c.triangle;
+        mc.px[slot] = c.closest.point[0], mc.py[slot] = c.closest.point[1], mc.pz[slot] = c.closest.point[2];
+        // Geometry and motion for the effects; a wall is flat (infinite radius).
+        ContactBatch& b = mb.b;
+        const int e = b.count++;
+        const double lever = dist;
+        const double vix = s.vx[p] - lever * (s.wy[p] * normal[2] - s.wz[p] * normal[1]);
+        const double viy = s.vy[p] - lever * (s.wz[p] * normal[0] - s.wx[p] * normal[2]);
+        const double viz = s.vz[p] - lever * (s.wx[p] * normal[1] - s.wy[p] * normal[0]);
+        const double rx = vix - wall_v[0], ry = viy - wall_v[1], rz = viz - wall_v[2];
+        const double vn = rx * normal[0] + ry * normal[1] + rz * normal[2];
+        b.nx[e] = normal[0], b.ny[e] = normal[1], b.nz[e] = normal[2];
+        b.vn[e] = vn;
+        b.vtx[e] = rx - vn * normal[0], b.vty[e] = ry - vn * normal[1], b.vtz[e] = rz - vn * normal[2];
+        b.wx[e] = s.wx[p] - wall_w[0], b.wy[e] = s.wy[p] - wall_w[1], b.wz[e] = s.wz[p] - wall_w[2];
+        b.pair_type[e] = model.pair_type(s.material[p], mesh.material);
+        b.overlap[e] = radius - dist;
+        b.radius_i[e] = radius, b.radius_j[e] = 0.0, b.r_eff[e] = radius;
+        b.m_eff[e] = 1.0 / s.inv_mass[p];
+        b.inertia_eff[e] = 1.4 * radius * radius / s.inv_mass[p];
+        b.history[e] = width ? &mc.history[slot * width] : old_history.data();
+        const size_t at = static_cast<size_t>(first) + static_cast<size_t>(count);  // results
+        mb.slot[e] = static_cast<std::int32_t>(slot);
+        mb.result[e] = static_cast<std::int32_t>(at);
+        mb.lever[e] = lever;
+        for (int a = 0; a < 3; ++a) mb.wall_v[e][a] = wall_v[a], mb.point[e][a] = point[a];
+        slot_results.impact_energy[at] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
+        ++count;
+      }
+    }
+    mc.count[p] = static_cast<std::uint8_t>(count);
+  }
+  if (mb.b.count) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
+}
+
+void sum_mesh_records(const Model& model, State& s, Workspace& work) {
+  if (model.meshes.empty()) return;
+  const size_t n = s.owned();
+  const MeshContacts& mc = s.mesh_contacts;
+  const MeshSlotResults& slot_results = work.mesh_slots;
   // Records per triangle and loads per mesh, summed in slot order.
   auto& loads = s.mesh_loads;
   for (auto* c : {&loads.fx, &loads.fy, &loads.fz, &loads.tx, &loads.ty, &loads.tz, &loads.power}) c->assign(model.meshes.size(), 0.0);
@@ -372,6 +396,19 @@ void mesh_contact_forces(const Model& model, State& s, Workspace& work) {
       loads.power[m] += slot_results.wall_power[at];
     }
   }
+}
+
+
+void mesh_contact_forces(const Model& model, State& state, Workspace& work) {
+  if (model.meshes.empty()) return;
+  prepare_mesh_contacts(model, state, work);
+  const long n = static_cast<long>(state.owned());  // ghosts touch no wall
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    MeshContactPass pass(model, state, work);
+    for_own_blocks(work, n, [&](long begin, long end) { pass.run(begin, end); });
+  }
+  sum_mesh_records(model, state, work);
 }
 
 }  // namespace dem

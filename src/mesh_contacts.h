@@ -4,6 +4,8 @@
 // triangle (forces, friction work, impacts) and per mesh (force, torque, power).
 #pragma once
 
+#include <memory>
+
 #include "model.h"
 #include "state.h"
 #include "workspace.h"
@@ -16,6 +18,33 @@ void place_meshes(const Model& model, double time, Workspace& work);
 void find_mesh_candidates(const Model& model, State& state, Workspace& work, double reach);
 /// Largest displacement of any mesh since the lists were built (for the skin criterion) [m].
 double mesh_displacement_since_build(const Model& model, const State& state, double time);
+/// Sizes the per-contact results for the candidates of the last rebuild (before any pass).
+void prepare_mesh_contacts(const Model& model, const State& state, Workspace& work);
+
+/// One thread's evaluation of mesh contacts, a range of slots at a time. Each slot's contacts
+/// are resolved and evaluated, their forces and torques added to its totals (which are complete
+/// when run returns), and kept by contact in Workspace::mesh_forces and mesh_slots. Any thread
+/// may take any slots, each slot once per step; the records are summed after all of them
+/// (sum_mesh_records).
+class MeshContactPass {
+ public:
+  MeshContactPass(const Model& model, State& state, Workspace& work);
+  ~MeshContactPass();
+  MeshContactPass(const MeshContactPass&) = delete;
+  MeshContactPass& operator=(const MeshContactPass&) = delete;
+  void run(long begin, long end);  ///< slots [begin, end)
+
+ private:
+  struct Scratch;
+  const Model& model_;
+  State& s_;
+  Workspace& work_;
+  std::unique_ptr<Scratch> scratch_;
+};
+
+/// Records per triangle and loads per mesh from this step's mesh contacts, in slot order.
+void sum_mesh_records(const Model& model, State& state, Workspace& work);
+
 /// Resolves and evaluates the mesh contacts of every particle at the meshes' current pose;
 /// forces and torques are added to the particles' totals (state.fx.., tx..) and kept per slot
 /// in Workspace::mesh_forces; records and loads go to the state.
