@@ -45,6 +45,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -95,6 +96,12 @@ using bench::reset_peak_rss;
 /// Bytes a vector holds (capacity, i.e. what it really occupies).
 template <typename T>
 std::size_t bytes(const std::vector<T>& v) { return v.capacity() * sizeof(T); }
+template <typename T, std::size_t N>
+std::size_t bytes(const std::array<std::vector<T>, N>& columns) {
+  std::size_t b = 0;
+  for (const auto& c : columns) b += bytes(c);
+  return b;
+}
 
 /// Bytes of the particle columns of State in use (size, not capacity): the engine's
 /// per-particle hot state (148 B for 17 doubles + int32 material + int64 id).
@@ -138,7 +145,9 @@ std::size_t workspace_bytes(const dem::Workspace& w) {
   return bytes(w.pair_begin) +
          bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order) +
-         bytes(w.members) + bytes(w.ghost_owners) + scratch_bytes(w);
+         bytes(w.members) + bytes(w.ghost_owners) + scratch_bytes(w) + bytes(w.near.k) + bytes(w.near.j) + bytes(w.near.end) +
+         bytes(w.near.x) + bytes(w.near.y) + bytes(w.near.z) + bytes(w.block_work) + bytes(w.block_time) +
+         bytes(w.block_prefix) + bytes(w.block_done);
 }
 
 /// Touching particle-particle pairs (overlap > 0).

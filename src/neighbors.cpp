@@ -425,14 +425,21 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     const int n_cells = grid.dims[0] * grid.dims[1] * grid.dims[2];
     work.cell_of.resize(owned);
     work.cell_start.assign(static_cast<size_t>(n_cells) + 1, 0);
-    for (size_t p = 0; p < owned; ++p) {
-      work.cell_of[p] = keep[p] ? grid.index(s.x[p], s.y[p], s.z[p]) : -1;
+    const long nl = static_cast<long>(owned);
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
+    for (long p = 0; p < nl; ++p) work.cell_of[p] = keep[p] ? grid.index(s.x[p], s.y[p], s.z[p]) : -1;
+    for (size_t p = 0; p < owned; ++p)
       if (keep[p]) ++work.cell_start[work.cell_of[p] + 1];
-    }
     for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
     work.order.resize(kept);  // the slots kept, by cell: the permutation drops the others
     scatter_by_cell(work.cell_of, owned, work.cell_start, work.order);
     s.permute(work.order, work.permute_scratch);
+    // Each sorted slot's cell, for the pair search below (without ghosts).
+    const long nk = static_cast<long>(kept);
+    work.members.resize(kept);
+#pragma omp parallel for schedule(static) if (nk >= kParallelMin)
+    for (long k = 0; k < nk; ++k) work.members[k] = work.cell_of[work.order[k]];
+    work.cell_of.swap(work.members);
   }
   if (domain) domain->make_ghosts(model, s);
   const size_t n = s.size(), n_owned = s.owned();
@@ -462,8 +469,6 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     for (int c = 0; c < n_cells; ++c) work.cell_start[c + 1] += work.cell_start[c];
     work.members.resize(n);
     scatter_by_cell(work.cell_of, n, work.cell_start, work.members);
-  } else {
-    for (int c = 0; c < n_cells; ++c) std::fill(work.cell_of.data() + work.cell_start[c], work.cell_of.data() + work.cell_start[c + 1], c);
   }
 
   // Particle pairs, in one pass (fill_rows). Ghosts list no pairs (ghost-ghost pairs are

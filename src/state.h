@@ -88,10 +88,12 @@ struct MeshLoads {
 /// column is swapped with its buffer, so buffers shared by columns of different lengths would
 /// hand every column the capacity of the longest.
 struct PermuteScratch {
-  std::vector<double> f64, slots_f64, history;  // per particle, per mesh slot, mesh slot histories
-  std::vector<std::int32_t> i32, slots_i32;
-  std::vector<std::int64_t> i64;
-  std::vector<std::uint8_t> u8;
+  std::array<std::vector<double>, 4> f64;       // per particle, 4 columns gathered at a time
+  std::vector<double> slots_f64, history;       // per mesh slot, mesh slot histories
+  std::array<std::vector<std::int32_t>, 4> i32;
+  std::vector<std::int32_t> slots_i32;
+  std::array<std::vector<std::int64_t>, 4> i64;
+  std::array<std::vector<std::uint8_t>, 4> u8;
 };
 
 struct State {

@@ -222,6 +222,36 @@ TEST(Neighbors, ReSortingTheSlotsDoesNotChangeAnyForce) {
   EXPECT_LT(worst, 1e-9 * scale) << "largest force change " << worst << " N of forces up to " << scale << " N";
 }
 
+TEST(Neighbors, ARebuildThatDropsSpheresKeepsEveryColumnWithItsSphere) {
+  // Spheres that left the domain are dropped by the rebuild's sort, which gathers the columns
+  // a few at a time: every column must come out as long as the others, and each slot's values
+  // must be those of the sphere with its id.
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 3000;  // above kParallelMin: the gathers are shared by the threads
+  spec.simulation.has_domain = true;
+  spec.simulation.domain_min = {-1, -1, -1}, spec.simulation.domain_max = {1, 1, 1};
+  Sim sim(spec);
+  for (int k = 0; k < 200; ++k) sim.advance();
+  State& s = sim.state;
+  for (size_t p = 0; p < s.size(); p += 97) s.x[p] = 1e3;  // far outside the domain
+  std::map<std::int64_t, std::array<double, 6>> by_id;
+  for (size_t p = 0; p < s.size(); ++p)
+    if (s.x[p] < 1e3) by_id[s.id[p]] = {s.y[p], s.vz[p], s.wx[p], s.radius[p], s.offset_z[p], static_cast<double>(s.material[p])};
+  const std::int64_t lost_before = s.lost;
+  rebuild_contacts(sim.model, s, sim.work);
+  EXPECT_EQ(s.lost - lost_before, 31);
+  ASSERT_EQ(s.size(), by_id.size());
+  for (const auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
+                        &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z})
+    EXPECT_EQ(c->size(), s.size());
+  for (const auto* c : {&s.material, &s.body, &s.attached}) EXPECT_EQ(c->size(), s.size());
+  EXPECT_EQ(s.id.size(), s.size());
+  size_t wrong = 0;
+  for (size_t p = 0; p < s.size(); ++p)
+    wrong += by_id.at(s.id[p]) != std::array<double, 6>{s.y[p], s.vz[p], s.wx[p], s.radius[p], s.offset_z[p], static_cast<double>(s.material[p])};
+  EXPECT_EQ(wrong, 0u) << "slots whose values are not their sphere's";
+}
+
 // The contact kernels see the history as batch columns (effect.h); every effect of the table
 // switched on at once must fit them, or compile() refuses the case.
 TEST(Effects, EveryEffectTogetherFitsTheBatchHistoryColumns) {
