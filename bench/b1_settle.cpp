@@ -96,12 +96,6 @@ using bench::reset_peak_rss;
 /// Bytes a vector holds (capacity, i.e. what it really occupies).
 template <typename T>
 std::size_t bytes(const std::vector<T>& v) { return v.capacity() * sizeof(T); }
-template <typename T, std::size_t N>
-std::size_t bytes(const std::array<std::vector<T>, N>& columns) {
-  std::size_t b = 0;
-  for (const auto& c : columns) b += bytes(c);
-  return b;
-}
 
 /// Bytes of the particle columns of State in use (size, not capacity): the engine's
 /// per-particle hot state (148 B for 17 doubles + int32 material + int64 id).

@@ -434,12 +434,14 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     work.order.resize(kept);  // the slots kept, by cell: the permutation drops the others
     scatter_by_cell(work.cell_of, owned, work.cell_start, work.order);
     s.permute(work.order, work.permute_scratch);
-    // Each sorted slot's cell, for the pair search below (without ghosts).
+    // Each sorted slot's cell, for the pair search below (without ghosts), gathered into the
+    // sort's scratch.
     const long nk = static_cast<long>(kept);
-    work.members.resize(kept);
+    std::vector<std::int32_t>& sorted_cells = work.permute_scratch.i32;
+    resize_discarding(sorted_cells, kept);
 #pragma omp parallel for schedule(static) if (nk >= kParallelMin)
-    for (long k = 0; k < nk; ++k) work.members[k] = work.cell_of[work.order[k]];
-    work.cell_of.swap(work.members);
+    for (long k = 0; k < nk; ++k) sorted_cells[k] = work.cell_of[work.order[k]];
+    work.cell_of.swap(sorted_cells);
   }
   if (domain) domain->make_ghosts(model, s);
   const size_t n = s.size(), n_owned = s.owned();

@@ -16,34 +16,36 @@ namespace dem {
 namespace {
 /// Columns gathered together by State::permute: each thread gathers its share of the slots of a
 /// group of columns into as many scratch columns, then one thread swaps each column with its
-/// scratch. Two barriers per group (not per column: 30 columns, 90 barriers of a few
-/// microseconds each were half of a rebuild's sort, B2); the scratch holds kGroup columns.
+/// scratch. Two barriers per group (not three per column: 30 columns, 90 barriers of a few
+/// microseconds each were half of a rebuild's sort, B2).
 constexpr size_t kGroup = 4;
 
-/// Gathers the columns (up to kGroup of one type) by `order` (called by every thread of a parallel
-/// region; the scratch columns already hold order.size() entries).
-template <typename T>
+/// Gathers the columns by `order`, as many at a time as there are scratch columns (called by
+/// every thread of a parallel region).
+template <typename T, size_t kScratch>
 void apply_order(std::initializer_list<std::vector<T>*> columns, const std::vector<std::int32_t>& order,
-                 std::array<std::vector<T>, kGroup>& scratch) {
+                 const std::array<std::vector<T>*, kScratch>& scratch) {
   const long n = static_cast<long>(order.size());
+#pragma omp single
+  for (std::vector<T>* c : scratch) resize_discarding(*c, order.size());
   for (auto c = columns.begin(); c != columns.end();) {
-    std::vector<T>* group[kGroup];
+    std::vector<T>* group[kScratch];
     size_t g = 0;
-    for (; g < kGroup && c != columns.end(); ++g, ++c) group[g] = *c;
+    for (; g < kScratch && c != columns.end(); ++g, ++c) group[g] = *c;
 #pragma omp for schedule(static)
     for (long k = 0; k < n; ++k)
-      for (size_t q = 0; q < g; ++q) scratch[q][k] = (*group[q])[order[k]];
+      for (size_t q = 0; q < g; ++q) (*scratch[q])[k] = (*group[q])[order[k]];
 #pragma omp single
     for (size_t q = 0; q < g; ++q) {
-      group[q]->swap(scratch[q]);
-      resize_discarding(scratch[q], order.size());  // it now holds a column as it was
+      group[q]->swap(*scratch[q]);
+      resize_discarding(*scratch[q], order.size());  // it now holds a column as it was
     }
   }
 }
 
 template <typename T>
-void apply_order(std::vector<T>& column, const std::vector<std::int32_t>& order, std::array<std::vector<T>, kGroup>& scratch) {
-  apply_order({&column}, order, scratch);
+void apply_order(std::vector<T>& column, const std::vector<std::int32_t>& order, std::vector<T>& scratch) {
+  apply_order({&column}, order, std::array<std::vector<T>*, 1>{&scratch});
 }
 /// Same for the mesh-contact columns: `per_slot` entries for each of a particle's kSlots slots,
 /// of which only the first used[p] hold a contact (the rest are never read, so not copied).
@@ -182,16 +184,15 @@ std::size_t State::unpack_body(const double* in) {
 
 void State::permute(const std::vector<std::int32_t>& order, PermuteScratch& scratch) {
   MeshContacts& mc = mesh_contacts;
-  for (auto& c : scratch.f64) resize_discarding(c, order.size());
-  for (auto& c : scratch.i32) resize_discarding(c, order.size());
-  resize_discarding(scratch.i64[0], order.size());
-  resize_discarding(scratch.u8[0], order.size());
+  // The positions at the last build lend their columns to the gathers (the lists are rebuilt
+  // after a permutation, which sets them again): four doubles at a time for 8 bytes of scratch.
+  const std::array<std::vector<double>*, kGroup> f64{&scratch.f64, &x_built, &y_built, &z_built};
 #pragma omp parallel if (static_cast<long>(order.size()) >= kParallelMin)
   {
     apply_order({&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
                  &offset_x, &offset_y, &offset_z},
-                order, scratch.f64);
-    apply_order({&material, &body, &attached}, order, scratch.i32);
+                order, f64);
+    apply_order({&material, &body, &attached}, order, std::array<std::vector<std::int32_t>*, 1>{&scratch.i32});
     apply_order(id, order, scratch.i64);
     if (has_meshes) {
       for (auto* c : {&mc.mesh, &mc.triangle}) apply_order_slots(*c, order, mc.count, 1, scratch.slots_i32);

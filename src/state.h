@@ -88,12 +88,10 @@ struct MeshLoads {
 /// column is swapped with its buffer, so buffers shared by columns of different lengths would
 /// hand every column the capacity of the longest.
 struct PermuteScratch {
-  std::array<std::vector<double>, 4> f64;       // per particle, 4 columns gathered at a time
-  std::vector<double> slots_f64, history;       // per mesh slot, mesh slot histories
-  std::array<std::vector<std::int32_t>, 4> i32;
-  std::vector<std::int32_t> slots_i32;
-  std::array<std::vector<std::int64_t>, 4> i64;
-  std::array<std::vector<std::uint8_t>, 4> u8;
+  std::vector<double> f64, slots_f64, history;  // per particle, per mesh slot, mesh slot histories
+  std::vector<std::int32_t> i32, slots_i32;
+  std::vector<std::int64_t> i64;
+  std::vector<std::uint8_t> u8;
 };
 
 struct State {
@@ -161,7 +159,8 @@ struct State {
   std::size_t add_sphere(double px, double py, double pz, double r, double density, int mat);
   /// Reorders particle slots: new slot k holds old slot order[k]. Contact lists are not touched.
   /// The columns are gathered into `scratch` and swapped with it (kept by the caller between
-  /// calls: a rebuild allocates nothing once it has grown).
+  /// calls: a rebuild allocates nothing once it has grown), and into x_built, y_built and
+  /// z_built, which are left holding no positions: the lists must be rebuilt.
   void permute(const std::vector<std::int32_t>& order, PermuteScratch& scratch);
   void permute(const std::vector<std::int32_t>& order) {
     PermuteScratch scratch;
