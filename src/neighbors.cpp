@@ -301,15 +301,38 @@ void ContactForces::resize(std::size_t n) {
 HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls) {
   HistoryRows out;
   if (width == 0) return out;
-  // Counted first and reserved exactly: grown by doubling, these rows (tens of MiB in a large
-  // bed) would hold up to twice their size at the rebuild's peak.
-  size_t count = 0;
-  for (size_t k = 0; k < list.size(); ++k) count += !row_is_zero(&list.history[k * width], width);
-  out.a.reserve(count), out.b.reserve(count), out.rows.reserve(count * width);
-  for (size_t k = 0; k < list.size(); ++k) {
-    const double* row = &list.history[k * width];
-    if (row_is_zero(row, width)) continue;
-    out.add(state.id[list.i[k]], walls ? list.j[k] : state.id[list.j[k]], row, width);
+  // Counted first and sized exactly (grown by doubling, these rows, tens of MiB in a large bed,
+  // would hold up to twice their size at the rebuild's peak); both passes in pieces shared by
+  // the threads, each piece's rows written from its own start: the rows in list order.
+  const long m = static_cast<long>(list.size());
+  const bool parallel = m >= kParallelMin;
+  const long pieces = parallel ? 4L * omp_get_max_threads() : 1;
+  const auto first = [&](long piece) { return m * piece / pieces; };
+  std::vector<size_t> start(static_cast<size_t>(pieces) + 1, 0);
+#pragma omp parallel if (parallel)
+  {
+#pragma omp for schedule(static)
+    for (long piece = 0; piece < pieces; ++piece) {
+      size_t count = 0;
+      for (long k = first(piece); k < first(piece + 1); ++k) count += !row_is_zero(&list.history[k * width], width);
+      start[piece + 1] = count;
+    }
+#pragma omp single
+    {
+      for (long piece = 0; piece < pieces; ++piece) start[piece + 1] += start[piece];
+      out.a.resize(start[pieces]), out.b.resize(start[pieces]), out.rows.resize(start[pieces] * width);
+    }
+#pragma omp for schedule(static)
+    for (long piece = 0; piece < pieces; ++piece) {
+      size_t q = start[piece];
+      for (long k = first(piece); k < first(piece + 1); ++k) {
+        const double* row = &list.history[k * width];
+        if (row_is_zero(row, width)) continue;
+        out.a[q] = state.id[list.i[k]], out.b[q] = walls ? list.j[k] : state.id[list.j[k]];
+        std::copy_n(row, width, &out.rows[q * width]);
+        ++q;
+      }
+    }
   }
   return out;
 }
