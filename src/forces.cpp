@@ -5,10 +5,10 @@
 // for the even blocks on either side (block_pass; which thread takes which block: balance.h).
 // Every particle's sum therefore runs in a fixed order (the pairs of the even block among its
 // own and the one before it, in list order, then those of the odd one) that depends on the data
-// only, so the result is bitwise the same for any thread count and schedule. Rejected alternatives: atomics or thread-private force arrays (the summation order,
-// and so the last bits of every trajectory, would depend on the number of threads); a buffer
-// slot per contact summed afterwards (what this engine did first: 48 bytes more per pair each
-// step, 1.3x slower on B1).
+// only, so the result is bitwise the same for any thread count and schedule. Rejected
+// alternatives: atomics or thread-private force arrays (the summation order, and so the last bits
+// of every trajectory, would depend on the number of threads); a buffer slot per contact summed
+// afterwards (what this engine did first: 48 bytes more per pair each step, 1.3x slower on B1).
 //
 // Sum per particle: particle pairs and plane walls as above, then meshes, then gravity. The
 // closing half kick of the step runs in the pass that adds gravity. Within step() the sums start
@@ -438,7 +438,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
   // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
   const bool finish_in_pass = !ghosts && !work.domain;
-  prepare_mesh_contacts(model, s, work);
+  if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
 #pragma omp parallel if (n >= kParallelMin)
   {
