@@ -68,6 +68,7 @@
 #include <vector>
 
 #include "allocator.h"
+#include "checkpoint.h"
 #include "diagnostics.h"
 #include "peak_memory.h"
 #include "mesh_health.h"
@@ -267,7 +268,7 @@ std::string csv_line(const Result& r) {
                      r.run_steps, r.threads, r.seconds, r.rate, r.mean_particles, r.pairs_per_particle, r.mass_flow, r.feed_flow, r.left, r.rebuilds, r.max_overlap, r.peak_mib, r.peak_bytes_per_particle);
 }
 
-Result run(std::int64_t fill_steps, std::int64_t run_steps) {
+Result run(std::int64_t fill_steps, std::int64_t run_steps, const std::string& fill_state) {
   // The STL both codes read, in a private temporary directory.
   char dir_template[] = "/tmp/bench_b2_XXXXXX";
   if (!mkdtemp(dir_template)) throw std::runtime_error("cannot create a temporary directory");
@@ -293,9 +294,17 @@ Result run(std::int64_t fill_steps, std::int64_t run_steps) {
   r.threads = omp_get_max_threads();
   const double mass = particle_mass();
 
-  // Fill: from the empty chute to steady flow (timed only for information).
+  // Fill: from the empty chute to steady flow (timed only for information), or the state at
+  // its end read from --fill-state (written there by the first run that fills).
   auto start = Clock::now();
-  for (std::int64_t k = 0; k < fill_steps; ++k) {
+  const bool resumed = !fill_state.empty() && std::filesystem::exists(fill_state);
+  if (resumed) {
+    state = dem::load_checkpoint(fill_state, model);
+    work = dem::Workspace{};
+    dem::prepare(model, state, work);
+    fmt::print("  fill: the state after the fill read from {} (t = {:.3f} s, {} particles)\n", fill_state, state.time, state.size());
+  }
+  for (std::int64_t k = 0; k < (resumed ? 0 : fill_steps); ++k) {
     dem::step(model, state, work);
     if ((k + 1) % 5000 == 0) {
       fmt::print("  fill: step {:>6}, t = {:.3f} s, {} particles, {} left the domain\n", state.step, state.time, state.size(),
@@ -304,6 +313,7 @@ Result run(std::int64_t fill_steps, std::int64_t run_steps) {
     }
   }
   r.fill_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!fill_state.empty() && !resumed) dem::save_checkpoint(fill_state, model, state);
   dem::check_numerics(model, state, work);
 
   // Timed phase: the clock runs around dem::step only; samples every kSampleEvery steps.
@@ -349,8 +359,10 @@ Result run(std::int64_t fill_steps, std::int64_t run_steps) {
 
 [[noreturn]] void usage(const char* argv0, const std::string& problem) {
   std::fprintf(stderr,
-               "%s\nusage: %s [--threads T] [--fill-steps S] [--run-steps S] [--write-stl FILE]\n"
-               "  default: all threads, fill 30000 steps, timed run 3000 steps\n",
+               "%s\nusage: %s [--threads T] [--fill-steps S] [--run-steps S] [--write-stl FILE] [--fill-state FILE]\n"
+               "  default: all threads, fill 30000 steps, timed run 3000 steps\n"
+               "  --fill-state FILE: the state after the fill is written to FILE, or read from it when it exists\n"
+               "    (for A/B comparisons of builds: the timed phase starts from the same state)\n",
                problem.c_str(), argv0);
   std::exit(2);
 }
@@ -361,6 +373,7 @@ int main(int argc, char** argv) {
   dem::tune_allocator();
   std::int64_t fill_steps = 30000, run_steps = 3000;
   int threads = 0;
+  std::string fill_state;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "-h" || arg == "--help") usage(argv[0], "B2 mesh chute benchmark");
@@ -377,6 +390,10 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
+    if (arg == "--fill-state") {
+      fill_state = value;
+      continue;
+    }
     char* end = nullptr;
     const long long v = std::strtoll(value.c_str(), &end, 10);
     if (end == value.c_str() || *end != '\0' || v < 0) usage(argv[0], arg + ": not a non-negative integer: " + value);
@@ -387,7 +404,7 @@ int main(int argc, char** argv) {
   }
   if (threads > 0) omp_set_num_threads(threads);
   try {
-    const Result r = run(fill_steps, run_steps);
+    const Result r = run(fill_steps, run_steps, fill_state);
     fmt::print("\nB2 mesh chute: particle-steps/s of the timed loop; N = mean particle count (samples every {} steps);\n"
                "pp/p = touching particle-particle pairs / N (mean over the samples);\n"
                "flow = particles that left the domain x m / timed duration (feed {:.4g} kg/s); peak = VmHWM / N\n",
