@@ -323,6 +323,20 @@ void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>
   for (size_t p = 0; p < n; ++p) begin[p + 1] += begin[p];
 }
 
+/// build_csr for a list in rows (owner ascending: the pair and wall lists), shared by the
+/// threads: each entry that starts a row writes where the rows since the one before begin.
+void build_csr_of_rows(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>& owner, size_t n) {
+  resize_discarding(begin, n + 1);
+  const long entries = static_cast<long>(owner.size());
+  const std::int32_t* o = owner.data();
+  std::int32_t* b = begin.data();
+#pragma omp parallel for schedule(static) if (entries >= kParallelMin)
+  for (long k = 0; k <= entries; ++k) {
+    const std::int32_t from = k == 0 ? 0 : o[k - 1] + 1, to = k == entries ? static_cast<std::int32_t>(n) : o[k];
+    for (std::int32_t r = from; r <= to; ++r) b[r] = static_cast<std::int32_t>(k);
+  }
+}
+
 }  // namespace
 
 void ContactForces::resize(std::size_t n) {
@@ -384,17 +398,20 @@ void minimum_image(const Model& model, double d[3]) {
 
 void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
-  build_csr(work.pair_begin, s.pairs.i, n);
-  build_csr(work.wall_begin, s.wall_pairs.i, n);
+  build_csr_of_rows(work.pair_begin, s.pairs.i, n);
+  build_csr_of_rows(work.wall_begin, s.wall_pairs.i, n);
   // Block size of the force evaluation: every pair's partner lies in its own block or the next
   // (pairs with ghosts are evaluated apart, forces.cpp).
   std::int32_t span = 0;
   const std::int32_t owned = static_cast<std::int32_t>(s.owned());
+  const long n_pairs = static_cast<long>(s.pairs.size());
+  const std::int32_t *pair_i = s.pairs.i.data(), *pair_j = s.pairs.j.data();
+#pragma omp parallel for schedule(static) reduction(max : span) if (n_pairs >= kParallelMin)
+  for (long k = 0; k < n_pairs; ++k)
+    if (pair_j[k] < owned) span = std::max(span, pair_j[k] - pair_i[k]);
   work.ghost_owners.clear();
-  for (size_t k = 0; k < s.pairs.size(); ++k) {
-    if (s.pairs.j[k] < owned) span = std::max(span, s.pairs.j[k] - s.pairs.i[k]);
-    else if (work.ghost_owners.empty() || work.ghost_owners.back() != s.pairs.i[k]) work.ghost_owners.push_back(s.pairs.i[k]);
-  }
+  for (long k = 0; k < n_pairs && s.ghosts > 0; ++k)
+    if (pair_j[k] >= owned && (work.ghost_owners.empty() || work.ghost_owners.back() != pair_i[k])) work.ghost_owners.push_back(pair_i[k]);
   work.block = std::max<std::int32_t>(span + 1, 64);
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
@@ -421,9 +438,13 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   // clears the history of an inactive contact only when it was active (idle pairs of the skin
   // are then read, never written, and their history rows not touched at all).
   const int width = model.history_width;
-  for (auto [list, active] : {std::pair{&s.pairs, &pf.active}, std::pair{&s.wall_pairs, &work.wall_forces.active}})
-    for (size_t k = 0; k < list->size() && width > 0; ++k)
-      (*active)[k] = !row_is_zero(&list->history[k * width], width);
+  for (auto [list, active] : {std::pair{&s.pairs, &pf.active}, std::pair{&s.wall_pairs, &work.wall_forces.active}}) {
+    const long rows = width > 0 ? static_cast<long>(list->size()) : 0;
+    const double* history = list->history.data();
+    std::uint8_t* flag = active->data();
+#pragma omp parallel for schedule(static) if (rows >= kParallelMin)
+    for (long k = 0; k < rows; ++k) flag[k] = !row_is_zero(&history[k * width], width);
+  }
   work.valid = true;
 }
 
@@ -535,34 +556,46 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     std::fill(s.pairs.i.data() + work.pair_begin[i], s.pairs.i.data() + work.pair_begin[i + 1], static_cast<std::int32_t>(i));
   const size_t n_pairs = s.pairs.size();
 
-  // Wall pairs, grouped by particle (ghosts touch no wall: their owners' contacts).
+  // Wall pairs, grouped by particle (ghosts touch no wall: their owners' contacts), in one
+  // pass shared by the threads as the pairs' (a plane's distance for every sphere and plane).
   s.wall_pairs.i.clear();
   s.wall_pairs.j.clear();
-  for (size_t p = 0; p < n_owned; ++p) {
-    if (s.attached[p] >= 0) continue;  // part of a wall: walls do not touch walls
-    for (size_t w = 0; w < model.planes.size(); ++w) {
-      const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[p], s.y[p], s.z[p]};
-      double normal[3];
-      const double d = model.planes[w].distance(at, x, normal);
-      if (d < s.radius[p] + reach && d > -s.radius[p]) {
-        s.wall_pairs.i.push_back(static_cast<std::int32_t>(p));
-        s.wall_pairs.j.push_back(static_cast<std::int32_t>(w));
-      }
-    }
+  if (!model.planes.empty()) {
+    fill_rows(nl, nl >= kParallelMin, work.partner_scratch, work.wall_begin, s.wall_pairs.j,
+              [&](long p, std::vector<std::int32_t>& out, size_t m) {
+                if (s.attached[p] >= 0) return m;  // part of a wall: walls do not touch walls
+                for (size_t w = 0; w < model.planes.size(); ++w) {
+                  const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[p], s.y[p], s.z[p]};
+                  double normal[3];
+                  const double d = model.planes[w].distance(at, x, normal);
+                  if (d < s.radius[p] + reach && d > -s.radius[p]) {
+                    if (out.size() <= m) out.resize(2 * m + 16);
+                    out[m++] = static_cast<std::int32_t>(w);
+                  }
+                }
+                return m;
+              });
+    resize_discarding(s.wall_pairs.i, s.wall_pairs.j.size());
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
+    for (long i = 0; i < nl; ++i)
+      std::fill(s.wall_pairs.i.data() + work.wall_begin[i], s.wall_pairs.i.data() + work.wall_begin[i + 1], static_cast<std::int32_t>(i));
   }
 
   // Carry histories to the new lists by particle id: each old row finds its pair in the new
   // list's row of the lower slot (a handful of partners), so the carry needs no index of its own.
+  // Each old row has a new row of its own (or none), so the threads share the old rows.
   assign_discarding(s.pairs.history, n_pairs * width, 0.0);
   s.wall_pairs.history.assign(s.wall_pairs.size() * width, 0.0);
   if (width > 0 && (old_pairs.size() > 0 || old_walls.size() > 0)) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
-    build_csr(work.wall_begin, s.wall_pairs.i, n);
+    build_csr_of_rows(work.wall_begin, s.wall_pairs.i, n);
     auto slot = [&](std::int64_t id) { return id >= 0 && id < s.next_id ? slot_of[id] : -1; };
     // A pair whose bodies swapped roles (the old i is now j) takes its odd history negated.
     auto carry = [&](const HistoryRows& old, bool walls, ContactList& list, const std::vector<std::int32_t>& begin) {
-      for (size_t q = 0; q < old.size(); ++q) {
+      const long rows = static_cast<long>(old.size());
+#pragma omp parallel for schedule(static) if (rows >= kParallelMin)
+      for (long q = 0; q < rows; ++q) {
         const std::int32_t a = slot(old.a[q]);
         const std::int32_t b = walls ? static_cast<std::int32_t>(old.b[q]) : slot(old.b[q]);
         if (a < 0 || b < 0) continue;  // a particle left
@@ -585,9 +618,10 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   old_pairs = {}, old_walls = {};
 
   find_mesh_candidates(model, s, work, reach);
-  s.x_built = s.x;
-  s.y_built = s.y;
-  s.z_built = s.z;
+  for (auto* c : {&s.x_built, &s.y_built, &s.z_built}) resize_discarding(*c, n);
+  const long all = static_cast<long>(n);
+#pragma omp parallel for schedule(static) if (all >= kParallelMin)
+  for (long p = 0; p < all; ++p) s.x_built[p] = s.x[p], s.y_built[p] = s.y[p], s.z_built[p] = s.z[p];
   index_contacts(model, s, work);
   ++work.rebuilds;
 }
