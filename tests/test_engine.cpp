@@ -252,6 +252,50 @@ TEST(Neighbors, ARebuildThatDropsSpheresKeepsEveryColumnWithItsSphere) {
   EXPECT_EQ(wrong, 0u) << "slots whose values are not their sphere's";
 }
 
+TEST(Neighbors, ListsOfALargeSparseGridHoldExactlyThePairsAndWallsWithinReach) {
+  // A dense bed of 2,500 beads and 500 strays over a box 12 times wider: the grid then has half
+  // a million cells, so the cell sort's passes over the cells are shared by the threads; the
+  // pair list must hold exactly the pairs closer than the reach (checked against all 4.5
+  // million pairs), in rows of ascending partners, and the wall list every sphere by the floor.
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
+  CaseSpec spec = load_case("settling_bed.yaml");
+  std::erase_if(spec.planes, [](const PlaneWallSpec& w) { return w.name != "floor"; });
+  spec.particles[0].count = 2500;
+  spec.particles[0].region_min = Vec3(0, 0, 0), spec.particles[0].region_max = Vec3(0.08, 0.08, 0.06);
+  ParticleSetSpec strays = spec.particles[0];
+  strays.count = 500;
+  strays.region_min = Vec3(-0.5, -0.5, 0), strays.region_max = Vec3(0.5, 0.5, 0.5);
+  spec.particles.push_back(strays);
+  Sim sim(spec);
+  for (int k = 0; k < 50; ++k) sim.advance();
+  rebuild_contacts(sim.model, sim.state, sim.work);
+  omp_set_num_threads(saved);
+  ASSERT_GT(sim.work.cell_start.size(), 65536u + 2) << "the grid must be large enough for the threads to share its passes";
+  const State& s = sim.state;
+  const double reach = sim.model.interaction_range + sim.model.skin;
+  std::set<std::pair<std::int64_t, std::int64_t>> listed, within;
+  for (size_t k = 0; k < s.pairs.size(); ++k) {
+    const std::int32_t i = s.pairs.i[k], j = s.pairs.j[k];
+    EXPECT_LT(i, j);
+    if (k > 0 && s.pairs.i[k - 1] == i) EXPECT_LT(s.pairs.j[k - 1], j) << "partners ascending within a row";
+    listed.insert({std::min(s.id[i], s.id[j]), std::max(s.id[i], s.id[j])});
+  }
+  EXPECT_EQ(listed.size(), s.pairs.size()) << "each pair listed once";
+  for (size_t i = 0; i < s.size(); ++i)
+    for (size_t j = i + 1; j < s.size(); ++j) {
+      const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j], cut = (s.radius[i] + reach) + s.radius[j];
+      if (dx * dx + dy * dy + dz * dz < cut * cut) within.insert({std::min(s.id[i], s.id[j]), std::max(s.id[i], s.id[j])});
+    }
+  EXPECT_GT(within.size(), 2000u);
+  EXPECT_TRUE(listed == within) << listed.size() << " listed, " << within.size() << " within reach";
+  size_t by_floor = 0;
+  for (size_t p = 0; p < s.size(); ++p) by_floor += s.z[p] < s.radius[p] + reach && s.z[p] > -s.radius[p];
+  EXPECT_EQ(s.wall_pairs.size(), by_floor);
+  EXPECT_GT(by_floor, 50u);
+  for (size_t k = 0; k + 1 < s.wall_pairs.size(); ++k) EXPECT_LT(s.wall_pairs.i[k], s.wall_pairs.i[k + 1]);
+}
+
 // The contact kernels see the history as batch columns (effect.h); every effect of the table
 // switched on at once must fit them, or compile() refuses the case.
 TEST(Effects, EveryEffectTogetherFitsTheBatchHistoryColumns) {
