@@ -326,15 +326,36 @@ struct Finish {
   double kick;              ///< [s] closing half kick (0: none)
 };
 
-/// Waits until block b's contacts of this pass are summed (Workspace::block_done).
-void wait_for_block(Workspace& work, long b) {
-  const std::atomic_ref<std::uint32_t> done(work.block_done[b]);
-  for (int spins = 0; done.load(std::memory_order_acquire) != work.pass_epoch; ++spins) {
+/// Waits until another thread has stored `value` in `flag` (release), and sees what it wrote.
+void wait_until(std::uint32_t& flag, std::uint32_t value) {
+  const std::atomic_ref<std::uint32_t> seen(flag);
+  for (int spins = 0; seen.load(std::memory_order_acquire) != value; ++spins) {
 #if defined(__x86_64__)
     __builtin_ia32_pause();
 #endif
     if (spins > 4096) std::this_thread::yield();  // more threads than cores
   }
+}
+
+/// Waits until block b's contacts of this pass are summed (Workspace::block_done).
+void wait_for_block(Workspace& work, long b) { wait_until(work.block_done[b], work.pass_epoch); }
+
+/// The mesh records and loads of this thread's blocks, summed once every thread before it has
+/// summed its own (Workspace::records_turn): the sums run in slot order, as one thread's would,
+/// while a thread that finished its contacts early adds its records as the others still
+/// compute, from its own cache. Their time counts in the blocks' work (balance.h). Called by
+/// every thread of the contact pass's region, after its blocks are finished.
+void sum_records_in_turn(const Model& model, State& s, Workspace& work, long n) {
+  const int t = omp_get_thread_num();
+  const auto [lo, hi] = thread_blocks(work, n, t, omp_get_num_threads());
+  wait_until(work.records_turn, static_cast<std::uint32_t>(t));
+  if (lo == hi && t == 0) sum_mesh_records(model, s, work, 0, 0);  // the loads start from zero
+  for (long b = lo; b < hi; ++b) {
+    const auto start = std::chrono::steady_clock::now();
+    sum_mesh_records(model, s, work, b * work.block, std::min(n, (b + 1) * work.block));
+    add_block_time(work, b, start);
+  }
+  std::atomic_ref<std::uint32_t>(work.records_turn).store(static_cast<std::uint32_t>(t + 1), std::memory_order_release);
 }
 
 /// The contacts of the owned slots, block by block (see the top of this file). Each thread takes
@@ -440,6 +461,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   const bool finish_in_pass = !ghosts && !work.domain;
   if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
+  work.records_turn = 0;
 #pragma omp parallel if (n >= kParallelMin)
   {
     const long clear_from = work.loads_cleared ? n : 0;  // owned slots zeroed by the kick-drift pass
@@ -450,12 +472,11 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
     if (finish_in_pass && !model.meshes.empty()) meshes.emplace(model, s, work);
     const Finish finish{meshes ? &*meshes : nullptr, kick};
     (near ? pass<Scan::kNear> : pass<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
+    if (meshes) sum_records_in_turn(model, s, work, n);
   }
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
   work.near_refreshes += !near;
-  if (finish_in_pass) {
-    sum_mesh_records(model, s, work);
-  } else {
+  if (!finish_in_pass) {
     if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
       Batch batch;
       for (const std::int32_t i : work.ghost_owners)

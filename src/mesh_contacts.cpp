@@ -359,17 +359,17 @@ void MeshContactPass::run(long begin, long end) {
   if (mb.b.count) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
 }
 
-void sum_mesh_records(const Model& model, State& s, Workspace& work) {
+void sum_mesh_records(const Model& model, State& s, Workspace& work, long begin, long end) {
   if (model.meshes.empty()) return;
-  const size_t n = s.owned();
   const MeshContacts& mc = s.mesh_contacts;
   const MeshSlotResults& slot_results = work.mesh_slots;
-  // Records per triangle and loads per mesh, summed in slot order.
+  // Records per triangle and loads per mesh, summed in slot order (from zero at slot 0).
   auto& loads = s.mesh_loads;
-  for (auto* c : {&loads.fx, &loads.fy, &loads.fz, &loads.tx, &loads.ty, &loads.tz, &loads.power}) c->assign(model.meshes.size(), 0.0);
+  if (begin == 0)
+    for (auto* c : {&loads.fx, &loads.fy, &loads.fz, &loads.tx, &loads.ty, &loads.tz, &loads.power}) c->assign(model.meshes.size(), 0.0);
   const double dt = model.dt;
   const ContactForces& f = work.mesh_forces;
-  for (size_t p = 0; p < n; ++p) {
+  for (size_t p = static_cast<size_t>(begin); p < static_cast<size_t>(end); ++p) {
     for (int k = 0; k < mc.count[p]; ++k) {
       const size_t slot = p * kSlots + k, at = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);
       if (!f.active[at]) continue;
@@ -408,7 +408,7 @@ void mesh_contact_forces(const Model& model, State& state, Workspace& work) {
     MeshContactPass pass(model, state, work);
     for_own_blocks(work, n, [&](long begin, long end) { pass.run(begin, end); });
   }
-  sum_mesh_records(model, state, work);
+  sum_mesh_records(model, state, work, 0, n);
 }
 
 }  // namespace dem

@@ -24,8 +24,8 @@ void prepare_mesh_contacts(const Model& model, const State& state, Workspace& wo
 /// One thread's evaluation of mesh contacts, a range of slots at a time. Each slot's contacts
 /// are resolved and evaluated, their forces and torques added to its totals (which are complete
 /// when run returns), and kept by contact in Workspace::mesh_forces and mesh_slots. Any thread
-/// may take any slots, each slot once per step; the records are summed after all of them
-/// (sum_mesh_records).
+/// may take any slots, each slot once per step; the records are summed afterwards, range after
+/// range in slot order (sum_mesh_records).
 class MeshContactPass {
  public:
   MeshContactPass(const Model& model, State& state, Workspace& work);
@@ -42,8 +42,10 @@ class MeshContactPass {
   std::unique_ptr<Scratch> scratch_;
 };
 
-/// Records per triangle and loads per mesh from this step's mesh contacts, in slot order.
-void sum_mesh_records(const Model& model, State& state, Workspace& work);
+/// Records per triangle and loads per mesh from the mesh contacts of slots [begin, end) this
+/// step, added in slot order; the loads start from zero at begin = 0. Calls for consecutive
+/// ranges from 0 to the owned slots give the sums of one call over them all, bitwise.
+void sum_mesh_records(const Model& model, State& state, Workspace& work, long begin, long end);
 
 /// Resolves and evaluates the mesh contacts of every particle at the meshes' current pose;
 /// forces and torques are added to the particles' totals (state.fx.., tx..) and kept per slot

@@ -65,6 +65,7 @@ struct Workspace {
   std::vector<double> block_work, block_time, block_prefix;
   std::vector<std::uint32_t> block_done;
   std::uint32_t pass_epoch = 0;
+  std::uint32_t records_turn = 0;  ///< the thread whose turn it is to sum its mesh records (forces.cpp)
   bool block_timed = false;  ///< block_work holds measured seconds
   /// Owned slots with a ghost partner, ascending (domain.h; empty without ghosts).
   std::vector<std::int32_t> ghost_owners;

@@ -278,7 +278,9 @@ TEST(Neighbors, ListsOfALargeSparseGridHoldExactlyThePairsAndWallsWithinReach) {
   for (size_t k = 0; k < s.pairs.size(); ++k) {
     const std::int32_t i = s.pairs.i[k], j = s.pairs.j[k];
     EXPECT_LT(i, j);
-    if (k > 0 && s.pairs.i[k - 1] == i) EXPECT_LT(s.pairs.j[k - 1], j) << "partners ascending within a row";
+    if (k > 0 && s.pairs.i[k - 1] == i) {
+      EXPECT_LT(s.pairs.j[k - 1], j) << "partners ascending within a row";
+    }
     listed.insert({std::min(s.id[i], s.id[j]), std::max(s.id[i], s.id[j])});
   }
   EXPECT_EQ(listed.size(), s.pairs.size()) << "each pair listed once";

@@ -1,6 +1,7 @@
 // Mesh walls against analytic planes: the failures users of other DEM codes report (bumps at
 // shared edges, double forces at vertices, lost contacts) must not happen here.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <numeric>
@@ -338,6 +339,49 @@ TEST(MeshWalls, RecordedFrictionWorkEqualsCoulombWorkAndImpactsAreCounted) {
   for (double w : r.shear_work) after += w;
   const double distance = sim.state.x[0] - x0;
   EXPECT_NEAR(after - before, 0.3 * mass * 9.81 * distance, 0.01 * 0.3 * mass * 9.81 * distance);
+}
+
+/// The settling bed of 3,000 beads with its floor and one side wall triangulated (two meshes,
+/// 16 x 16 x 2 triangles each), after `steps` steps on `threads` threads: every triangle's
+/// records and each mesh's loads, in one column, and the hash of the particles.
+std::pair<std::vector<double>, std::uint64_t> bed_on_meshes(int threads, int steps) {
+  omp_set_num_threads(threads);
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 3000;  // above kParallelMin: two threads split the passes
+  spec.particles[0].region_min.z() = 0.0;
+  spec.particles[0].region_max.z() = 0.06;  // on the floor soon
+  std::erase_if(spec.planes, [](const PlaneWallSpec& w) { return w.name == "floor" || w.name == "x0"; });
+  const double L = 0.08;
+  spec.meshes.push_back(rectangle("floor", Vec3(0, 0, 0), Vec3(L, 0, 0), Vec3(0, L, 0), 16));
+  spec.meshes.push_back(rectangle("x0", Vec3(0, 0, 0), Vec3(0, L, 0), Vec3(0, 0, L), 16));
+  spec.output.records_from = 0.0;
+  Sim sim(spec);
+  for (int k = 0; k < steps; ++k) sim.advance();
+  std::vector<double> out;
+  for (const TriangleRecords& r : sim.state.records)
+    for (const auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) out.insert(out.end(), c->begin(), c->end());
+  const MeshLoads& l = sim.state.mesh_loads;
+  for (const auto* c : {&l.fx, &l.fy, &l.fz, &l.tx, &l.ty, &l.tz, &l.power}) out.insert(out.end(), c->begin(), c->end());
+  return {out, state_hash(sim.state, sim.model.history_width)};
+}
+
+TEST(MeshWalls, RecordsAndLoadsAreBitwiseTheSameOnOneTwoAndThreeThreads) {
+  // Each thread sums the records and loads of its own spheres, in turn (forces.cpp): every
+  // number must still be summed in slot order, so bitwise that of one thread, however the
+  // spheres are shared.
+  const int saved = omp_get_max_threads();
+  const auto one = bed_on_meshes(1, 4000), two = bed_on_meshes(2, 4000), three = bed_on_meshes(3, 4000);
+  omp_set_num_threads(saved);
+  size_t touched = 0;
+  for (const double v : one.first) touched += v != 0.0;
+  EXPECT_GT(touched, 1000u) << "the beads must have loaded many triangles of both meshes";
+  for (const auto* other : {&two, &three}) {
+    EXPECT_EQ(one.second, other->second);
+    ASSERT_EQ(one.first.size(), other->first.size());
+    size_t differ = 0;
+    for (size_t k = 0; k < one.first.size(); ++k) differ += one.first[k] != other->first[k];
+    EXPECT_EQ(differ, 0u) << (other == &two ? "two" : "three") << " threads";
+  }
 }
 
 }  // namespace
