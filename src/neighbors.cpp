@@ -1,5 +1,6 @@
 #include "neighbors.h"
 
+#include "cell_grid.h"
 #include "domain.h"
 #include "mesh_contacts.h"
 
@@ -8,8 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
-#include <numeric>
 #include <optional>
 
 namespace dem {
@@ -79,77 +78,6 @@ bool find_lost(const Model& model, State& state, std::vector<std::uint8_t>& keep
   for (size_t p = 0; p < n; ++p)
     if (state.body[p] >= 0 && body_outlet[state.body[p]] != -2) keep[p] = 0;
   return true;
-}
-
-/// Cells along each axis; periodic axes span exactly one period, others the particles' extent.
-/// Cells are numbered with the non-periodic axis of most cells varying slowest (`order`: minor,
-/// middle, major), so that after the sort a particle's neighbours lie within a short run of slots (the
-/// block size of the force evaluation, see forces.cpp) even in long, flat equipment.
-struct Grid {
-  double origin[3];
-  double cell[3];
-  int dims[3];
-  bool wrap[3];
-  double period[3];
-  int order[3] = {0, 1, 2};
-  int axis_index(int a, double v) const {
-    if (wrap[a]) v -= period[a] * std::floor((v - origin[a]) / period[a]);
-    return std::clamp(static_cast<int>((v - origin[a]) / cell[a]), 0, dims[a] - 1);
-  }
-  int encode(const int at[3]) const {
-    return (at[order[2]] * dims[order[1]] + at[order[1]]) * dims[order[0]] + at[order[0]];
-  }
-  void decode(int c, int at[3]) const {
-    at[order[0]] = c % dims[order[0]];
-    at[order[1]] = (c / dims[order[0]]) % dims[order[1]];
-    at[order[2]] = c / (dims[order[0]] * dims[order[1]]);
-  }
-  int index(double x, double y, double z) const {
-    const int at[3] = {axis_index(0, x), axis_index(1, y), axis_index(2, z)};
-    return encode(at);
-  }
-};
-
-Grid make_grid(const Model& model, const State& s, double cell, const std::uint8_t* keep = nullptr) {
-  double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                  std::numeric_limits<double>::infinity()};
-  double hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (size_t p = 0; p < s.size(); ++p) {
-    if (keep && !keep[p]) continue;
-    lo[0] = std::min(lo[0], s.x[p]), hi[0] = std::max(hi[0], s.x[p]);
-    lo[1] = std::min(lo[1], s.y[p]), hi[1] = std::max(hi[1], s.y[p]);
-    lo[2] = std::min(lo[2], s.z[p]), hi[2] = std::max(hi[2], s.z[p]);
-  }
-  Grid g;
-  for (int a = 0; a < 3; ++a) {
-    g.wrap[a] = model.period[a] > 0;
-    g.period[a] = model.period[a];
-    if (g.wrap[a]) lo[a] = model.domain_min[a], hi[a] = model.domain_max[a];
-  }
-  // Cap the number of cells at 4 per particle, or 2^19 (2 MiB of cell starts) if more: a few
-  // particles flung far away must not make the grid huge, while a thin stream in a large box
-  // (a chute) keeps cells one reach wide. Larger cells stay correct, only slower (B2: cells
-  // 1.6 reaches wide under a cap of 4 per particle, 4 times the candidates to measure).
-  // Periodic axes keep whole periods.
-  const double cap = std::max(4.0 * static_cast<double>(s.size()) + 64.0, 524288.0);
-  for (;;) {
-    double cells = 1.0;
-    for (int a = 0; a < 3; ++a) {
-      g.dims[a] = g.wrap[a] ? std::max(1, static_cast<int>(std::floor(g.period[a] / cell)))
-                            : static_cast<int>(std::floor((hi[a] - lo[a]) / cell)) + 1;
-      g.cell[a] = g.wrap[a] ? g.period[a] / g.dims[a] : cell;
-      g.origin[a] = lo[a];
-      cells *= g.dims[a];
-    }
-    if (cells <= cap) break;
-    cell *= 1.26;
-  }
-  // Major axis: the non-periodic axis of most cells (a pair across a periodic boundary of the
-  // major axis would stretch the slot span to the whole system).
-  std::stable_sort(g.order, g.order + 3, [&](int a, int b) {
-    return std::pair(!g.wrap[a], g.dims[a]) < std::pair(!g.wrap[b], g.dims[b]);
-  });
-  return g;
 }
 
 /// Moves free spheres and body centres that crossed a periodic boundary back into the period
@@ -274,48 +202,6 @@ struct PairFinder {
     return m;
   }
 };
-
-/// The running sum of a column in place (a[k] becomes a[0] + ... + a[k]), in one piece per
-/// thread when long (each thread sums its piece, then writes it from the sum of those before).
-void running_sum(std::vector<std::int32_t>& a) {
-  const long size = static_cast<long>(a.size());
-  if (size < (1L << 16)) {
-    std::partial_sum(a.begin(), a.end(), a.begin());
-    return;
-  }
-  std::vector<std::int64_t> piece_sum(static_cast<size_t>(omp_get_max_threads()) + 1, 0);
-#pragma omp parallel
-  {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    const long lo = size * t / nt, hi = size * (t + 1) / nt;
-    piece_sum[t + 1] = std::accumulate(a.begin() + lo, a.begin() + hi, std::int64_t{0});
-#pragma omp barrier
-    const auto offset = std::accumulate(piece_sum.begin(), piece_sum.begin() + t + 1, std::int64_t{0});
-    auto sum = static_cast<std::int32_t>(offset);
-    for (long k = lo; k < hi; ++k) sum += a[k], a[k] = sum;
-  }
-}
-
-/// Lists the slots p in [0, n) with cell_of[p] >= 0 by cell, in slot order within a cell (a
-/// counting sort): `out` gets the slots, cell_start[c] is where cell c's slots begin (n_cells + 2
-/// entries, the last unused). Each cell's count is kept one place further up than its start,
-/// so the scatter, which advances cell_start[c + 1] as cell c's cursor, leaves every start in
-/// place: no pass over the cells afterwards to shift them back. The passes over the cells are
-/// shared by the threads when there are many (B2: half a million cells for 18,000 spheres, so
-/// the cells, not the spheres, made most of the sort's time).
-void sort_by_cell(const std::vector<std::int32_t>& cell_of, size_t n, int n_cells, std::vector<std::int32_t>& cell_start,
-                  std::vector<std::int32_t>& out) {
-  const long size = static_cast<long>(n_cells) + 2;
-  resize_discarding(cell_start, static_cast<size_t>(size));
-  std::int32_t* start = cell_start.data();
-#pragma omp parallel for schedule(static) if (size >= (1L << 16))
-  for (long c = 0; c < size; ++c) start[c] = 0;
-  for (size_t p = 0; p < n; ++p)
-    if (cell_of[p] >= 0) ++start[cell_of[p] + 2];
-  running_sum(cell_start);  // now cell_start[c + 1] is where cell c begins
-  for (size_t p = 0; p < n; ++p)
-    if (cell_of[p] >= 0) out[start[cell_of[p] + 1]++] = static_cast<std::int32_t>(p);
-}
 
 void build_csr(std::vector<std::int32_t>& begin, const std::vector<std::int32_t>& owner, size_t n) {
   begin.assign(n + 1, 0);
