@@ -77,13 +77,8 @@ Grid make_grid(const Model& model, const State& s, double cell, const std::uint8
   return g;
 }
 
-/// Lists the slots p in [0, n) with cell_of[p] >= 0 by cell, in slot order within a cell (a
-/// counting sort): `out` gets the slots, cell_start[c] is where cell c's slots begin (n_cells + 2
-/// entries, the last unused). Each cell's count is kept one place further up than its start,
-/// so the scatter, which advances cell_start[c + 1] as cell c's cursor, leaves every start in
-/// place: no pass over the cells afterwards to shift them back. The passes over the cells are
-/// shared by the threads when there are many (B2: half a million cells for 18,000 spheres, so
-/// the cells, not the spheres, made most of the sort's time).
+// Each cell's count goes one place above its start (cell_start[c + 2]), so that after the
+// running sum cell_start[c + 1] is c's start, the scatter's cursor, which ends at c + 1's.
 void sort_by_cell(const std::vector<std::int32_t>& cell_of, size_t n, int n_cells, std::vector<std::int32_t>& cell_start,
                   std::vector<std::int32_t>& out) {
   const long size = static_cast<long>(n_cells) + 2;

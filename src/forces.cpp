@@ -349,7 +349,6 @@ void sum_records_in_turn(const Model& model, State& s, Workspace& work, long n) 
   const int t = omp_get_thread_num();
   const auto [lo, hi] = thread_blocks(work, n, t, omp_get_num_threads());
   wait_until(work.records_turn, static_cast<std::uint32_t>(t));
-  if (lo == hi && t == 0) sum_mesh_records(model, s, work, 0, 0);  // the loads start from zero
   for (long b = lo; b < hi; ++b) {
     const auto start = std::chrono::steady_clock::now();
     sum_mesh_records(model, s, work, b * work.block, std::min(n, (b + 1) * work.block));

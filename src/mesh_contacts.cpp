@@ -190,8 +190,10 @@ struct MeshContactPass::Scratch {
   std::vector<double> old_history;
 };
 
-void prepare_mesh_contacts(const Model& model, const State& s, Workspace& work) {
+void prepare_mesh_contacts(const Model& model, State& s, Workspace& work) {
   if (model.meshes.empty()) return;
+  auto& loads = s.mesh_loads;  // summed afresh by sum_mesh_records
+  for (auto* c : {&loads.fx, &loads.fy, &loads.fz, &loads.tx, &loads.ty, &loads.tz, &loads.power}) c->assign(model.meshes.size(), 0.0);
   // Results by candidate: contact k of particle p at candidate_begin[p] + k (a particle has no
   // more contacts than candidates), not one row per slot: most particles touch no wall. Written
   // by the pass before they are read, so not filled.
@@ -363,10 +365,8 @@ void sum_mesh_records(const Model& model, State& s, Workspace& work, long begin,
   if (model.meshes.empty()) return;
   const MeshContacts& mc = s.mesh_contacts;
   const MeshSlotResults& slot_results = work.mesh_slots;
-  // Records per triangle and loads per mesh, summed in slot order (from zero at slot 0).
+  // Records per triangle and loads per mesh, summed in slot order.
   auto& loads = s.mesh_loads;
-  if (begin == 0)
-    for (auto* c : {&loads.fx, &loads.fy, &loads.fz, &loads.tx, &loads.ty, &loads.tz, &loads.power}) c->assign(model.meshes.size(), 0.0);
   const double dt = model.dt;
   const ContactForces& f = work.mesh_forces;
   for (size_t p = static_cast<size_t>(begin); p < static_cast<size_t>(end); ++p) {

@@ -18,8 +18,9 @@ void place_meshes(const Model& model, double time, Workspace& work);
 void find_mesh_candidates(const Model& model, State& state, Workspace& work, double reach);
 /// Largest displacement of any mesh since the lists were built (for the skin criterion) [m].
 double mesh_displacement_since_build(const Model& model, const State& state, double time);
-/// Sizes the per-contact results for the candidates of the last rebuild (before any pass).
-void prepare_mesh_contacts(const Model& model, const State& state, Workspace& work);
+/// Sizes the per-contact results for the candidates of the last rebuild and sets the meshes'
+/// loads to zero (before any pass).
+void prepare_mesh_contacts(const Model& model, State& state, Workspace& work);
 
 /// One thread's evaluation of mesh contacts, a range of slots at a time. Each slot's contacts
 /// are resolved and evaluated, their forces and torques added to its totals (which are complete
@@ -43,8 +44,8 @@ class MeshContactPass {
 };
 
 /// Records per triangle and loads per mesh from the mesh contacts of slots [begin, end) this
-/// step, added in slot order; the loads start from zero at begin = 0. Calls for consecutive
-/// ranges from 0 to the owned slots give the sums of one call over them all, bitwise.
+/// step, added in slot order (to the loads prepare_mesh_contacts set to zero). Calls for
+/// consecutive ranges from 0 to the owned slots give the sums of one call over them all, bitwise.
 void sum_mesh_records(const Model& model, State& state, Workspace& work, long begin, long end);
 
 /// Resolves and evaluates the mesh contacts of every particle at the meshes' current pose;

@@ -296,8 +296,9 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   for (long k = 0; k < n_pairs; ++k)
     if (pair_j[k] < owned) span = std::max(span, pair_j[k] - pair_i[k]);
   work.ghost_owners.clear();
-  for (long k = 0; k < n_pairs && s.ghosts > 0; ++k)
-    if (pair_j[k] >= owned && (work.ghost_owners.empty() || work.ghost_owners.back() != pair_i[k])) work.ghost_owners.push_back(pair_i[k]);
+  if (s.ghosts > 0)
+    for (long k = 0; k < n_pairs; ++k)
+      if (pair_j[k] >= owned && (work.ghost_owners.empty() || work.ghost_owners.back() != pair_i[k])) work.ghost_owners.push_back(pair_i[k]);
   work.block = std::max<std::int32_t>(span + 1, 64);
   // Spheres of each body, in slot order.
   std::vector<std::int32_t> owner;
@@ -446,7 +447,9 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   // pass shared by the threads as the pairs' (a plane's distance for every sphere and plane).
   s.wall_pairs.i.clear();
   s.wall_pairs.j.clear();
-  if (!model.planes.empty()) {
+  if (model.planes.empty()) {
+    work.wall_begin.assign(n + 1, 0);
+  } else {
     fill_rows(nl, nl >= kParallelMin, work.partner_scratch, work.wall_begin, s.wall_pairs.j,
               [&](long p, std::vector<std::int32_t>& out, size_t m) {
                 if (s.attached[p] >= 0) return m;  // part of a wall: walls do not touch walls
@@ -465,6 +468,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
 #pragma omp parallel for schedule(static) if (nl >= kParallelMin)
     for (long i = 0; i < nl; ++i)
       std::fill(s.wall_pairs.i.data() + work.wall_begin[i], s.wall_pairs.i.data() + work.wall_begin[i + 1], static_cast<std::int32_t>(i));
+    work.wall_begin.resize(n + 1, work.wall_begin[nl]);  // ghosts: no walls
   }
 
   // Carry histories to the new lists by particle id: each old row finds its pair in the new
@@ -475,7 +479,6 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   if (width > 0 && (old_pairs.size() > 0 || old_walls.size() > 0)) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
-    build_csr_of_rows(work.wall_begin, s.wall_pairs.i, n);
     auto slot = [&](std::int64_t id) { return id >= 0 && id < s.next_id ? slot_of[id] : -1; };
     // A pair whose bodies swapped roles (the old i is now j) takes its odd history negated.
     auto carry = [&](const HistoryRows& old, bool walls, ContactList& list, const std::vector<std::int32_t>& begin) {
