@@ -36,12 +36,14 @@
 #include "domain.h"
 #include "mesh_contacts.h"
 #include "neighbors.h"
+#include "verlet.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 
@@ -290,40 +292,15 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   }
 }
 
-/// Adds gravity to the free spheres among slots [begin, end) and gives them the closing half
-/// kick (none when kick = 0). A body carries its own weight; a glued sphere is part of its wall,
-/// which has none.
-DEM_KERNEL void gravity_kick_range(const double* gravity, State& s, long begin, long end, double kick) {
-  const double gx = gravity[0], gy = gravity[1], gz = gravity[2];
-  const std::int32_t *body = s.body.data(), *attached = s.attached.data();
-  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
-  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
-  const double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
-  double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
-  double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
-  const bool kicks = kick != 0.0;
-  DEM_VECTOR_LOOP
-  for (long p = begin; p < end; ++p) {
-    const bool free = (body[p] < 0) & (attached[p] < 0);
-    const double weight = 1.0 / inv_mass[p];
-    const double mass = free ? weight : 0.0;
-    const double nfx = fx[p] + mass * gx, nfy = fy[p] + mass * gy, nfz = fz[p] + mass * gz;
-    fx[p] = nfx, fy[p] = nfy, fz[p] = nfz;
-    const bool kicked = free & kicks;
-    const double a = kick * inv_mass[p], b = kick * inv_inertia[p];
-    const double nvx = vx[p] + a * nfx, nvy = vy[p] + a * nfy, nvz = vz[p] + a * nfz;
-    const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
-    vx[p] = kicked ? nvx : vx[p], vy[p] = kicked ? nvy : vy[p], vz[p] = kicked ? nvz : vz[p];
-    wx[p] = kicked ? nwx : wx[p], wy[p] = kicked ? nwy : wy[p], wz[p] = kicked ? nwz : wz[p];
-  }
-}
-
 /// What is left of a sphere's step once its contacts with other spheres are summed: its mesh
 /// contacts, then gravity and the closing half kick. The block pass does it block by block when
 /// nothing else is to be added (no pairs with ghosts, no loads returned by other ranks).
 struct Finish {
-  MeshContactPass* meshes;  ///< this thread's; null without meshes
-  double kick;              ///< [s] closing half kick (0: none)
+  MeshContactPass* meshes;   ///< this thread's; null without meshes
+  double kick;               ///< [s] closing half kick (0: none)
+  const DriftLimits* next;   ///< predict the next drift's flags into *next_moved (null: no)
+  int* next_moved;           ///< this thread's
+  bool drifted;              ///< the pass drifted each thread's blocks first (a fused step)
 };
 
 /// Waits until another thread has stored `value` in `flag` (release), and sees what it wrote.
@@ -367,6 +344,8 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
   const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
   const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
   const auto evaluate = [&](long b) {
+    // In a fused step the next block may be another thread's, drifted by it.
+    if (finish && finish->drifted && b + 1 < blocks && b + 1 >= hi) wait_until(work.block_drifted[b + 1], work.pass_epoch);
     const auto start = std::chrono::steady_clock::now();
     for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
       particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
@@ -383,7 +362,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
     const auto start = std::chrono::steady_clock::now();
     const long first = b * block, last = std::min(n, (b + 1) * block);
     if (finish->meshes) finish->meshes->run(first, last);
-    gravity_kick_range(model.gravity.data(), s, first, last, finish->kick);
+    *finish->next_moved |= gravity_kick_range(model.gravity.data(), s, first, last, finish->kick, finish->next, model.dt);
     add_block_time(work, b, start);
   };
   const auto evaluate_odd = [&](long b) { evaluate(b), complete(b), complete(b + 1); };
@@ -408,7 +387,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
 /// The block pass for each case, by [periodic][ghosts].
 using BlockPass = void (*)(const Model&, State&, Workspace&, Batch&, const Finish*);
 template <Scan kScan>
-constexpr BlockPass pass[2][2] = {{block_pass<false, false, kScan>, block_pass<false, true, kScan>},
+constexpr BlockPass pass_of[2][2] = {{block_pass<false, false, kScan>, block_pass<false, true, kScan>},
                                   {block_pass<true, false, kScan>, block_pass<true, true, kScan>}};
 
 /// Slots [begin, end): forces and torques set to zero.
@@ -438,6 +417,13 @@ void evaluate_effects(const Model& model, ContactBatch& b) {
 }
 
 void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
+  ForcePass pass;
+  pass.kick = kick;
+  compute_forces(model, s, work, pass);
+}
+
+int compute_forces(const Model& model, State& s, Workspace& work, const ForcePass& pass) {
+  const double kick = pass.kick;
   const long n_all = static_cast<long>(s.size());
   const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
   const std::int32_t owned = static_cast<std::int32_t>(n);
@@ -458,21 +444,37 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
   // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
   const bool finish_in_pass = !ghosts && !work.domain;
+  const bool drifts = pass.drift_kick != 0.0;
+  if (drifts && !finish_in_pass) throw std::logic_error("compute_forces: a drift in the contact pass with ghosts");
+  // The next drift's limits, as they will be once this pass has scanned the pairs.
+  const bool predict = pass.predict && kick != 0.0 && finish_in_pass;
+  const DriftLimits next = predict ? drift_limits(model, s, work, true) : DriftLimits{};
   if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
   work.records_turn = 0;
-#pragma omp parallel if (n >= kParallelMin)
+  int drift_moved = 0, next_moved = 0;
+#pragma omp parallel if (n >= kParallelMin) reduction(| : drift_moved, next_moved)
   {
+    if (drifts)  // each thread its own blocks, each marked as drifted (block_pass waits for it)
+      for_own_blocks(work, n, [&](long begin, long end) {
+        drift_moved |= kick_drift_range(s, pass.drift, begin, end, pass.drift_kick, model.dt);
+        std::atomic_ref<std::uint32_t>(work.block_drifted[begin / work.block]).store(work.pass_epoch, std::memory_order_release);
+      });
     const long clear_from = work.loads_cleared ? n : 0;  // owned slots zeroed by the kick-drift pass
+    if (clear_from < n_all) {
 #pragma omp for schedule(static)
-    for (long begin = clear_from; begin < n_all; begin += kChunk) clear_loads(s, begin, std::min(n_all, begin + kChunk));
+      for (long begin = clear_from; begin < n_all; begin += kChunk) clear_loads(s, begin, std::min(n_all, begin + kChunk));
+    }
     Batch batch;
     std::optional<MeshContactPass> meshes;
     if (finish_in_pass && !model.meshes.empty()) meshes.emplace(model, s, work);
-    const Finish finish{meshes ? &*meshes : nullptr, kick};
-    (near ? pass<Scan::kNear> : pass<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
+    int thread_next = 0;
+    const Finish finish{meshes ? &*meshes : nullptr, kick, predict ? &next : nullptr, &thread_next, drifts};
+    (near ? pass_of<Scan::kNear> : pass_of<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
     if (meshes) sum_records_in_turn(model, s, work, n);
+    next_moved |= thread_next;
   }
+  work.next_moved = predict ? (next_moved | untested(next)) : -1;
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
   work.near_refreshes += !near;
   if (!finish_in_pass) {
@@ -486,7 +488,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
     if (work.domain) work.domain->return_ghost_loads(s);
     // Gravity, and the closing half kick of free spheres.
 #pragma omp parallel if (n >= kParallelMin)
-    for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick); });
+    for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick, nullptr, model.dt); });
   }
 
   // Bodies: force and torque about the centre of mass from their spheres, plus weight.
@@ -530,12 +532,13 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
     if (work.domain) work.domain->sum_wall_loads(s);
   }
   // Glued spheres pass their contact forces to their wall, summed in slot order.
-  if (!model.has_attached) return;
-  for (long p = 0; p < n; ++p) {
-    const std::int32_t w = s.attached[p];
-    if (w < 0) continue;
-    s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
-  }
+  if (model.has_attached)
+    for (long p = 0; p < n; ++p) {
+      const std::int32_t w = s.attached[p];
+      if (w < 0) continue;
+      s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
+    }
+  return drifts ? drift_moved | untested(pass.drift) : 0;
 }
 
 }  // namespace dem

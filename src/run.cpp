@@ -340,9 +340,21 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const auto start = Clock::now();
   auto last_progress = start;
   std::int64_t particle_steps = 0;
+  // Steps until the next one that checks, records or writes run as one advance() (fused steps,
+  // step.h); under domain decomposition one at a time (the ranks exchange every step anyway).
+  const auto steps_to_next_event = [&] {
+    std::int64_t steps = last_step - state.step;
+    for (const std::int64_t every_n : {check_every, every, frame_every, checkpoint_every})
+      if (every_n > 0) steps = std::min(steps, every_n - state.step % every_n);
+    return std::max<std::int64_t>(steps, 1);
+  };
   while (state.step < last_step) {
-    step(stepped, state, work);
-    particle_steps += static_cast<std::int64_t>(results->size());
+    if (domain) {
+      step(stepped, state, work);
+      particle_steps += static_cast<std::int64_t>(results->size());
+    } else {
+      particle_steps += advance(stepped, state, work, steps_to_next_event());
+    }
     const bool last = state.step == last_step;
     const bool check_due = state.step % check_every == 0 || last;
     // A signal stops every rank at the same step.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include "balance.h"
 #include "domain.h"
@@ -11,61 +13,11 @@
 #include "parallel.h"
 #include "particles.h"
 #include "rigid_body.h"
+#include "verlet.h"
 
 namespace dem {
 
 namespace {
-
-/// What kick_drift found: a free sphere moved more than half the skin since the lists were
-/// built (kRebuild), or more than half the near margin since the last full scan (kRescan).
-enum Moved : int { kRebuild = 1, kRescan = 2 };
-
-/// kick_drift for the free spheres among slots [begin, end), as a loop the compiler vectorises
-/// (spheres of bodies and glued spheres keep their values: their body or wall moves them).
-/// Returns the Moved flags: kRebuild checked when kCheck (lists built for these slots), kRescan
-/// when kNear (near pairs valid); each flag is set when it is not checked.
-template <bool kCheck, bool kNear>
-[[gnu::always_inline]] inline int kick_drift_loop(State& s, const Workspace& work, long begin, long end, double h, double dt,
-                                                  double limit2, double near2) {
-  const std::int32_t *body = s.body.data(), *attached = s.attached.data();
-  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
-  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
-  double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
-  double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
-  double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
-  double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
-  const double *xb = s.x_built.data(), *yb = s.y_built.data(), *zb = s.z_built.data();
-  const double *xn = work.near.x.data(), *yn = work.near.y.data(), *zn = work.near.z.data();
-  int moved = (kCheck ? 0 : kRebuild) | (kNear ? 0 : kRescan);
-  DEM_VECTOR_LOOP
-  for (long p = begin; p < end; ++p) {
-    const bool free = (body[p] < 0) & (attached[p] < 0);
-    const double a = h * inv_mass[p], b = h * inv_inertia[p];
-    const double nvx = vx[p] + a * fx[p], nvy = vy[p] + a * fy[p], nvz = vz[p] + a * fz[p];
-    const double nx = x[p] + dt * nvx, ny = y[p] + dt * nvy, nz = z[p] + dt * nvz;
-    if constexpr (kCheck) {
-      const double dx = nx - xb[p], dy = ny - yb[p], dz = nz - zb[p];
-      moved |= (free & (dx * dx + dy * dy + dz * dz > limit2)) * kRebuild;
-    }
-    if constexpr (kNear) {
-      const double ex = nx - xn[p], ey = ny - yn[p], ez = nz - zn[p];
-      moved |= (free & (ex * ex + ey * ey + ez * ez > near2)) * kRescan;
-    }
-    const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
-    wx[p] = free ? nwx : wx[p], wy[p] = free ? nwy : wy[p], wz[p] = free ? nwz : wz[p];
-    vx[p] = free ? nvx : vx[p], vy[p] = free ? nvy : vy[p], vz[p] = free ? nvz : vz[p];
-    x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
-    fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;  // used: the contact pass sums anew (Workspace::loads_cleared)
-  }
-  return moved;
-}
-
-DEM_KERNEL int kick_drift_range(State& s, const Workspace& work, long begin, long end, double h, double dt, bool check, bool near,
-                                double limit2, double near2) {
-  if (check) return near ? kick_drift_loop<true, true>(s, work, begin, end, h, dt, limit2, near2)
-                         : kick_drift_loop<true, false>(s, work, begin, end, h, dt, limit2, near2);
-  return kick_drift_loop<false, false>(s, work, begin, end, h, dt, limit2, near2);
-}
 
 /// The opening half kick and the drift in one pass: v += h F/m, w += h T/I, x += dt v for free
 /// spheres, and every owned slot's F and T set to zero once used; bodies take the same kick
@@ -74,14 +26,10 @@ DEM_KERNEL int kick_drift_range(State& s, const Workspace& work, long begin, lon
 /// while the positions are in cache).
 int kick_drift(State& s, Workspace& work, const Model& model, double h, double dt) {
   const long n = static_cast<long>(s.owned());  // ghosts are moved by their owners
-  const bool check = s.x_built.size() == s.size();
-  const bool near = check && work.near.valid && work.near.x.size() == static_cast<size_t>(n);
-  const double limit2 = 0.25 * model.skin * model.skin, near2 = 0.25 * work.near.margin * work.near.margin;
-  int moved = (check ? 0 : kRebuild) | (near ? 0 : kRescan);
+  const DriftLimits limits = drift_limits(model, s, work, work.near.valid);
+  int moved = untested(limits);
 #pragma omp parallel reduction(| : moved) if (n >= kParallelMin)
-  for_own_blocks(work, n, [&](long begin, long end) {
-    moved |= kick_drift_range(s, work, begin, end, h, dt, check, near, limit2, near2);
-  });
+  for_own_blocks(work, n, [&](long begin, long end) { moved |= kick_drift_range(s, limits, begin, end, h, dt); });
   Bodies& b = s.bodies;
   if (b.size() == 0) return moved;
   for (size_t k = 0; k < b.size(); ++k) {
@@ -151,6 +99,73 @@ void run_inlets_decomposed(const Model& model, State& state, Workspace& work) {
   }
 }
 
+/// Whether this step's opening kick and drift may run inside its contact pass (a fused step,
+/// ForcePass::drift_kick): the closing kick of the step before predicted the drift's flags
+/// (`predicted`, -1: not predicted) and no free sphere will have used up half the skin, and
+/// nothing else moves spheres or changes the slots in between: no bodies, glued spheres, ghosts
+/// or ranks, no inlet due, no mesh that moved half the skin since the lists were built.
+/// Without the prediction the threads would have to meet between the drift and the contact pass
+/// (whether the lists are rebuilt depends on every sphere's drift): the barrier fusing removes.
+/// Rejected: predicting across calls of step() (a caller may change the state between them, and
+/// a wrong prediction would miss contacts).
+bool fusable(const Model& model, const State& state, const Workspace& work, int predicted) {
+  if (predicted < 0 || (predicted & kRebuild) || work.domain || state.bodies.size() > 0 || model.has_attached || state.ghosts > 0)
+    return false;
+  for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
+    if (inlet_due(model, state, k)) return false;
+  return !needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
+}
+
+/// One step. `predict`: the closing kick also predicts the next step's drift (a next step
+/// follows in the same advance() call, and it could be fused).
+void one_step(const Model& model, State& state, Workspace& work, bool predict) {
+  const double dt = model.dt;
+  const int predicted = std::exchange(work.next_moved, -1);
+  // Walls and meshes first: what they do does not depend on the spheres' drift.
+  move_walls(model, state, dt);
+  place_meshes(model, state.time + dt, work);
+  ForcePass pass;
+  pass.kick = 0.5 * dt;
+  pass.predict = predict && !work.domain && state.bodies.size() == 0 && !model.has_attached;
+  if (fusable(model, state, work, predicted)) {
+    // The drift in the contact pass: no rebuild (predicted), the owned slots' loads zeroed by it.
+    pass.drift_kick = 0.5 * dt;
+    pass.drift = drift_limits(model, state, work, work.near.valid);
+    work.loads_cleared = true;
+    work.near.trusted = !(predicted & kRescan);
+    const int moved = compute_forces(model, state, work, pass);
+    ++work.fused_steps;
+    if (moved != predicted)  // the same operations on the same numbers: a broken invariant
+      throw std::logic_error("step: the drift found other flags than the closing kick of the step before predicted");
+  } else {
+    const int moved = kick_drift(state, work, model, 0.5 * dt, dt);
+    const bool free_moved = moved & kRebuild;
+    bool rebuilt = false;  // a rebuild may add slots (inlets, migration) whose loads are not zero
+    if (work.domain) {
+      run_inlets_decomposed(model, state, work);
+      // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
+      rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
+      if (rebuilt)
+        rebuild_contacts(model, state, work);
+      else
+        work.domain->refresh_ghosts(state);
+    } else {
+      for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
+        if (run_inlet(model, state, k) > 0) work.valid = false;
+      rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
+      if (rebuilt) rebuild_contacts(model, state, work);
+    }
+    work.loads_cleared = !rebuilt;
+    // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
+    // clears near.valid) and no free sphere moved half the margin since the last full scan.
+    work.near.trusted = !(moved & kRescan);
+    compute_forces(model, state, work, pass);
+  }
+  refresh_body_spheres(model, state, work);
+  state.time += dt;
+  ++state.step;
+}
+
 }  // namespace
 
 void prepare(const Model& model, State& state, Workspace& work) {
@@ -169,35 +184,16 @@ void prepare(const Model& model, State& state, Workspace& work) {
   compute_forces(model, state, work);
 }
 
-void step(const Model& model, State& state, Workspace& work) {
-  const double dt = model.dt;
-  const int moved = kick_drift(state, work, model, 0.5 * dt, dt);
-  const bool free_moved = moved & kRebuild;
-  move_walls(model, state, dt);
-  place_meshes(model, state.time + dt, work);
-  bool rebuilt = false;  // a rebuild may add slots (inlets, migration) whose loads are not zero
-  if (work.domain) {
-    run_inlets_decomposed(model, state, work);
-    // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
-    rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
-    if (rebuilt)
-      rebuild_contacts(model, state, work);
-    else
-      work.domain->refresh_ghosts(state);
-  } else {
-    for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
-      if (run_inlet(model, state, k) > 0) work.valid = false;
-    rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
-    if (rebuilt) rebuild_contacts(model, state, work);
+std::int64_t advance(const Model& model, State& state, Workspace& work, std::int64_t steps) {
+  std::int64_t particle_steps = 0;
+  work.next_moved = -1;  // a prediction holds within its call: between calls the caller may change the state
+  for (std::int64_t k = 0; k < steps; ++k) {
+    one_step(model, state, work, k + 1 < steps);
+    particle_steps += static_cast<std::int64_t>(state.owned());
   }
-  work.loads_cleared = !rebuilt;
-  // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
-  // clears near.valid) and no free sphere moved half the margin since the last full scan.
-  work.near.trusted = !(moved & kRescan);
-  compute_forces(model, state, work, 0.5 * dt);
-  refresh_body_spheres(model, state, work);
-  state.time += dt;
-  ++state.step;
+  return particle_steps;
 }
+
+void step(const Model& model, State& state, Workspace& work) { advance(model, state, work, 1); }
 
 }  // namespace dem

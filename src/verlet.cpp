@@ -1,0 +1,119 @@
+#include "verlet.h"
+
+#include "parallel.h"
+
+namespace dem {
+
+namespace {
+
+/// The Moved flags of a free sphere at (x, y, z) in slot p: kRebuild checked when kCheck,
+/// kRescan when kNear (the caller sets the flags it does not check).
+template <bool kCheck, bool kNear>
+[[gnu::always_inline]] inline int moved(const DriftLimits& l, long p, bool free, double x, double y, double z) {
+  int flags = 0;
+  if constexpr (kCheck) {
+    const double dx = x - l.x_built[p], dy = y - l.y_built[p], dz = z - l.z_built[p];
+    flags |= (free & (dx * dx + dy * dy + dz * dz > l.skin2)) * kRebuild;
+  }
+  if constexpr (kNear) {
+    const double ex = x - l.x_near[p], ey = y - l.y_near[p], ez = z - l.z_near[p];
+    flags |= (free & (ex * ex + ey * ey + ez * ez > l.near2)) * kRescan;
+  }
+  return flags;
+}
+
+template <bool kCheck, bool kNear>
+[[gnu::always_inline]] inline int kick_drift_loop(State& s, const DriftLimits& limits, long begin, long end, double h, double dt) {
+  const std::int32_t *body = s.body.data(), *attached = s.attached.data();
+  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
+  double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
+  double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
+  double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
+  int flags = 0;
+  DEM_VECTOR_LOOP
+  for (long p = begin; p < end; ++p) {
+    const bool free = (body[p] < 0) & (attached[p] < 0);
+    const double a = h * inv_mass[p], b = h * inv_inertia[p];
+    const double nvx = vx[p] + a * fx[p], nvy = vy[p] + a * fy[p], nvz = vz[p] + a * fz[p];
+    const double nx = x[p] + dt * nvx, ny = y[p] + dt * nvy, nz = z[p] + dt * nvz;
+    flags |= moved<kCheck, kNear>(limits, p, free, nx, ny, nz);
+    const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
+    wx[p] = free ? nwx : wx[p], wy[p] = free ? nwy : wy[p], wz[p] = free ? nwz : wz[p];
+    vx[p] = free ? nvx : vx[p], vy[p] = free ? nvy : vy[p], vz[p] = free ? nvz : vz[p];
+    x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
+    fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;  // used: the contact pass sums anew
+  }
+  return flags;
+}
+
+/// kPredict: also the flags of the next drift (kick_drift_loop<true, kNear> with the same h).
+template <bool kPredict, bool kNear>
+[[gnu::always_inline]] inline int gravity_kick_loop(const double* gravity, State& s, const DriftLimits& next, long begin, long end,
+                                                    double h, double dt) {
+  const double gx = gravity[0], gy = gravity[1], gz = gravity[2];
+  const std::int32_t *body = s.body.data(), *attached = s.attached.data();
+  const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
+  const double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
+  double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
+  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
+  const bool kicks = h != 0.0;
+  int flags = 0;
+  DEM_VECTOR_LOOP
+  for (long p = begin; p < end; ++p) {
+    const bool free = (body[p] < 0) & (attached[p] < 0);
+    const double weight = 1.0 / inv_mass[p];
+    const double mass = free ? weight : 0.0;
+    const double nfx = fx[p] + mass * gx, nfy = fy[p] + mass * gy, nfz = fz[p] + mass * gz;
+    fx[p] = nfx, fy[p] = nfy, fz[p] = nfz;
+    const bool kicked = free & kicks;
+    const double a = h * inv_mass[p], b = h * inv_inertia[p];
+    const double nvx = vx[p] + a * nfx, nvy = vy[p] + a * nfy, nvz = vz[p] + a * nfz;
+    const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
+    const double kvx = kicked ? nvx : vx[p], kvy = kicked ? nvy : vy[p], kvz = kicked ? nvz : vz[p];
+    vx[p] = kvx, vy[p] = kvy, vz[p] = kvz;
+    wx[p] = kicked ? nwx : wx[p], wy[p] = kicked ? nwy : wy[p], wz[p] = kicked ? nwz : wz[p];
+    if constexpr (kPredict) {
+      // The next opening kick and drift, as kick_drift_loop will compute them.
+      const double pvx = kvx + a * nfx, pvy = kvy + a * nfy, pvz = kvz + a * nfz;
+      flags |= moved<true, kNear>(next, p, free, x[p] + dt * pvx, y[p] + dt * pvy, z[p] + dt * pvz);
+    }
+  }
+  return flags;
+}
+
+}  // namespace
+
+int untested(const DriftLimits& limits) { return (limits.x_built ? 0 : kRebuild) | (limits.x_near ? 0 : kRescan); }
+
+DriftLimits drift_limits(const Model& model, const State& s, const Workspace& work, bool near_valid) {
+  DriftLimits limits;
+  const size_t n = s.owned();
+  if (s.x_built.size() != s.size()) return limits;
+  limits.x_built = s.x_built.data(), limits.y_built = s.y_built.data(), limits.z_built = s.z_built.data();
+  limits.skin2 = 0.25 * model.skin * model.skin;
+  if (!near_valid || work.near.x.size() != n) return limits;
+  limits.x_near = work.near.x.data(), limits.y_near = work.near.y.data(), limits.z_near = work.near.z.data();
+  limits.near2 = 0.25 * work.near.margin * work.near.margin;
+  return limits;
+}
+
+DEM_KERNEL int kick_drift_range(State& s, const DriftLimits& limits, long begin, long end, double h, double dt) {
+  const int flags = untested(limits);
+  if (!limits.x_built) return flags | kick_drift_loop<false, false>(s, limits, begin, end, h, dt);
+  if (!limits.x_near) return flags | kick_drift_loop<true, false>(s, limits, begin, end, h, dt);
+  return flags | kick_drift_loop<true, true>(s, limits, begin, end, h, dt);
+}
+
+DEM_KERNEL int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* next, double dt) {
+  if (!next) return gravity_kick_loop<false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
+  const int flags = untested(*next);
+  if (!next->x_built) return flags | gravity_kick_loop<false, false>(gravity, s, *next, begin, end, h, dt);
+  if (!next->x_near) return flags | gravity_kick_loop<true, false>(gravity, s, *next, begin, end, h, dt);
+  return flags | gravity_kick_loop<true, true>(gravity, s, *next, begin, end, h, dt);
+}
+
+}  // namespace dem
