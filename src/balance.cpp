@@ -29,8 +29,7 @@ void share_blocks(Workspace& work, long n) {
     std::fill(work.block_time.begin(), work.block_time.end(), 0.0);
     work.block_timed = true;
   }
-  if (work.block_done.size() != size || ++work.pass_epoch == 0)
-    work.block_done.assign(size, 0), work.block_drifted.assign(size, 0), work.pass_epoch = 1;
+  if (work.block_done.size() != size || ++work.pass_epoch == 0) work.block_done.assign(size, 0), work.pass_epoch = 1;
   work.block_prefix.resize(size + 1);
   work.block_prefix[0] = 0.0;
   for (long b = 0; b < blocks; ++b) work.block_prefix[b + 1] = work.block_prefix[b] + work.block_work[b];

@@ -25,8 +25,7 @@
 namespace dem {
 
 /// Before a contact pass over n owned slots: the step's measured times folded into the blocks'
-/// work, the running sum of that work for thread_blocks, a new pass number for block_done and
-/// block_drifted.
+/// work, the running sum of that work for thread_blocks, a new pass number for block_done.
 void share_blocks(Workspace& work, long n);
 
 /// Thread t of nt: blocks [lo, hi), a contiguous run holding about 1/nt of the work. All

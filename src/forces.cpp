@@ -43,7 +43,6 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
-#include <stdexcept>
 #include <thread>
 #include <utility>
 
@@ -298,9 +297,8 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
 struct Finish {
   MeshContactPass* meshes;   ///< this thread's; null without meshes
   double kick;               ///< [s] closing half kick (0: none)
-  const DriftLimits* next;   ///< predict the next drift's flags into *next_moved (null: no)
-  int* next_moved;           ///< this thread's
-  bool drifted;              ///< the pass drifted each thread's blocks first (a fused step)
+  const DriftLimits* ahead;  ///< then the next step's opening kick and drift (null: no)
+  int* moved;                ///< this thread's Moved flags of that drift
 };
 
 /// Waits until another thread has stored `value` in `flag` (release), and sees what it wrote.
@@ -344,8 +342,6 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
   const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
   const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
   const auto evaluate = [&](long b) {
-    // In a fused step the next block may be another thread's, drifted by it.
-    if (finish && finish->drifted && b + 1 < blocks && b + 1 >= hi) wait_until(work.block_drifted[b + 1], work.pass_epoch);
     const auto start = std::chrono::steady_clock::now();
     for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
       particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
@@ -362,7 +358,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
     const auto start = std::chrono::steady_clock::now();
     const long first = b * block, last = std::min(n, (b + 1) * block);
     if (finish->meshes) finish->meshes->run(first, last);
-    *finish->next_moved |= gravity_kick_range(model.gravity.data(), s, first, last, finish->kick, finish->next, model.dt);
+    *finish->moved |= gravity_kick_range(model.gravity.data(), s, first, last, finish->kick, finish->ahead, model.dt);
     add_block_time(work, b, start);
   };
   const auto evaluate_odd = [&](long b) { evaluate(b), complete(b), complete(b + 1); };
@@ -422,7 +418,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, double kick) 
   compute_forces(model, s, work, pass);
 }
 
-int compute_forces(const Model& model, State& s, Workspace& work, const ForcePass& pass) {
+void compute_forces(const Model& model, State& s, Workspace& work, const ForcePass& pass) {
   const double kick = pass.kick;
   const long n_all = static_cast<long>(s.size());
   const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
@@ -444,22 +440,15 @@ int compute_forces(const Model& model, State& s, Workspace& work, const ForcePas
   // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
   // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
   const bool finish_in_pass = !ghosts && !work.domain;
-  const bool drifts = pass.drift_kick != 0.0;
-  if (drifts && !finish_in_pass) throw std::logic_error("compute_forces: a drift in the contact pass with ghosts");
-  // The next drift's limits, as they will be once this pass has scanned the pairs.
-  const bool predict = pass.predict && kick != 0.0 && finish_in_pass;
-  const DriftLimits next = predict ? drift_limits(model, s, work, true) : DriftLimits{};
+  // The next step's drift tests positions against the lists as they are after this pass.
+  const bool ahead = pass.drift_ahead && kick != 0.0 && finish_in_pass;
+  const DriftLimits limits = ahead ? drift_limits(model, s, work, /*near_valid=*/true) : DriftLimits{};
   if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
   work.records_turn = 0;
-  int drift_moved = 0, next_moved = 0;
-#pragma omp parallel if (n >= kParallelMin) reduction(| : drift_moved, next_moved)
+  int moved = 0;
+#pragma omp parallel if (n >= kParallelMin) reduction(| : moved)
   {
-    if (drifts)  // each thread its own blocks, each marked as drifted (block_pass waits for it)
-      for_own_blocks(work, n, [&](long begin, long end) {
-        drift_moved |= kick_drift_range(s, pass.drift, begin, end, pass.drift_kick, model.dt);
-        std::atomic_ref<std::uint32_t>(work.block_drifted[begin / work.block]).store(work.pass_epoch, std::memory_order_release);
-      });
     const long clear_from = work.loads_cleared ? n : 0;  // owned slots zeroed by the kick-drift pass
     if (clear_from < n_all) {
 #pragma omp for schedule(static)
@@ -468,13 +457,14 @@ int compute_forces(const Model& model, State& s, Workspace& work, const ForcePas
     Batch batch;
     std::optional<MeshContactPass> meshes;
     if (finish_in_pass && !model.meshes.empty()) meshes.emplace(model, s, work);
-    int thread_next = 0;
-    const Finish finish{meshes ? &*meshes : nullptr, kick, predict ? &next : nullptr, &thread_next, drifts};
+    int thread_moved = 0;
+    const Finish finish{meshes ? &*meshes : nullptr, kick, ahead ? &limits : nullptr, &thread_moved};
     (near ? pass_of<Scan::kNear> : pass_of<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
     if (meshes) sum_records_in_turn(model, s, work, n);
-    next_moved |= thread_next;
+    moved |= thread_moved;
   }
-  work.next_moved = predict ? (next_moved | untested(next)) : -1;
+  work.drifted_ahead = ahead ? (moved | untested(limits)) : -1;
+  work.drifts_ahead += ahead;
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
   work.near_refreshes += !near;
   if (!finish_in_pass) {
@@ -538,7 +528,6 @@ int compute_forces(const Model& model, State& s, Workspace& work, const ForcePas
       if (w < 0) continue;
       s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
     }
-  return drifts ? drift_moved | untested(pass.drift) : 0;
 }
 
 }  // namespace dem

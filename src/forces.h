@@ -18,17 +18,15 @@ void compute_forces(const Model& model, State& state, Workspace& work, double ki
 /// What a contact pass does besides the contacts (step.cpp).
 struct ForcePass {
   double kick = 0.0;  ///< [s] closing half kick h (0: none), as compute_forces' `kick`
-  /// [s] when not 0: the step's opening half kick (this h) and drift (Model::dt) come first, each
-  /// thread's spheres right before their contacts, with no barrier between the two (a fused
-  /// step: no bodies, glued spheres or ghosts, and the lists need no rebuild). Zeroes the owned
-  /// slots' loads (Workspace::loads_cleared must be set).
-  double drift_kick = 0.0;
-  DriftLimits drift;     ///< what that drift tests (drift_limits before the pass)
-  bool predict = false;  ///< with a kick: Workspace::next_moved, the flags of the next step's drift
+  /// With a kick: each sphere's closing kick is followed by the next step's opening kick (the
+  /// same h) and drift (Model::dt), in the same pass (drift ahead); Workspace::drifted_ahead
+  /// gets their Moved flags. Only without bodies, glued spheres or ghosts, and only when the
+  /// next step follows at once (advance(): no one else reads or changes the state in between).
+  bool drift_ahead = false;
 };
 
-/// compute_forces as `pass` says. Returns the Moved flags of its drift (0 without).
-int compute_forces(const Model& model, State& state, Workspace& work, const ForcePass& pass);
+/// compute_forces as `pass` says.
+void compute_forces(const Model& model, State& state, Workspace& work, const ForcePass& pass);
 
 /// Runs the model's effects over a filled batch (outputs zeroed first). Exposed for kernel tests.
 void evaluate_effects(const Model& model, ContactBatch& batch);

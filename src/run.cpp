@@ -340,8 +340,8 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const auto start = Clock::now();
   auto last_progress = start;
   std::int64_t particle_steps = 0;
-  // Steps until the next one that checks, records or writes run as one advance() (fused steps,
-  // step.h); under domain decomposition one at a time (the ranks exchange every step anyway).
+  // Steps until the next one that checks, records or writes run as one advance() (each closing
+  // kick gives the next step's drift, step.h); under domain decomposition one at a time.
   const auto steps_to_next_event = [&] {
     std::int64_t steps = last_step - state.step;
     for (const std::int64_t every_n : {check_every, every, frame_every, checkpoint_every})

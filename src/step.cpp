@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <utility>
 
 #include "balance.h"
@@ -99,68 +98,45 @@ void run_inlets_decomposed(const Model& model, State& state, Workspace& work) {
   }
 }
 
-/// Whether this step's opening kick and drift may run inside its contact pass (a fused step,
-/// ForcePass::drift_kick): the closing kick of the step before predicted the drift's flags
-/// (`predicted`, -1: not predicted) and no free sphere will have used up half the skin, and
-/// nothing else moves spheres or changes the slots in between: no bodies, glued spheres, ghosts
-/// or ranks, no inlet due, no mesh that moved half the skin since the lists were built.
-/// Without the prediction the threads would have to meet between the drift and the contact pass
-/// (whether the lists are rebuilt depends on every sphere's drift): the barrier fusing removes.
-/// Rejected: predicting across calls of step() (a caller may change the state between them, and
-/// a wrong prediction would miss contacts).
-bool fusable(const Model& model, const State& state, const Workspace& work, int predicted) {
-  if (predicted < 0 || (predicted & kRebuild) || work.domain || state.bodies.size() > 0 || model.has_attached || state.ghosts > 0)
-    return false;
-  for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
-    if (inlet_due(model, state, k)) return false;
-  return !needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
-}
-
-/// One step. `predict`: the closing kick also predicts the next step's drift (a next step
-/// follows in the same advance() call, and it could be fused).
-void one_step(const Model& model, State& state, Workspace& work, bool predict) {
+/// One step. `next_follows`: another step follows in the same advance() call, and no one reads
+/// or changes the state in between, so this step's closing kick may give that step's opening
+/// kick and drift too (ForcePass::drift_ahead: one pass over the spheres less per step, the
+/// spheres in cache as their contacts are summed). Without bodies, glued spheres or ranks,
+/// whose motion the closing kick does not give. Rejected: the drift inside the next step's
+/// contact pass, its flags predicted by the closing kick (a region per step, but the spheres
+/// read twice); drifting ahead across calls of step() (the state between steps would not be the
+/// state of a time).
+void one_step(const Model& model, State& state, Workspace& work, bool next_follows) {
   const double dt = model.dt;
-  const int predicted = std::exchange(work.next_moved, -1);
+  const int drifted = std::exchange(work.drifted_ahead, -1);
   // Walls and meshes first: what they do does not depend on the spheres' drift.
   move_walls(model, state, dt);
   place_meshes(model, state.time + dt, work);
+  const int moved = drifted >= 0 ? drifted : kick_drift(state, work, model, 0.5 * dt, dt);
+  const bool free_moved = moved & kRebuild;
+  bool rebuilt = false;  // a rebuild may add slots (inlets, migration) whose loads are not zero
+  if (work.domain) {
+    run_inlets_decomposed(model, state, work);
+    // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
+    rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
+    if (rebuilt)
+      rebuild_contacts(model, state, work);
+    else
+      work.domain->refresh_ghosts(state);
+  } else {
+    for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
+      if (run_inlet(model, state, k) > 0) work.valid = false;
+    rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
+    if (rebuilt) rebuild_contacts(model, state, work);
+  }
+  work.loads_cleared = !rebuilt;
+  // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
+  // clears near.valid) and no free sphere moved half the margin since the last full scan.
+  work.near.trusted = !(moved & kRescan);
   ForcePass pass;
   pass.kick = 0.5 * dt;
-  pass.predict = predict && !work.domain && state.bodies.size() == 0 && !model.has_attached;
-  if (fusable(model, state, work, predicted)) {
-    // The drift in the contact pass: no rebuild (predicted), the owned slots' loads zeroed by it.
-    pass.drift_kick = 0.5 * dt;
-    pass.drift = drift_limits(model, state, work, work.near.valid);
-    work.loads_cleared = true;
-    work.near.trusted = !(predicted & kRescan);
-    const int moved = compute_forces(model, state, work, pass);
-    ++work.fused_steps;
-    if (moved != predicted)  // the same operations on the same numbers: a broken invariant
-      throw std::logic_error("step: the drift found other flags than the closing kick of the step before predicted");
-  } else {
-    const int moved = kick_drift(state, work, model, 0.5 * dt, dt);
-    const bool free_moved = moved & kRebuild;
-    bool rebuilt = false;  // a rebuild may add slots (inlets, migration) whose loads are not zero
-    if (work.domain) {
-      run_inlets_decomposed(model, state, work);
-      // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
-      rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
-      if (rebuilt)
-        rebuild_contacts(model, state, work);
-      else
-        work.domain->refresh_ghosts(state);
-    } else {
-      for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
-        if (run_inlet(model, state, k) > 0) work.valid = false;
-      rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
-      if (rebuilt) rebuild_contacts(model, state, work);
-    }
-    work.loads_cleared = !rebuilt;
-    // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
-    // clears near.valid) and no free sphere moved half the margin since the last full scan.
-    work.near.trusted = !(moved & kRescan);
-    compute_forces(model, state, work, pass);
-  }
+  pass.drift_ahead = next_follows && !work.domain && state.bodies.size() == 0 && !model.has_attached;
+  compute_forces(model, state, work, pass);
   refresh_body_spheres(model, state, work);
   state.time += dt;
   ++state.step;
@@ -186,7 +162,7 @@ void prepare(const Model& model, State& state, Workspace& work) {
 
 std::int64_t advance(const Model& model, State& state, Workspace& work, std::int64_t steps) {
   std::int64_t particle_steps = 0;
-  work.next_moved = -1;  // a prediction holds within its call: between calls the caller may change the state
+  work.drifted_ahead = -1;  // (the last step of a call never drifts ahead)
   for (std::int64_t k = 0; k < steps; ++k) {
     one_step(model, state, work, k + 1 < steps);
     particle_steps += static_cast<std::int64_t>(state.owned());

@@ -48,18 +48,18 @@ template <bool kCheck, bool kNear>
   return flags;
 }
 
-/// kPredict: also the flags of the next drift (kick_drift_loop<true, kNear> with the same h).
-template <bool kPredict, bool kNear>
-[[gnu::always_inline]] inline int gravity_kick_loop(const double* gravity, State& s, const DriftLimits& next, long begin, long end,
+/// kAhead: then the next step's opening kick and drift (kick_drift_loop<kCheck, kNear>).
+template <bool kAhead, bool kCheck, bool kNear>
+[[gnu::always_inline]] inline int gravity_kick_loop(const double* gravity, State& s, const DriftLimits& limits, long begin, long end,
                                                     double h, double dt) {
   const double gx = gravity[0], gy = gravity[1], gz = gravity[2];
   const std::int32_t *body = s.body.data(), *attached = s.attached.data();
   const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
   double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
-  const double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
   double *vx = s.vx.data(), *vy = s.vy.data(), *vz = s.vz.data();
   double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
-  const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
+  double *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
   const bool kicks = h != 0.0;
   int flags = 0;
   DEM_VECTOR_LOOP
@@ -68,18 +68,26 @@ template <bool kPredict, bool kNear>
     const double weight = 1.0 / inv_mass[p];
     const double mass = free ? weight : 0.0;
     const double nfx = fx[p] + mass * gx, nfy = fy[p] + mass * gy, nfz = fz[p] + mass * gz;
-    fx[p] = nfx, fy[p] = nfy, fz[p] = nfz;
     const bool kicked = free & kicks;
     const double a = h * inv_mass[p], b = h * inv_inertia[p];
     const double nvx = vx[p] + a * nfx, nvy = vy[p] + a * nfy, nvz = vz[p] + a * nfz;
     const double nwx = wx[p] + b * tx[p], nwy = wy[p] + b * ty[p], nwz = wz[p] + b * tz[p];
     const double kvx = kicked ? nvx : vx[p], kvy = kicked ? nvy : vy[p], kvz = kicked ? nvz : vz[p];
-    vx[p] = kvx, vy[p] = kvy, vz[p] = kvz;
-    wx[p] = kicked ? nwx : wx[p], wy[p] = kicked ? nwy : wy[p], wz[p] = kicked ? nwz : wz[p];
-    if constexpr (kPredict) {
-      // The next opening kick and drift, as kick_drift_loop will compute them.
-      const double pvx = kvx + a * nfx, pvy = kvy + a * nfy, pvz = kvz + a * nfz;
-      flags |= moved<true, kNear>(next, p, free, x[p] + dt * pvx, y[p] + dt * pvy, z[p] + dt * pvz);
+    const double kwx = kicked ? nwx : wx[p], kwy = kicked ? nwy : wy[p], kwz = kicked ? nwz : wz[p];
+    if constexpr (kAhead) {
+      // The next step's opening kick and drift, as kick_drift_loop computes them.
+      const double ovx = kvx + a * nfx, ovy = kvy + a * nfy, ovz = kvz + a * nfz;
+      const double owx = kwx + b * tx[p], owy = kwy + b * ty[p], owz = kwz + b * tz[p];
+      const double nx = x[p] + dt * ovx, ny = y[p] + dt * ovy, nz = z[p] + dt * ovz;
+      flags |= moved<kCheck, kNear>(limits, p, free, nx, ny, nz);
+      vx[p] = free ? ovx : kvx, vy[p] = free ? ovy : kvy, vz[p] = free ? ovz : kvz;
+      wx[p] = free ? owx : kwx, wy[p] = free ? owy : kwy, wz[p] = free ? owz : kwz;
+      x[p] = free ? nx : x[p], y[p] = free ? ny : y[p], z[p] = free ? nz : z[p];
+      fx[p] = fy[p] = fz[p] = tx[p] = ty[p] = tz[p] = 0.0;  // used: the next contact pass sums anew
+    } else {
+      fx[p] = nfx, fy[p] = nfy, fz[p] = nfz;
+      vx[p] = kvx, vy[p] = kvy, vz[p] = kvz;
+      wx[p] = kwx, wy[p] = kwy, wz[p] = kwz;
     }
   }
   return flags;
@@ -108,12 +116,12 @@ DEM_KERNEL int kick_drift_range(State& s, const DriftLimits& limits, long begin,
   return flags | kick_drift_loop<true, true>(s, limits, begin, end, h, dt);
 }
 
-DEM_KERNEL int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* next, double dt) {
-  if (!next) return gravity_kick_loop<false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
-  const int flags = untested(*next);
-  if (!next->x_built) return flags | gravity_kick_loop<false, false>(gravity, s, *next, begin, end, h, dt);
-  if (!next->x_near) return flags | gravity_kick_loop<true, false>(gravity, s, *next, begin, end, h, dt);
-  return flags | gravity_kick_loop<true, true>(gravity, s, *next, begin, end, h, dt);
+DEM_KERNEL int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* ahead, double dt) {
+  if (!ahead || h == 0.0) return gravity_kick_loop<false, false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
+  const int flags = untested(*ahead);
+  if (!ahead->x_built) return flags | gravity_kick_loop<true, false, false>(gravity, s, *ahead, begin, end, h, dt);
+  if (!ahead->x_near) return flags | gravity_kick_loop<true, true, false>(gravity, s, *ahead, begin, end, h, dt);
+  return flags | gravity_kick_loop<true, true, true>(gravity, s, *ahead, begin, end, h, dt);
 }
 
 }  // namespace dem

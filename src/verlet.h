@@ -37,9 +37,9 @@ DriftLimits drift_limits(const Model& model, const State& s, const Workspace& wo
 int kick_drift_range(State& s, const DriftLimits& limits, long begin, long end, double h, double dt);
 
 /// Slots [begin, end): gravity added to the free spheres' forces, then the closing half kick
-/// v += h F/m, w += h T/I (none when h = 0). With `next`, returns the Moved flags that the next
-/// step's kick_drift_range (same h, drift dt) will find for these spheres if nothing else
-/// changes them in between, computed by the same operations, so bitwise its answer; else 0.
-int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* next, double dt);
+/// v += h F/m, w += h T/I (none when h = 0). With `ahead` (and h != 0), then also the next step's
+/// opening half kick and drift (drift ahead), by the same operations as kick_drift_range, so
+/// bitwise what it would give, F and T set to zero, and returns their Moved flags; else 0.
+int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* ahead, double dt);
 
 }  // namespace dem

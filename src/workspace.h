@@ -64,7 +64,6 @@ struct Workspace {
   /// over the blocks, and the number of the last contact pass that summed its contacts.
   std::vector<double> block_work, block_time, block_prefix;
   std::vector<std::uint32_t> block_done;
-  std::vector<std::uint32_t> block_drifted;  ///< the number of the last pass that drifted the block (fused steps)
   std::uint32_t pass_epoch = 0;
   std::uint32_t records_turn = 0;  ///< the thread whose turn it is to sum its mesh records (forces.cpp)
   bool block_timed = false;  ///< block_work holds measured seconds
@@ -87,10 +86,10 @@ struct Workspace {
     bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since
   } near;
   std::int64_t near_refreshes = 0;   ///< full scans of the pair list
-  /// The Moved flags (verlet.h) the next step's drift will find, predicted by the closing kick of
-  /// this one inside advance() (step.h); -1 when not predicted.
-  int next_moved = -1;
-  std::int64_t fused_steps = 0;  ///< steps whose drift ran inside the contact pass (step.cpp)
+  /// The Moved flags (verlet.h) of the next step's opening kick and drift when the closing kick of
+  /// this one gave them already (ForcePass::drift_ahead); -1 when it did not.
+  int drifted_ahead = -1;
+  std::int64_t drifts_ahead = 0;  ///< steps whose opening kick and drift the step before gave
   /// Set by step() when the kick-drift pass zeroed the owned slots' forces and torques after
   /// using them and no rebuild moved or added slots since: compute_forces then clears only the
   /// ghosts' (one pass over 6 columns less per step). Cleared by compute_forces.
