@@ -522,12 +522,12 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
     if (work.domain) work.domain->sum_wall_loads(s);
   }
   // Glued spheres pass their contact forces to their wall, summed in slot order.
-  if (model.has_attached)
-    for (long p = 0; p < n; ++p) {
-      const std::int32_t w = s.attached[p];
-      if (w < 0) continue;
-      s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
-    }
+  if (!model.has_attached) return;
+  for (long p = 0; p < n; ++p) {
+    const std::int32_t w = s.attached[p];
+    if (w < 0) continue;
+    s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
+  }
 }
 
 }  // namespace dem

@@ -345,10 +345,8 @@ TEST(MeshWalls, RecordedFrictionWorkEqualsCoulombWorkAndImpactsAreCounted) {
 }
 
 /// The settling bed of 3,000 beads with its floor and one side wall triangulated (two meshes,
-/// 16 x 16 x 2 triangles each), after `steps` steps on `threads` threads: every triangle's
-/// records and each mesh's loads, in one column, and the hash of the particles.
-std::pair<std::vector<double>, std::uint64_t> bed_on_meshes(int threads, int steps) {
-  omp_set_num_threads(threads);
+/// 16 x 16 x 2 triangles each), recording from the start.
+CaseSpec bed_on_meshes_spec() {
   CaseSpec spec = load_case("settling_bed.yaml");
   spec.particles[0].count = 3000;  // above kParallelMin: two threads split the passes
   spec.particles[0].region_min.z() = 0.0;
@@ -358,7 +356,14 @@ std::pair<std::vector<double>, std::uint64_t> bed_on_meshes(int threads, int ste
   spec.meshes.push_back(rectangle("floor", Vec3(0, 0, 0), Vec3(L, 0, 0), Vec3(0, L, 0), 16));
   spec.meshes.push_back(rectangle("x0", Vec3(0, 0, 0), Vec3(0, L, 0), Vec3(0, 0, L), 16));
   spec.output.records_from = 0.0;
-  Sim sim(spec);
+  return spec;
+}
+
+/// That bed after `steps` steps on `threads` threads: every triangle's records and each mesh's
+/// loads, in one column, and the hash of the particles.
+std::pair<std::vector<double>, std::uint64_t> bed_on_meshes(int threads, int steps) {
+  omp_set_num_threads(threads);
+  Sim sim(bed_on_meshes_spec());
   for (int k = 0; k < steps; ++k) sim.advance();
   std::vector<double> out;
   for (const TriangleRecords& r : sim.state.records)
@@ -387,20 +392,12 @@ TEST(MeshWalls, RecordsAndLoadsAreBitwiseTheSameOnOneTwoAndThreeThreads) {
   }
 }
 
-/// The bed of bed_on_meshes, stepped by advance() in calls of `chunk` steps (1: step()). Between
+/// The bed of bed_on_meshes_spec thrown down, stepped by advance() in calls of `chunk` steps (1: step()). Between
 /// calls, every 500 steps, the highest sphere is put 3 mm higher, as a caller of the engine may do.
 std::pair<std::uint64_t, Workspace> bed_in_calls(int threads, int steps, int chunk) {
   omp_set_num_threads(threads);
-  CaseSpec spec = load_case("settling_bed.yaml");
-  spec.particles[0].count = 3000;
-  spec.particles[0].region_min.z() = 0.0;
-  spec.particles[0].region_max.z() = 0.06;
-  spec.particles[0].velocity = Vec3(0.2, 0.1, -0.5);  // [m/s] thrown at the floor: rebuilds the steps foresee
-  std::erase_if(spec.planes, [](const PlaneWallSpec& w) { return w.name == "floor" || w.name == "x0"; });
-  const double L = 0.08;
-  spec.meshes.push_back(rectangle("floor", Vec3(0, 0, 0), Vec3(L, 0, 0), Vec3(0, L, 0), 16));
-  spec.meshes.push_back(rectangle("x0", Vec3(0, 0, 0), Vec3(0, L, 0), Vec3(0, 0, L), 16));
-  spec.output.records_from = 0.0;
+  CaseSpec spec = bed_on_meshes_spec();
+  spec.particles[0].velocity = Vec3(0.2, 0.1, -0.5);  // [m/s] thrown at the floor: rebuilds the drift finds
   Sim sim(spec);
   for (int done = 0; done < steps; done += 500) {
     if (chunk == 1)
