@@ -222,7 +222,7 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
   std::int32_t kept = first_k;
   [[maybe_unused]] const std::int32_t *body = s.body.data(), *attached = s.attached.data();
   [[maybe_unused]] const bool i_free = (body[i] < 0) & (attached[i] < 0);
-  int c = batch.b.count, first = c;  // entries [first, c) are i's
+  int c = batch.b.count;
   for (std::int32_t e = first_k; e < end_k; ++e) {
     const std::int32_t j = partner[e];
     const std::int32_t k = kScan == Scan::kNear ? near.k[e] : e;
@@ -235,7 +235,8 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     const bool acts = dist2 < reach * reach;
     batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
     batch.contact[c] = k;
-    batch.other[c] = j;
+    batch.owner[c] = static_cast<std::int32_t>(i), batch.other[c] = j;
+    batch.pair[c] = true;
     if constexpr (kScan == Scan::kRefresh) {
       const double keep_reach = reach + near.margin;
       const bool keep = (dist2 < keep_reach * keep_reach) | !i_free | (body[j] >= 0) | (attached[j] >= 0);
@@ -245,14 +246,12 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
     c += acts;
     if (c == kBatch) {
-      for (int e2 = first; e2 < c; ++e2) batch.owner[e2] = static_cast<std::int32_t>(i), batch.pair[e2] = true;
       batch.b.count = c;
       flush(model, batch, s, work);
-      c = first = 0;
+      c = 0;
     }
   }
   if constexpr (kScan == Scan::kRefresh) near.end[i] = kept, near.x[i] = xi, near.y[i] = yi, near.z[i] = zi;
-  for (int e = first; e < c; ++e) batch.owner[e] = static_cast<std::int32_t>(i), batch.pair[e] = true;
   batch.b.count = c;
 }
 
