@@ -5,7 +5,6 @@
 
 #include "model.h"
 #include "state.h"
-#include "verlet.h"
 #include "workspace.h"
 
 namespace dem {

@@ -162,7 +162,6 @@ void prepare(const Model& model, State& state, Workspace& work) {
 
 std::int64_t advance(const Model& model, State& state, Workspace& work, std::int64_t steps) {
   std::int64_t particle_steps = 0;
-  work.drifted_ahead = -1;  // (the last step of a call never drifts ahead)
   for (std::int64_t k = 0; k < steps; ++k) {
     one_step(model, state, work, k + 1 < steps);
     particle_steps += static_cast<std::int64_t>(state.owned());
