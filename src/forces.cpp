@@ -195,8 +195,8 @@ void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
 
 /// How the contact pass reads the pair list (Workspace::NearPairs):
 ///   kAll      every listed pair (the pairs with ghosts);
-///   kRefresh  every listed pair, and slot i's near pairs and position written as it goes;
-///   kNear     slot i's near pairs only (step() found no free sphere moved margin/2 since).
+///   kRefresh  every listed pair, and the near pairs and slot i's position written as it goes;
+///   kNear     the near pairs only (step() found no free sphere moved margin/2 since).
 /// The pairs left out of the near rows cannot touch before the next full scan, and any of them
 /// that was active was cleared by that scan, so the three read the same batches.
 enum class Scan { kAll, kRefresh, kNear };
@@ -208,24 +208,27 @@ enum class Scan { kAll, kRefresh, kNear };
 /// to the branch predictor, so the loop does not branch on it.
 /// kPeriodic: the model wraps an axis (minimum image); kGhosts: partners outside [lo, hi) are
 /// skipped (without ghosts every partner is an owned slot, and the test is left out).
+/// kRefresh: `next_near` is where the block's next near pair goes (NearPairs).
 template <bool kPeriodic, bool kGhosts, Scan kScan>
-void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi) {
+void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi,
+                       std::int32_t& next_near) {
+  static_assert(kScan != Scan::kNear, "near pairs: near_contacts");
   const int width = model.history_width;
   const double range = model.interaction_range;
   const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
   const double xi = px[i], yi = py[i], zi = pz[i], ri = pr[i];
   Workspace::NearPairs& near = work.near;
-  const std::int32_t* partner = kScan == Scan::kNear ? near.j.data() : s.pairs.j.data();
-  const std::int32_t first_k = work.pair_begin[i], end_k = kScan == Scan::kNear ? near.end[i] : work.pair_begin[i + 1];
+  const std::int32_t* partner = s.pairs.j.data();
+  const std::int32_t first_k = work.pair_begin[i], end_k = work.pair_begin[i + 1];
   std::uint8_t* active = work.pair_forces.active.data();
   // kRefresh: a pair is kept when its gap is under the margin, or either sphere is not free.
-  std::int32_t kept = first_k;
   [[maybe_unused]] const std::int32_t *body = s.body.data(), *attached = s.attached.data();
   [[maybe_unused]] const bool i_free = (body[i] < 0) & (attached[i] < 0);
+  std::int32_t kept = next_near;
   int c = batch.b.count;
   for (std::int32_t e = first_k; e < end_k; ++e) {
     const std::int32_t j = partner[e];
-    const std::int32_t k = kScan == Scan::kNear ? near.k[e] : e;
+    const std::int32_t k = e;
     if constexpr (kGhosts)
       if (j < lo || j >= hi) continue;
     double d[3] = {xi - px[j], yi - py[j], zi - pz[j]};
@@ -240,7 +243,7 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
     if constexpr (kScan == Scan::kRefresh) {
       const double keep_reach = reach + near.margin;
       const bool keep = (dist2 < keep_reach * keep_reach) | !i_free | (body[j] >= 0) | (attached[j] >= 0);
-      near.k[kept] = k, near.j[kept] = j;
+      near.k[kept] = k, near.i[kept] = static_cast<std::int32_t>(i), near.j[kept] = j;
       kept += keep;
     }
     if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
@@ -251,7 +254,43 @@ void particle_contacts(const Model& model, State& s, Workspace& work, Batch& bat
       c = 0;
     }
   }
-  if constexpr (kScan == Scan::kRefresh) near.end[i] = kept, near.x[i] = xi, near.y[i] = yi, near.z[i] = zi;
+  if constexpr (kScan == Scan::kRefresh) near.end[i] = next_near = kept, near.x[i] = xi, near.y[i] = yi, near.z[i] = zi;
+  batch.b.count = c;
+}
+
+/// The near pairs [begin, end) of a block's run (NearPairs), as particle_contacts reads a row:
+/// the same tests, batch entries and order, in one loop whatever the owners.
+template <bool kPeriodic, bool kGhosts>
+void near_contacts(const Model& model, State& s, Workspace& work, Batch& batch, std::int32_t begin, std::int32_t end,
+                   std::int32_t lo, std::int32_t hi) {
+  const int width = model.history_width;
+  const double range = model.interaction_range;
+  const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
+  const Workspace::NearPairs& near = work.near;
+  const std::int32_t *owner = near.i.data(), *partner = near.j.data(), *pair = near.k.data();
+  std::uint8_t* active = work.pair_forces.active.data();
+  int c = batch.b.count;
+  for (std::int32_t e = begin; e < end; ++e) {
+    const std::int32_t i = owner[e], j = partner[e], k = pair[e];
+    if constexpr (kGhosts)
+      if (j < lo || j >= hi) continue;
+    double d[3] = {px[i] - px[j], py[i] - py[j], pz[i] - pz[j]};
+    if constexpr (kPeriodic) minimum_image(model, d);
+    const double dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    const double reach = pr[i] + pr[j] + range;
+    const bool acts = dist2 < reach * reach;
+    batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
+    batch.contact[c] = k;
+    batch.owner[c] = i, batch.other[c] = j;
+    batch.pair[c] = true;
+    if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
+    c += acts;
+    if (c == kBatch) {
+      batch.b.count = c;
+      flush(model, batch, s, work);
+      c = 0;
+    }
+  }
   batch.b.count = c;
 }
 
@@ -340,11 +379,25 @@ template <bool kPeriodic, bool kGhosts, Scan kScan>
 void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, const Finish* finish) {
   const long n = static_cast<long>(s.owned()), block = work.block, blocks = (n + block - 1) / block;
   const auto [lo, hi] = thread_blocks(work, n, omp_get_thread_num(), omp_get_num_threads());
+  const std::int32_t owned = static_cast<std::int32_t>(n);
   const auto evaluate = [&](long b) {
     const auto start = std::chrono::steady_clock::now();
-    for (long i = b * block, last = std::min(n, (b + 1) * block); i < last; ++i) {
-      particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, static_cast<std::int32_t>(n));
-      if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
+    const long first = b * block, last = std::min(n, (b + 1) * block);
+    std::int32_t kept = work.pair_begin[first];  // the block's run of near pairs
+    if constexpr (kScan == Scan::kNear) {
+      // The run up to each slot with plane walls, then its walls (a slot's walls follow its pairs).
+      const std::vector<std::int32_t>& rows = work.wall_rows;
+      for (auto r = std::lower_bound(rows.begin(), rows.end(), first); r != rows.end() && *r < last; ++r) {
+        near_contacts<kPeriodic, kGhosts>(model, s, work, batch, kept, work.near.end[*r], 0, owned);
+        kept = work.near.end[*r];
+        wall_contacts(model, s, work, batch, *r);
+      }
+      near_contacts<kPeriodic, kGhosts>(model, s, work, batch, kept, work.near.end[last - 1], 0, owned);
+    } else {
+      for (long i = first; i < last; ++i) {
+        particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, owned, kept);
+        if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
+      }
     }
     flush(model, batch, s, work);
     std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
@@ -469,8 +522,9 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
   if (!finish_in_pass) {
     if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
       Batch batch;
+      std::int32_t unused = 0;
       for (const std::int32_t i : work.ghost_owners)
-        (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all));
+        (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all), unused);
       flush(model, batch, s, work);
     }
     mesh_contact_forces(model, s, work);

@@ -286,6 +286,9 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr_of_rows(work.pair_begin, s.pairs.i, n);
   build_csr_of_rows(work.wall_begin, s.wall_pairs.i, n);
+  work.wall_rows.clear();
+  for (size_t p = 0; p < s.owned(); ++p)
+    if (work.wall_begin[p] != work.wall_begin[p + 1]) work.wall_rows.push_back(static_cast<std::int32_t>(p));
   // Block size of the force evaluation: every pair's partner lies in its own block or the next
   // (pairs with ghosts are evaluated apart, forces.cpp).
   std::int32_t span = 0;
@@ -316,7 +319,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   assign_discarding(pf.active, s.pairs.size(), std::uint8_t{0});
   work.wall_forces.resize(s.wall_pairs.size());
   Workspace::NearPairs& near = work.near;
-  resize_discarding(near.k, s.pairs.size()), resize_discarding(near.j, s.pairs.size());
+  for (auto* c : {&near.k, &near.i, &near.j}) resize_discarding(*c, s.pairs.size());
   for (auto* c : {&near.x, &near.y, &near.z}) resize_discarding(*c, s.owned());
   resize_discarding(near.end, s.owned());
   near.margin = near.margin > 0 ? std::clamp(near.margin, 0.05 * model.skin, 0.5 * model.skin) : 0.1 * model.skin;

@@ -56,6 +56,7 @@ struct Workspace {
   // Contact-list indexing (n + 1 entries each): pairs owned by slot p are
   // [pair_begin[p], pair_begin[p+1]); wall contacts likewise.
   std::vector<std::int32_t> pair_begin, wall_begin;
+  std::vector<std::int32_t> wall_rows;  ///< owned slots with plane-wall pairs, ascending
   /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
   /// (forces.cpp).
   std::int32_t block = 64;
@@ -72,13 +73,16 @@ struct Workspace {
 
   /// The pairs of the list that can act before the spheres move another margin/2: those whose
   /// gap was under `margin` when the list was last scanned in full (plus every pair with a
-  /// sphere of a body or a glued one, whose motion the drift does not check). Stored in the
-  /// pair list's own rows: slot p's near pairs are k[pair_begin[p] .. end[p]), in list order,
-  /// with their partners j, so a contact pass over them forms the same batches in the same
-  /// order as one over the whole list, for a fraction of the distance tests (forces.cpp).
+  /// sphere of a body or a glued one, whose motion the drift does not check). Stored block by
+  /// block (Workspace::block), one run per block from the pair list's start of the block's first
+  /// slot, in list order: slot p's near pairs are k[end[p - 1] .. end[p]) (from pair_begin[p] for
+  /// the block's first slot), with their owners i and partners j. A contact pass reads a block's
+  /// run in one loop, with no loop per slot (whose end, after one to three pairs, the branch
+  /// predictor misses), and forms the same batches in the same order as one over the whole list,
+  /// for a fraction of the distance tests (forces.cpp).
   struct NearPairs {
-    std::vector<std::int32_t> k, j;  ///< pair index and partner, by row of the pair list
-    std::vector<std::int32_t> end;   ///< end of slot p's near pairs (owned slots)
+    std::vector<std::int32_t> k, i, j;  ///< pair index, owner and partner
+    std::vector<std::int32_t> end;      ///< end of slot p's near pairs (owned slots)
     std::vector<double> x, y, z;     ///< [m] positions at the last full scan
     double margin = 0.0;             ///< [m] gap below which a pair is kept (0.05-0.5 Model::skin, adapted: forces.cpp)
     int age = 0;                     ///< contact passes over the near pairs since the last full scan
