@@ -17,7 +17,7 @@
 //
 // A contact passes three stages (measured with perf on B1; each change kept the results
 // bitwise the same, except the one-division pair geometry, which changed the last bits):
-//   1. the list scan (particle_contacts): distance of every pair read, from the x, y, z and
+//   1. the list scan (list_contacts): distance of every pair read, from the x, y, z and
 //      radius columns (a copy of the four side by side, one cache line per partner, was 5 %
 //      faster while the contact pass was slower; later its pass cost more than it saved: B1 and
 //      B2 +3 % without it). Every pair is written to the next batch entry and kept by advancing
@@ -201,77 +201,33 @@ void forget(ContactList& list, std::uint8_t& active, size_t k, int width) {
 /// that was active was cleared by that scan, so the three read the same batches.
 enum class Scan { kAll, kRefresh, kNear };
 
-/// The pairs of slot i with partners j in [lo, hi): owned partners in the parallel block pass,
-/// ghosts in a pass of their own (a ghost may touch spheres of several blocks). Only finds which
-/// pairs act; pair_geometry does the rest for a whole batch. Every pair read is written to the
-/// next free entry and kept by advancing the count: whether a skin pair touches is a coin toss
-/// to the branch predictor, so the loop does not branch on it.
+/// The entries [begin, end) of the pair list (kAll, kRefresh) or of the near pairs (kNear), with
+/// partners j in [lo, hi): owned partners in the parallel block pass, ghosts in a pass of their
+/// own (a ghost may touch spheres of several blocks). One loop whatever the owners: a loop per
+/// slot ends after one to three pairs, and the branch predictor misses most of those ends.
+/// Only finds which pairs act; pair_geometry does the rest for a whole batch. Every pair read is
+/// written to the next free entry and kept by advancing the count: whether a skin pair touches
+/// is a coin toss to the branch predictor, so the loop does not branch on it.
 /// kPeriodic: the model wraps an axis (minimum image); kGhosts: partners outside [lo, hi) are
 /// skipped (without ghosts every partner is an owned slot, and the test is left out).
-/// kRefresh: `next_near` is where the block's next near pair goes (NearPairs).
+/// kRefresh: the pairs kept as near pairs are written from `next_near` on, which is advanced.
 template <bool kPeriodic, bool kGhosts, Scan kScan>
-void particle_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i, std::int32_t lo, std::int32_t hi,
-                       std::int32_t& next_near) {
-  static_assert(kScan != Scan::kNear, "near pairs: near_contacts");
+void list_contacts(const Model& model, State& s, Workspace& work, Batch& batch, std::int32_t begin, std::int32_t end,
+                   std::int32_t lo, std::int32_t hi, std::int32_t& next_near) {
+  constexpr bool kFromNear = kScan == Scan::kNear;
   const int width = model.history_width;
   const double range = model.interaction_range;
   const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
-  const double xi = px[i], yi = py[i], zi = pz[i], ri = pr[i];
   Workspace::NearPairs& near = work.near;
-  const std::int32_t* partner = s.pairs.j.data();
-  const std::int32_t first_k = work.pair_begin[i], end_k = work.pair_begin[i + 1];
+  const std::int32_t *owner = kFromNear ? near.i.data() : s.pairs.i.data(), *partner = kFromNear ? near.j.data() : s.pairs.j.data();
   std::uint8_t* active = work.pair_forces.active.data();
   // kRefresh: a pair is kept when its gap is under the margin, or either sphere is not free.
   [[maybe_unused]] const std::int32_t *body = s.body.data(), *attached = s.attached.data();
-  [[maybe_unused]] const bool i_free = (body[i] < 0) & (attached[i] < 0);
   std::int32_t kept = next_near;
   int c = batch.b.count;
-  for (std::int32_t e = first_k; e < end_k; ++e) {
-    const std::int32_t j = partner[e];
-    const std::int32_t k = e;
-    if constexpr (kGhosts)
-      if (j < lo || j >= hi) continue;
-    double d[3] = {xi - px[j], yi - py[j], zi - pz[j]};
-    if constexpr (kPeriodic) minimum_image(model, d);
-    const double dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    const double reach = ri + pr[j] + range;
-    const bool acts = dist2 < reach * reach;
-    batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
-    batch.contact[c] = k;
-    batch.owner[c] = static_cast<std::int32_t>(i), batch.other[c] = j;
-    batch.pair[c] = true;
-    if constexpr (kScan == Scan::kRefresh) {
-      const double keep_reach = reach + near.margin;
-      const bool keep = (dist2 < keep_reach * keep_reach) | !i_free | (body[j] >= 0) | (attached[j] >= 0);
-      near.k[kept] = k, near.i[kept] = static_cast<std::int32_t>(i), near.j[kept] = j;
-      kept += keep;
-    }
-    if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
-    c += acts;
-    if (c == kBatch) {
-      batch.b.count = c;
-      flush(model, batch, s, work);
-      c = 0;
-    }
-  }
-  if constexpr (kScan == Scan::kRefresh) near.end[i] = next_near = kept, near.x[i] = xi, near.y[i] = yi, near.z[i] = zi;
-  batch.b.count = c;
-}
-
-/// The near pairs [begin, end) of a block's run (NearPairs), as particle_contacts reads a row:
-/// the same tests, batch entries and order, in one loop whatever the owners.
-template <bool kPeriodic, bool kGhosts>
-void near_contacts(const Model& model, State& s, Workspace& work, Batch& batch, std::int32_t begin, std::int32_t end,
-                   std::int32_t lo, std::int32_t hi) {
-  const int width = model.history_width;
-  const double range = model.interaction_range;
-  const double *px = s.x.data(), *py = s.y.data(), *pz = s.z.data(), *pr = s.radius.data();
-  const Workspace::NearPairs& near = work.near;
-  const std::int32_t *owner = near.i.data(), *partner = near.j.data(), *pair = near.k.data();
-  std::uint8_t* active = work.pair_forces.active.data();
-  int c = batch.b.count;
   for (std::int32_t e = begin; e < end; ++e) {
-    const std::int32_t i = owner[e], j = partner[e], k = pair[e];
+    const std::int32_t i = owner[e], j = partner[e];
+    const std::int32_t k = kFromNear ? near.k[e] : e;
     if constexpr (kGhosts)
       if (j < lo || j >= hi) continue;
     double d[3] = {px[i] - px[j], py[i] - py[j], pz[i] - pz[j]};
@@ -283,6 +239,12 @@ void near_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     batch.contact[c] = k;
     batch.owner[c] = i, batch.other[c] = j;
     batch.pair[c] = true;
+    if constexpr (kScan == Scan::kRefresh) {
+      const double keep_reach = reach + near.margin;
+      const bool keep = (dist2 < keep_reach * keep_reach) | (body[i] >= 0) | (attached[i] >= 0) | (body[j] >= 0) | (attached[j] >= 0);
+      near.k[kept] = k, near.i[kept] = i, near.j[kept] = j;
+      kept += keep;
+    }
     if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
     c += acts;
     if (c == kBatch) {
@@ -291,6 +253,7 @@ void near_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
       c = 0;
     }
   }
+  next_near = kept;
   batch.b.count = c;
 }
 
@@ -383,22 +346,22 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
   const auto evaluate = [&](long b) {
     const auto start = std::chrono::steady_clock::now();
     const long first = b * block, last = std::min(n, (b + 1) * block);
-    std::int32_t kept = work.pair_begin[first];  // the block's run of near pairs
-    if constexpr (kScan == Scan::kNear) {
-      // The run up to each slot with plane walls, then its walls (a slot's walls follow its pairs).
-      const std::vector<std::int32_t>& rows = work.wall_rows;
-      for (auto r = std::lower_bound(rows.begin(), rows.end(), first); r != rows.end() && *r < last; ++r) {
-        near_contacts<kPeriodic, kGhosts>(model, s, work, batch, kept, work.near.end[*r], 0, owned);
-        kept = work.near.end[*r];
-        wall_contacts(model, s, work, batch, *r);
-      }
-      near_contacts<kPeriodic, kGhosts>(model, s, work, batch, kept, work.near.end[last - 1], 0, owned);
-    } else {
-      for (long i = first; i < last; ++i) {
-        particle_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, i, 0, owned, kept);
-        if (work.wall_begin[i] != work.wall_begin[i + 1]) wall_contacts(model, s, work, batch, i);
-      }
-    }
+    // The list up to each slot with plane walls, then its walls (a slot's walls follow its
+    // pairs), then the rest of the block's list.
+    Workspace::NearPairs& near = work.near;
+    std::int32_t from = work.pair_begin[first], kept = from;  // kept: the block's run of near pairs
+    const auto up_to = [&](long i) {
+      const std::int32_t to = kScan == Scan::kNear ? near.end[i] : work.pair_begin[i + 1];
+      list_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, from, to, 0, owned, kept);
+      if constexpr (kScan == Scan::kRefresh) near.end[i] = kept;
+      from = to;
+    };
+    const std::vector<std::int32_t>& rows = work.wall_rows;
+    for (auto r = std::lower_bound(rows.begin(), rows.end(), first); r != rows.end() && *r < last; ++r)
+      up_to(*r), wall_contacts(model, s, work, batch, *r);
+    up_to(last - 1);
+    if constexpr (kScan == Scan::kRefresh)
+      for (long i = first; i < last; ++i) near.x[i] = s.x[i], near.y[i] = s.y[i], near.z[i] = s.z[i];
     flush(model, batch, s, work);
     std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
     add_block_time(work, b, start);
@@ -524,7 +487,8 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
       Batch batch;
       std::int32_t unused = 0;
       for (const std::int32_t i : work.ghost_owners)
-        (periodic ? particle_contacts<true, true, Scan::kAll> : particle_contacts<false, true, Scan::kAll>)(model, s, work, batch, i, owned, static_cast<std::int32_t>(n_all), unused);
+        (periodic ? list_contacts<true, true, Scan::kAll> : list_contacts<false, true, Scan::kAll>)(
+            model, s, work, batch, work.pair_begin[i], work.pair_begin[i + 1], owned, static_cast<std::int32_t>(n_all), unused);
       flush(model, batch, s, work);
     }
     mesh_contact_forces(model, s, work);

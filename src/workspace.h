@@ -75,14 +75,15 @@ struct Workspace {
   /// gap was under `margin` when the list was last scanned in full (plus every pair with a
   /// sphere of a body or a glued one, whose motion the drift does not check). Stored block by
   /// block (Workspace::block), one run per block from the pair list's start of the block's first
-  /// slot, in list order: slot p's near pairs are k[end[p - 1] .. end[p]) (from pair_begin[p] for
-  /// the block's first slot), with their owners i and partners j. A contact pass reads a block's
-  /// run in one loop, with no loop per slot (whose end, after one to three pairs, the branch
-  /// predictor misses), and forms the same batches in the same order as one over the whole list,
-  /// for a fraction of the distance tests (forces.cpp).
+  /// slot, in list order, with their owners i and partners j. A contact pass reads a block's run
+  /// in one loop (no loop per slot, whose end, after one to three pairs, the branch predictor
+  /// misses), and forms the same batches in the same order as one over the whole list, for a
+  /// fraction of the distance tests (forces.cpp).
   struct NearPairs {
     std::vector<std::int32_t> k, i, j;  ///< pair index, owner and partner
-    std::vector<std::int32_t> end;      ///< end of slot p's near pairs (owned slots)
+    /// End of the near pairs up to slot p, for the slots with plane walls (whose wall contacts
+    /// follow their pairs) and the last slot of each block; not set for the others.
+    std::vector<std::int32_t> end;
     std::vector<double> x, y, z;     ///< [m] positions at the last full scan
     double margin = 0.0;             ///< [m] gap below which a pair is kept (0.05-0.5 Model::skin, adapted: forces.cpp)
     int age = 0;                     ///< contact passes over the near pairs since the last full scan
