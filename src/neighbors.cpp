@@ -152,8 +152,9 @@ struct PairFinder {
     const int lo0 = std::max(at[o0] - 1, 0), hi0 = std::min(at[o0] + 1, grid.dims[o0] - 1);
     const double *x = s.x.data(), *y = s.y.data(), *z = s.z.data(), *radius = s.radius.data();
     const double xi = x[i], yi = y[i], zi = z[i], ri = radius[i] + reach;
-    for (int v2 = std::max(at[o2] - 1, 0); v2 <= std::min(at[o2] + 1, grid.dims[o2] - 1); ++v2)
-      for (int v1 = std::max(at[o1] - 1, 0); v1 <= std::min(at[o1] + 1, grid.dims[o1] - 1); ++v1) {
+    // Only the rows of cells from i's own on: those before it hold slots below i only.
+    for (int v2 = at[o2]; v2 <= std::min(at[o2] + 1, grid.dims[o2] - 1); ++v2)
+      for (int v1 = v2 == at[o2] ? at[o1] : std::max(at[o1] - 1, 0); v1 <= std::min(at[o1] + 1, grid.dims[o1] - 1); ++v1) {
         const int base = (v2 * grid.dims[o1] + v1) * grid.dims[o0];
         const std::int32_t first = std::max(cell_start[base + lo0], i + 1), last = cell_start[base + hi0 + 1];
         if (first >= last) continue;
