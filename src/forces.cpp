@@ -361,7 +361,9 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
       up_to(*r), wall_contacts(model, s, work, batch, *r);
     up_to(last - 1);
     if constexpr (kScan == Scan::kRefresh)
-      for (long i = first; i < last; ++i) near.x[i] = s.x[i], near.y[i] = s.y[i], near.z[i] = s.z[i];
+      for (long i = first; i < last; ++i)
+        near.x[i] = static_cast<float>(s.x[i] - s.x_built[i]), near.y[i] = static_cast<float>(s.y[i] - s.y_built[i]),
+        near.z[i] = static_cast<float>(s.z[i] - s.z_built[i]);
     flush(model, batch, s, work);
     std::atomic_ref<std::uint32_t>(work.block_done[b]).store(work.pass_epoch, std::memory_order_release);
     add_block_time(work, b, start);

@@ -16,7 +16,7 @@ template <bool kCheck, bool kNear>
     flags |= (free & (dx * dx + dy * dy + dz * dz > l.skin2)) * kRebuild;
   }
   if constexpr (kNear) {
-    const double ex = x - l.x_near[p], ey = y - l.y_near[p], ez = z - l.z_near[p];
+    const double ex = (x - l.x_built[p]) - l.x_near[p], ey = (y - l.y_built[p]) - l.y_near[p], ez = (z - l.z_built[p]) - l.z_near[p];
     flags |= (free & (ex * ex + ey * ey + ez * ez > l.near2)) * kRescan;
   }
   return flags;
@@ -105,7 +105,11 @@ DriftLimits drift_limits(const Model& model, const State& s, const Workspace& wo
   limits.skin2 = 0.25 * model.skin * model.skin;
   if (!near_valid || work.near.x.size() != n) return limits;
   limits.x_near = work.near.x.data(), limits.y_near = work.near.y.data(), limits.z_near = work.near.z.data();
-  limits.near2 = 0.25 * work.near.margin * work.near.margin;
+  // The scan positions are kept as single-precision offsets from the build positions, at most
+  // skin/2 long for a free sphere (else the list is rebuilt): their rounding, under 1e-7 of the
+  // skin, is taken off the margin, so that the test stays on the safe side.
+  const double half_margin = 0.5 * work.near.margin - 1e-6 * model.skin;
+  limits.near2 = half_margin * half_margin;
   return limits;
 }
 

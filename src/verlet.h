@@ -19,7 +19,7 @@ enum Moved : int { kRebuild = 1, kRescan = 2 };
 /// missing (null) is always set.
 struct DriftLimits {
   const double *x_built = nullptr, *y_built = nullptr, *z_built = nullptr;  ///< [m] at the last build (State)
-  const double *x_near = nullptr, *y_near = nullptr, *z_near = nullptr;     ///< [m] at the last full scan (Workspace::near)
+  const float *x_near = nullptr, *y_near = nullptr, *z_near = nullptr;      ///< [m] at the last full scan, from x_built (Workspace::near)
   double skin2 = 0.0;  ///< [m^2] (skin/2)^2
   double near2 = 0.0;  ///< [m^2] (near margin/2)^2
 };
