@@ -226,7 +226,10 @@ void MeshContactPass::run(long begin, long end) {
   MeshBatch& mb = scratch_->mb;
   std::vector<Candidate>& list = scratch_->list;
   std::vector<double>& old_history = scratch_->old_history;
-  for (long p = begin; p < end; ++p) {
+  // Only the slots that had candidates or contacts when the lists were indexed (Workspace::mesh_rows).
+  const std::vector<std::int32_t>& rows = work.mesh_rows;
+  for (auto row = std::lower_bound(rows.begin(), rows.end(), begin); row != rows.end() && *row < end; ++row) {
+    const long p = *row;
     const std::int32_t first = s.candidate_begin[p], last = s.candidate_begin[p + 1];
     if (first == last && mc.count[p] == 0) continue;
     // The contacts of the last step, to carry their history.
@@ -369,7 +372,9 @@ void sum_mesh_records(const Model& model, State& s, Workspace& work, long begin,
   auto& loads = s.mesh_loads;
   const double dt = model.dt;
   const ContactForces& f = work.mesh_forces;
-  for (size_t p = static_cast<size_t>(begin); p < static_cast<size_t>(end); ++p) {
+  const std::vector<std::int32_t>& rows = work.mesh_rows;  // the others have no contacts
+  for (auto row = std::lower_bound(rows.begin(), rows.end(), begin); row != rows.end() && *row < end; ++row) {
+    const size_t p = static_cast<size_t>(*row);
     for (int k = 0; k < mc.count[p]; ++k) {
       const size_t slot = p * kSlots + k, at = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);
       if (!f.active[at]) continue;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <stdexcept>
 
 namespace dem {
 
@@ -290,6 +291,14 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   work.wall_rows.clear();
   for (size_t p = 0; p < s.owned(); ++p)
     if (work.wall_begin[p] != work.wall_begin[p + 1]) work.wall_rows.push_back(static_cast<std::int32_t>(p));
+  work.mesh_rows.clear();
+  if (!model.meshes.empty()) {
+    if (s.candidate_begin.size() != s.owned() + 1 || s.mesh_contacts.count.size() < s.owned())
+      throw std::logic_error("index_contacts: the mesh candidates or contacts do not match the particles");
+    for (size_t p = 0; p < s.owned(); ++p)
+      if (s.candidate_begin[p] != s.candidate_begin[p + 1] || s.mesh_contacts.count[p] > 0)
+        work.mesh_rows.push_back(static_cast<std::int32_t>(p));
+  }
   // Block size of the force evaluation: every pair's partner lies in its own block or the next
   // (pairs with ghosts are evaluated apart, forces.cpp).
   std::int32_t span = 0;

@@ -57,6 +57,9 @@ struct Workspace {
   // [pair_begin[p], pair_begin[p+1]); wall contacts likewise.
   std::vector<std::int32_t> pair_begin, wall_begin;
   std::vector<std::int32_t> wall_rows;  ///< owned slots with plane-wall pairs, ascending
+  /// Owned slots with mesh candidates or mesh contacts when the lists were indexed, ascending:
+  /// the others cannot touch a mesh before the next build (mesh_contacts.cpp).
+  std::vector<std::int32_t> mesh_rows;
   /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
   /// (forces.cpp).
   std::int32_t block = 64;
