@@ -94,7 +94,7 @@ std::size_t State::add_sphere(double px, double py, double pz, double r, double 
   id.push_back(next_id++);
   body.push_back(-1);
   attached.push_back(-1);
-  offset_x.push_back(0.0), offset_y.push_back(0.0), offset_z.push_back(0.0);
+  if (has_offsets()) offset_x.push_back(0.0), offset_y.push_back(0.0), offset_z.push_back(0.0);
   MeshContacts& mc = mesh_contacts;
   if (!has_meshes) return x.size() - 1;
   mc.count.push_back(0);
@@ -119,6 +119,8 @@ std::size_t State::add_body(double px, double py, double pz, const double q[4], 
 
 void State::attach(std::size_t sphere, std::size_t b, double ox, double oy, double oz) {
   body[sphere] = static_cast<std::int32_t>(b);
+  if (!has_offsets())
+    for (auto* c : {&offset_x, &offset_y, &offset_z}) c->assign(size(), 0.0);
   offset_x[sphere] = ox, offset_y[sphere] = oy, offset_z[sphere] = oz;
   // Contacts see the body's mass, and a moment of inertia 2/5 m_body r^2 about the sphere's
   // centre (the reduced inertia of rolling resistance, forces.cpp, 7/5 m r^2 about the contact
@@ -132,9 +134,9 @@ std::size_t State::record_size() const {
 }
 
 void State::pack(std::size_t p, std::vector<double>& out) const {
-  for (const auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
-                        &offset_x, &offset_y, &offset_z})
+  for (const auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
     out.push_back((*c)[p]);
+  for (const auto* c : {&offset_x, &offset_y, &offset_z}) out.push_back(has_offsets() ? (*c)[p] : 0.0);
   out.push_back(material[p]), out.push_back(static_cast<double>(id[p])), out.push_back(body[p]), out.push_back(attached[p]);
   if (!has_meshes) return;
   const MeshContacts& mc = mesh_contacts;
@@ -147,13 +149,18 @@ void State::pack(std::size_t p, std::vector<double>& out) const {
 }
 
 void State::unpack(const double* in) {
-  for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
-                  &offset_x, &offset_y, &offset_z})
+  for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
     c->push_back(*in++);
+  const double* offset = in;
+  in += 3;
   material.push_back(static_cast<std::int32_t>(*in++));
   id.push_back(static_cast<std::int64_t>(*in++));
   body.push_back(static_cast<std::int32_t>(*in++));
   attached.push_back(static_cast<std::int32_t>(*in++));
+  if (has_offsets() || body.back() >= 0) {
+    for (auto* c : {&offset_x, &offset_y, &offset_z}) c->resize(size() - 1, 0.0);  // the first sphere of a body: zeros before it
+    offset_x.push_back(offset[0]), offset_y.push_back(offset[1]), offset_z.push_back(offset[2]);
+  }
   if (!has_meshes) return;
   MeshContacts& mc = mesh_contacts;
   mc.count.push_back(static_cast<std::uint8_t>(*in++));
@@ -189,9 +196,9 @@ void State::permute(const std::vector<std::int32_t>& order, PermuteScratch& scra
   const std::array<std::vector<double>*, kGroup> f64{&scratch.f64, &x_built, &y_built, &z_built};
 #pragma omp parallel if (static_cast<long>(order.size()) >= kParallelMin)
   {
-    apply_order({&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia,
-                 &offset_x, &offset_y, &offset_z},
+    apply_order({&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia},
                 order, f64);
+    if (has_offsets()) apply_order({&offset_x, &offset_y, &offset_z}, order, f64);
     apply_order({&material, &body, &attached}, order, std::array<std::vector<std::int32_t>*, 1>{&scratch.i32});
     apply_order(id, order, scratch.i64);
     if (has_meshes) {
@@ -206,7 +213,8 @@ void State::permute(const std::vector<std::int32_t>& order, PermuteScratch& scra
 void State::compact(const std::vector<std::uint8_t>& keep) {
   for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &radius, &inv_mass, &inv_inertia})
     keep_only(*c, keep);
-  for (auto* c : {&offset_x, &offset_y, &offset_z}) keep_only(*c, keep);
+  if (has_offsets())
+    for (auto* c : {&offset_x, &offset_y, &offset_z}) keep_only(*c, keep);
   keep_only(material, keep);
   keep_only(id, keep);
   keep_only(body, keep);

@@ -236,19 +236,21 @@ TEST(Neighbors, ARebuildThatDropsSpheresKeepsEveryColumnWithItsSphere) {
   for (size_t p = 0; p < s.size(); p += 97) s.x[p] = 1e3;  // far outside the domain
   std::map<std::int64_t, std::array<double, 6>> by_id;
   for (size_t p = 0; p < s.size(); ++p)
-    if (s.x[p] < 1e3) by_id[s.id[p]] = {s.y[p], s.vz[p], s.wx[p], s.radius[p], s.offset_z[p], static_cast<double>(s.material[p])};
+    if (s.x[p] < 1e3) by_id[s.id[p]] = {s.y[p], s.vz[p], s.wx[p], s.radius[p], s.inv_mass[p], static_cast<double>(s.material[p])};
   const std::int64_t lost_before = s.lost;
   rebuild_contacts(sim.model, s, sim.work);
   EXPECT_EQ(s.lost - lost_before, 31);
   ASSERT_EQ(s.size(), by_id.size());
   for (const auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
-                        &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z})
+                        &s.radius, &s.inv_mass, &s.inv_inertia})
     EXPECT_EQ(c->size(), s.size());
+  // Free spheres only: no clump offsets held (24 bytes a particle).
+  for (const auto* c : {&s.offset_x, &s.offset_y, &s.offset_z}) EXPECT_TRUE(c->empty());
   for (const auto* c : {&s.material, &s.body, &s.attached}) EXPECT_EQ(c->size(), s.size());
   EXPECT_EQ(s.id.size(), s.size());
   size_t wrong = 0;
   for (size_t p = 0; p < s.size(); ++p)
-    wrong += by_id.at(s.id[p]) != std::array<double, 6>{s.y[p], s.vz[p], s.wx[p], s.radius[p], s.offset_z[p], static_cast<double>(s.material[p])};
+    wrong += by_id.at(s.id[p]) != std::array<double, 6>{s.y[p], s.vz[p], s.wx[p], s.radius[p], s.inv_mass[p], static_cast<double>(s.material[p])};
   EXPECT_EQ(wrong, 0u) << "slots whose values are not their sphere's";
 }
 
