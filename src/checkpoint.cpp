@@ -13,11 +13,14 @@ namespace dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
+/// Version 5 lacks State::lists_drift_velocity: read as zero, which is always a valid drift
+/// (verlet.h), so its runs resume.
+constexpr char kMagic5[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
 
-/// Every field of the State, in one order, for both directions.
+/// Every field of the State, in one order, for both directions (`version` 5 or 6).
 template <typename Io, typename S>
-void visit(Io& io, S& s) {
+void visit(Io& io, S& s, int version = 6) {
   io(s.time), io(s.step), io(s.next_id), io(s.lost), io(s.lost_mass);
   for (auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
                   &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
@@ -37,6 +40,7 @@ void visit(Io& io, S& s) {
   auto& mc = s.mesh_contacts;
   io(mc.count), io(mc.mesh), io(mc.triangle), io(mc.px), io(mc.py), io(mc.pz), io(mc.history);
   io(s.candidate_begin), io(s.mesh_candidates), io(s.lists_built_time);
+  if (version >= 6) io(s.lists_drift_velocity);
   std::uint64_t meshes = s.records.size();
   io(meshes);
   if constexpr (!std::is_const_v<S>) s.records.resize(meshes);
@@ -108,8 +112,8 @@ State load_checkpoint(const std::string& path, const Model& model) {
   Reader reader{in, path, static_cast<std::uint64_t>(std::filesystem::file_size(path))};
   char magic[sizeof kMagic];
   reader.read(magic, sizeof magic);
-  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0)
-    throw std::runtime_error(fmt::format("{}: not a demdesign checkpoint of this version", path));
+  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0 ? 6 : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5 : 0;
+  if (version == 0) throw std::runtime_error(fmt::format("{}: not a demdesign checkpoint of this version", path));
   std::uint64_t hash = 0;
   reader(hash);
   if (hash != model.hash)
@@ -117,7 +121,7 @@ State load_checkpoint(const std::string& path, const Model& model) {
                                          "since it was written); run without --resume to start again",
                                          path));
   State state;
-  visit(reader, state);
+  visit(reader, state, version);
   return state;
 }
 

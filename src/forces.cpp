@@ -459,7 +459,8 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
   const bool finish_in_pass = !ghosts && !work.domain;
   // The next step's drift tests positions against the lists as they are after this pass.
   const bool ahead = pass.drift_ahead && kick != 0.0 && finish_in_pass;
-  const DriftLimits limits = ahead ? drift_limits(model, s, work, /*near_valid=*/true) : DriftLimits{};
+  // The drift ahead brings the spheres to the next step's time.
+  const DriftLimits limits = ahead ? drift_limits(model, s, work, /*near_valid=*/true, s.time + 2.0 * model.dt) : DriftLimits{};
   if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
   work.records_turn = 0;

@@ -5,6 +5,7 @@
 #include "mesh_contacts.h"
 
 #include "parallel.h"
+#include "verlet.h"
 
 #include <algorithm>
 #include <cmath>
@@ -79,6 +80,21 @@ bool find_lost(const Model& model, State& state, std::vector<std::uint8_t>& keep
   for (size_t p = 0; p < n; ++p)
     if (state.body[p] >= 0 && body_outlet[state.body[p]] != -2) keep[p] = 0;
   return true;
+}
+
+/// The velocity the lists follow until the next rebuild: the middle of the range of the free
+/// spheres' velocities along each axis, so that the drift carries the build positions as near to
+/// every sphere as one velocity can (the fastest and the slowest equally far off).
+std::array<double, 3> common_velocity(const State& s) {
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  bool any = false;
+  for (size_t p = 0; p < s.owned(); ++p) {
+    if (s.body[p] >= 0) continue;
+    const double v[3] = {s.vx[p], s.vy[p], s.vz[p]};
+    for (int a = 0; a < 3; ++a) lo[a] = any ? std::min(lo[a], v[a]) : v[a], hi[a] = any ? std::max(hi[a], v[a]) : v[a];
+    any = true;
+  }
+  return {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
 }
 
 /// Moves free spheres and body centres that crossed a periodic boundary back into the period
@@ -348,9 +364,18 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   work.valid = true;
 }
 
-bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bool free_spheres_checked) {
+bool lists_follow_drift(const Model& model, const Workspace& work) {
+  if (work.domain || model.has_attached) return false;
+  for (const PlaneWall& wall : model.planes)
+    if (wall.servo || wall.velocity[0] != 0.0 || wall.velocity[1] != 0.0 || wall.velocity[2] != 0.0) return false;
+  for (const MeshWall& mesh : model.meshes)
+    if (!mesh.motion.is_static()) return false;
+  return true;
+}
+
+bool needs_rebuild(const Model& model, const State& s, const Workspace& work, double time, bool free_spheres_checked) {
   if (!work.valid || s.x_built.size() != s.size()) return true;
-  const double limit2 = 0.25 * model.skin * model.skin;
+  const DriftLimits limits = drift_limits(model, s, work, /*near_valid=*/false, time);
   const long n = static_cast<long>(s.owned());
   const bool all = !free_spheres_checked;
   const bool others = s.bodies.size() > 0 || model.has_attached;
@@ -359,8 +384,7 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, bo
 #pragma omp parallel for reduction(| : moved) schedule(static) if (n >= kParallelMin)
     for (long p = 0; p < n; ++p) {
       if (!all && s.body[p] < 0 && s.attached[p] < 0) continue;
-      const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
-      moved |= (dx * dx + dy * dy + dz * dz > limit2);
+      moved |= outside_skin(limits, p, s.x[p], s.y[p], s.z[p]);
     }
   }
   if (moved) return true;
@@ -520,6 +544,7 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   old_pairs = {}, old_walls = {};
 
   find_mesh_candidates(model, s, work, reach);
+  s.lists_drift_velocity = lists_follow_drift(model, work) ? common_velocity(s) : std::array<double, 3>{0.0, 0.0, 0.0};
   for (auto* c : {&s.x_built, &s.y_built, &s.z_built}) resize_discarding(*c, n);
   const long all = static_cast<long>(n);
 #pragma omp parallel for schedule(static) if (all >= kParallelMin)

@@ -1,5 +1,7 @@
 // Linked cells with a Verlet skin. The contact lists are rebuilt only when some particle has
-// moved more than half the skin since the last rebuild; at each rebuild particles leaving the
+// used up its share of the skin since the last rebuild (half of it, measured from where the
+// spheres' common drift has carried its build position where walls are static: DriftLimits,
+// verlet.h); at each rebuild particles leaving the
 // domain are removed, the particle slots are sorted by cell (neighbours near in memory), and
 // every contact's history is carried to its new slot by particle id.
 #pragma once
@@ -10,10 +12,16 @@
 
 namespace dem {
 
-/// True when the lists no longer cover every contact that could form. With
-/// free_spheres_checked the caller has already tested the free spheres (step's fused kick and
-/// drift) and only spheres of bodies, glued spheres and meshes are tested here.
-bool needs_rebuild(const Model& model, const State& state, const Workspace& work, bool free_spheres_checked = false);
+/// True when the lists no longer cover every contact that could form, the spheres being where
+/// they are at `time` [s]. With free_spheres_checked the caller has already tested the free
+/// spheres (step's fused kick and drift) and only spheres of bodies, glued spheres and meshes
+/// are tested here.
+bool needs_rebuild(const Model& model, const State& state, const Workspace& work, double time, bool free_spheres_checked = false);
+
+/// Whether the lists follow the spheres' common drift (DriftLimits, verlet.h): no plane or mesh
+/// moves (a static wall only needs each sphere within a skin of where it was listed), no sphere
+/// is glued to a wall, no ranks (each would drift its own way).
+bool lists_follow_drift(const Model& model, const Workspace& work);
 /// Rebuilds the contact lists (see above).
 void rebuild_contacts(const Model& model, State& state, Workspace& work);
 /// Rebuilds the workspace's indexing of the state's contact lists without changing them (after

@@ -140,10 +140,13 @@ struct State {
   std::vector<std::int32_t> candidate_begin;
   std::vector<std::array<std::int32_t, 2>> mesh_candidates;
   double lists_built_time = 0;  ///< [s] time of the last rebuild (meshes move)
+  /// [m/s] The velocity of the spheres' common drift since the last rebuild, where the lists
+  /// follow it (neighbors.h, lists_follow_drift), else zero.
+  std::array<double, 3> lists_drift_velocity = {0.0, 0.0, 0.0};
   std::vector<TriangleRecords> records;  ///< per mesh
   MeshLoads mesh_loads;
   /// Positions at the last rebuild of the contact lists: the lists stay valid until a sphere
-  /// has moved half the skin from here. Part of the state so a restart rebuilds when the
+  /// has used up its share of the skin from here (DriftLimits, verlet.h). Part of the state so a restart rebuilds when the
   /// uninterrupted run would.
   std::vector<double> x_built, y_built, z_built;
 

@@ -25,7 +25,7 @@ namespace {
 /// while the positions are in cache).
 int kick_drift(State& s, Workspace& work, const Model& model, double h, double dt) {
   const long n = static_cast<long>(s.owned());  // ghosts are moved by their owners
-  const DriftLimits limits = drift_limits(model, s, work, work.near.valid);
+  const DriftLimits limits = drift_limits(model, s, work, work.near.valid, s.time + dt);
   int moved = untested(limits);
 #pragma omp parallel reduction(| : moved) if (n >= kParallelMin)
   for_own_blocks(work, n, [&](long begin, long end) { moved |= kick_drift_range(s, limits, begin, end, h, dt); });
@@ -118,7 +118,7 @@ void one_step(const Model& model, State& state, Workspace& work, bool next_follo
   if (work.domain) {
     run_inlets_decomposed(model, state, work);
     // Every rank rebuilds when any must: the ghosts and the pairs across faces change together.
-    rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true));
+    rebuilt = work.domain->any(free_moved || needs_rebuild(model, state, work, state.time + dt, /*free_spheres_checked=*/true));
     if (rebuilt)
       rebuild_contacts(model, state, work);
     else
@@ -126,7 +126,7 @@ void one_step(const Model& model, State& state, Workspace& work, bool next_follo
   } else {
     for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k)
       if (run_inlet(model, state, k) > 0) work.valid = false;
-    rebuilt = free_moved || needs_rebuild(model, state, work, /*free_spheres_checked=*/true);
+    rebuilt = free_moved || needs_rebuild(model, state, work, state.time + dt, /*free_spheres_checked=*/true);
     if (rebuilt) rebuild_contacts(model, state, work);
   }
   work.loads_cleared = !rebuilt;

@@ -1,6 +1,9 @@
 #include "verlet.h"
 
+#include "neighbors.h"
 #include "parallel.h"
+
+#include <limits>
 
 namespace dem {
 
@@ -11,10 +14,7 @@ namespace {
 template <bool kCheck, bool kNear>
 [[gnu::always_inline]] inline int moved(const DriftLimits& l, long p, bool free, double x, double y, double z) {
   int flags = 0;
-  if constexpr (kCheck) {
-    const double dx = x - l.x_built[p], dy = y - l.y_built[p], dz = z - l.z_built[p];
-    flags |= (free & (dx * dx + dy * dy + dz * dz > l.skin2)) * kRebuild;
-  }
+  if constexpr (kCheck) flags |= (free & outside_skin(l, p, x, y, z)) * kRebuild;
   if constexpr (kNear) {
     const double ex = (x - l.x_built[p]) - l.x_near[p], ey = (y - l.y_built[p]) - l.y_near[p], ez = (z - l.z_built[p]) - l.z_near[p];
     flags |= (free & (ex * ex + ey * ey + ez * ez > l.near2)) * kRescan;
@@ -97,16 +97,25 @@ template <bool kAhead, bool kCheck, bool kNear>
 
 int untested(const DriftLimits& limits) { return (limits.x_built ? 0 : kRebuild) | (limits.x_near ? 0 : kRescan); }
 
-DriftLimits drift_limits(const Model& model, const State& s, const Workspace& work, bool near_valid) {
+DriftLimits drift_limits(const Model& model, const State& s, const Workspace& work, bool near_valid, double time) {
   DriftLimits limits;
   const size_t n = s.owned();
   if (s.x_built.size() != s.size()) return limits;
   limits.x_built = s.x_built.data(), limits.y_built = s.y_built.data(), limits.z_built = s.z_built.data();
   limits.skin2 = 0.25 * model.skin * model.skin;
+  limits.wall2 = limits.skin2;
+  if (lists_follow_drift(model, work)) {
+    const double since = time - s.lists_built_time;  // [s]
+    limits.cx = s.lists_drift_velocity[0] * since, limits.cy = s.lists_drift_velocity[1] * since, limits.cz = s.lists_drift_velocity[2] * since;
+    // Spheres that leave the domain or enter an outlet are found at a rebuild: as promptly as
+    // before, a skin of travel, as if these were walls.
+    const bool bounds = !model.planes.empty() || !model.meshes.empty() || model.has_domain || !model.outlets.empty();
+    limits.wall2 = bounds ? model.skin * model.skin : std::numeric_limits<double>::infinity();
+  }
   if (!near_valid || work.near.x.size() != n) return limits;
   limits.x_near = work.near.x.data(), limits.y_near = work.near.y.data(), limits.z_near = work.near.z.data();
   // The scan positions are kept as single-precision offsets from the build positions, at most
-  // skin/2 long for a free sphere (else the list is rebuilt): their rounding, under 1e-7 of the
+  // a skin long for a free sphere (else the list is rebuilt): their rounding, under 1e-7 of the
   // skin, is taken off the margin, so that the test stays on the safe side.
   const double half_margin = 0.5 * work.near.margin - 1e-6 * model.skin;
   limits.near2 = half_margin * half_margin;
