@@ -3,8 +3,6 @@
 #include "neighbors.h"
 #include "parallel.h"
 
-#include <limits>
-
 namespace dem {
 
 namespace {
@@ -108,15 +106,16 @@ DriftLimits drift_limits(const Model& model, const State& s, const Workspace& wo
     const double since = time - s.lists_built_time;  // [s]
     limits.cx = s.lists_drift_velocity[0] * since, limits.cy = s.lists_drift_velocity[1] * since, limits.cz = s.lists_drift_velocity[2] * since;
     // Spheres that leave the domain or enter an outlet are found at a rebuild: as promptly as
-    // before, a skin of travel, as if these were walls.
+    // before, a skin of travel, as if these were walls. Without any, 8 skins, so that the scan
+    // offsets below stay short enough for single precision.
     const bool bounds = !model.planes.empty() || !model.meshes.empty() || model.has_domain || !model.outlets.empty();
-    limits.wall2 = bounds ? model.skin * model.skin : std::numeric_limits<double>::infinity();
+    limits.wall2 = (bounds ? 1.0 : 64.0) * model.skin * model.skin;
   }
   if (!near_valid || work.near.x.size() != n) return limits;
   limits.x_near = work.near.x.data(), limits.y_near = work.near.y.data(), limits.z_near = work.near.z.data();
   // The scan positions are kept as single-precision offsets from the build positions, at most
-  // a skin long for a free sphere (else the list is rebuilt): their rounding, under 1e-7 of the
-  // skin, is taken off the margin, so that the test stays on the safe side.
+  // 8 skins long for a free sphere (else the list is rebuilt): their rounding, under 5e-7 of
+  // the skin, is taken off the margin, so that the test stays on the safe side.
   const double half_margin = 0.5 * work.near.margin - 1e-6 * model.skin;
   limits.near2 = half_margin * half_margin;
   return limits;

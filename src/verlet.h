@@ -32,7 +32,7 @@ struct DriftLimits {
   const float *x_near = nullptr, *y_near = nullptr, *z_near = nullptr;      ///< [m] at the last full scan, from x_built (Workspace::near)
   double skin2 = 0.0;             ///< [m^2] (skin/2)^2: how far from the build position carried along by c
   double cx = 0, cy = 0, cz = 0;  ///< [m] c, the common drift since the build
-  double wall2 = 0.0;             ///< [m^2] how far from the build position itself: skin^2 with static walls, a domain or outlets (infinite without any), else (skin/2)^2
+  double wall2 = 0.0;             ///< [m^2] how far from the build position itself: skin^2 with static walls, a domain or outlets ((8 skin)^2 without any), else (skin/2)^2
   double near2 = 0.0;             ///< [m^2] (near margin/2)^2
 };
 

@@ -88,7 +88,7 @@ struct Workspace {
     /// follow their pairs) and the last slot of each block; not set for the others.
     std::vector<std::int32_t> end;
     /// [m] positions at the last full scan less the build positions (State::x_built): single
-    /// precision is plenty for an offset of at most a skin (verlet.cpp)
+    /// precision is plenty for an offset of at most 8 skins (verlet.cpp)
     std::vector<float> x, y, z;
     double margin = 0.0;             ///< [m] gap below which a pair is kept (0.05-0.5 Model::skin, adapted: forces.cpp)
     int age = 0;                     ///< contact passes over the near pairs since the last full scan

@@ -296,6 +296,52 @@ TEST(Neighbors, ListsThatFollowTheCommonDriftStayCompleteAndAreRebuiltAsAtRest) 
   EXPECT_LT(static_cast<double>(flown), 0.5 * travel / (0.5 * flying.model.skin)) << "far fewer than the flight's skin/2 steps";
 }
 
+TEST(Neighbors, ListsThatFollowTheDriftHoldEveryBridgeAndWallOfASettlingBed) {
+  // The settling bed (static box, liquid bridges acting beyond contact, rolling resistance):
+  // spheres fall, bounce and pack while the lists follow their drift; at every step the pair
+  // list must hold every pair closer than the interaction range and the wall list every sphere
+  // within it of a wall (checked against all pairs and walls).
+  CaseSpec spec = load_case("settling_bed.yaml");
+  spec.particles[0].count = 600;
+  spec.particles[0].region_min.z() = 0.0;  // a column that falls onto the floor at once
+  spec.particles[0].region_max.z() = 0.03;
+  Sim sim(spec);
+  ASSERT_TRUE(lists_follow_drift(sim.model, sim.work));
+  ASSERT_GT(sim.model.interaction_range, 0.0);
+  const std::int64_t before = sim.work.rebuilds;
+  size_t missing = 0, acting = 0, walls_missing = 0, walls_acting = 0;
+  for (int k = 0; k < 4000; ++k) {
+    sim.advance();
+    const State& s = sim.state;
+    const double range = sim.model.interaction_range;
+    std::set<std::pair<std::int32_t, std::int32_t>> listed, listed_walls;
+    for (size_t q = 0; q < s.pairs.size(); ++q) listed.insert({s.pairs.i[q], s.pairs.j[q]});
+    for (size_t q = 0; q < s.wall_pairs.size(); ++q) listed_walls.insert({s.wall_pairs.i[q], s.wall_pairs.j[q]});
+    for (size_t i = 0; i < s.size(); ++i) {
+      for (size_t j = i + 1; j < s.size(); ++j) {
+        const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j], cut = s.radius[i] + s.radius[j] + range;
+        if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
+        ++acting;
+        missing += !listed.count({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+      }
+      for (size_t w = 0; w < sim.model.planes.size(); ++w) {
+        const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
+        double normal[3];
+        const double d = sim.model.planes[w].distance(at, x, normal);
+        if (d >= s.radius[i] + range || d <= -s.radius[i]) continue;
+        ++walls_acting;
+        walls_missing += !listed_walls.count({static_cast<std::int32_t>(i), static_cast<std::int32_t>(w)});
+      }
+    }
+  }
+  std::printf("4000 steps: %lld rebuilds; %zu pair and %zu wall interactions seen, %zu and %zu missing\n",
+              static_cast<long long>(sim.work.rebuilds - before), acting, walls_acting, missing, walls_missing);
+  EXPECT_GT(acting, 100000u) << "the bed must have packed";
+  EXPECT_GT(walls_acting, 10000u);
+  EXPECT_EQ(missing, 0u);
+  EXPECT_EQ(walls_missing, 0u);
+}
+
 TEST(Neighbors, ListsOfALargeSparseGridHoldExactlyThePairsAndWallsWithinReach) {
   // A dense bed of 2,500 beads and 500 strays over a box 12 times wider: the grid then has half
   // a million cells, so the cell sort's passes over the cells are shared by the threads; the
