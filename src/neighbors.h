@@ -1,9 +1,9 @@
 // Linked cells with a Verlet skin. The contact lists are rebuilt only when some particle has
 // used up its share of the skin since the last rebuild (half of it, measured from where the
 // spheres' common drift has carried its build position where walls are static: DriftLimits,
-// verlet.h); at each rebuild particles leaving the
-// domain are removed, the particle slots are sorted by cell (neighbours near in memory), and
-// every contact's history is carried to its new slot by particle id.
+// verlet.h); at each rebuild particles leaving the domain are removed, the particle slots are
+// sorted by cell (neighbours near in memory), and every contact's history is carried to its new
+// slot by particle id.
 #pragma once
 
 #include "model.h"

@@ -146,8 +146,8 @@ struct State {
   std::vector<TriangleRecords> records;  ///< per mesh
   MeshLoads mesh_loads;
   /// Positions at the last rebuild of the contact lists: the lists stay valid until a sphere
-  /// has used up its share of the skin from here (DriftLimits, verlet.h). Part of the state so a restart rebuilds when the
-  /// uninterrupted run would.
+  /// has used up its share of the skin from here (DriftLimits, verlet.h). Part of the state so
+  /// a restart rebuilds when the uninterrupted run would.
   std::vector<double> x_built, y_built, z_built;
 
   /// Whether particles carry mesh-contact slots (only when the model has meshes), and the

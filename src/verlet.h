@@ -11,8 +11,8 @@
 namespace dem {
 
 /// What the drift found: a free sphere used up its share of the skin since the lists were built
-/// (kRebuild, DriftLimits), or more than half the near margin since the last full scan of the pair list
-/// (kRescan).
+/// (kRebuild, DriftLimits), or moved more than half the near margin since the last full scan of
+/// the pair list (kRescan).
 enum Moved : int { kRebuild = 1, kRescan = 2 };
 
 /// What the drift measures a free sphere's new position against. A flag whose positions are
