@@ -254,6 +254,22 @@ TEST(Neighbors, ARebuildThatDropsSpheresKeepsEveryColumnWithItsSphere) {
   EXPECT_EQ(wrong, 0u) << "slots whose values are not their sphere's";
 }
 
+/// Pairs of spheres closer than their radii plus `range` (checked against all pairs), and how many
+/// of them the pair list lacks: {acting, missing}.
+std::pair<size_t, size_t> pairs_acting_and_missing(const State& s, double range) {
+  std::set<std::pair<std::int32_t, std::int32_t>> listed;
+  for (size_t q = 0; q < s.pairs.size(); ++q) listed.insert({s.pairs.i[q], s.pairs.j[q]});
+  size_t acting = 0, missing = 0;
+  for (size_t i = 0; i < s.size(); ++i)
+    for (size_t j = i + 1; j < s.size(); ++j) {
+      const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j], cut = s.radius[i] + s.radius[j] + range;
+      if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
+      ++acting;
+      missing += !listed.count({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+    }
+  return {acting, missing};
+}
+
 TEST(Neighbors, ListsThatFollowTheCommonDriftStayCompleteAndAreRebuiltAsAtRest) {
   // With static walls the lists follow the spheres' common drift (DriftLimits, verlet.h): only
   // the spheres' motion relative to it uses up the skin. The elastic gas without its box, once at
@@ -273,17 +289,8 @@ TEST(Neighbors, ListsThatFollowTheCommonDriftStayCompleteAndAreRebuiltAsAtRest) 
   size_t missing = 0, touching = 0;
   for (int k = 0; k < steps; ++k) {
     rest.advance(), flying.advance();
-    const State& s = flying.state;
-    std::set<std::pair<std::int32_t, std::int32_t>> listed;
-    for (size_t q = 0; q < s.pairs.size(); ++q) listed.insert({s.pairs.i[q], s.pairs.j[q]});
-    const double range = flying.model.interaction_range;
-    for (size_t i = 0; i < s.size(); ++i)
-      for (size_t j = i + 1; j < s.size(); ++j) {
-        const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j], cut = s.radius[i] + s.radius[j] + range;
-        if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
-        ++touching;
-        missing += !listed.count({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
-      }
+    const auto [acting, lacking] = pairs_acting_and_missing(flying.state, flying.model.interaction_range);
+    touching += acting, missing += lacking;
   }
   const std::int64_t at_rest = rest.work.rebuilds - rest_before, flown = flying.work.rebuilds - flying_before;
   const double travel = 5.0 * steps * flying.model.dt;  // [m]
@@ -314,16 +321,11 @@ TEST(Neighbors, ListsThatFollowTheDriftHoldEveryBridgeAndWallOfASettlingBed) {
     sim.advance();
     const State& s = sim.state;
     const double range = sim.model.interaction_range;
-    std::set<std::pair<std::int32_t, std::int32_t>> listed, listed_walls;
-    for (size_t q = 0; q < s.pairs.size(); ++q) listed.insert({s.pairs.i[q], s.pairs.j[q]});
+    const auto [pairs_acting, pairs_lacking] = pairs_acting_and_missing(s, range);
+    acting += pairs_acting, missing += pairs_lacking;
+    std::set<std::pair<std::int32_t, std::int32_t>> listed_walls;
     for (size_t q = 0; q < s.wall_pairs.size(); ++q) listed_walls.insert({s.wall_pairs.i[q], s.wall_pairs.j[q]});
     for (size_t i = 0; i < s.size(); ++i) {
-      for (size_t j = i + 1; j < s.size(); ++j) {
-        const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j], cut = s.radius[i] + s.radius[j] + range;
-        if (dx * dx + dy * dy + dz * dz >= cut * cut) continue;
-        ++acting;
-        missing += !listed.count({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
-      }
       for (size_t w = 0; w < sim.model.planes.size(); ++w) {
         const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
         double normal[3];
