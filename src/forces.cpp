@@ -63,8 +63,10 @@ struct WallInputs {
 struct Batch {
   ContactBatch b;
   std::int32_t contact[kBatch];  // index in the pair or wall list
-  std::int32_t owner[kBatch];    // slot of body i
-  std::int32_t other[kBatch];    // slot of body j (for a wall entry: i, so the gathers stay in range)
+  // Slots as 64-bit integers, so that pair_geometry's loop has no 32-bit column: mixed with
+  // doubles those made GCC take 16 contacts an iteration, two registers a quantity, and spill.
+  std::int64_t owner[kBatch];    // slot of body i
+  std::int64_t other[kBatch];    // slot of body j (for a wall entry: i, so the gathers stay in range)
   bool pair[kBatch];             // particle pair, else plane wall
   double dx[kBatch], dy[kBatch], dz[kBatch], dist2[kBatch];  // [m], [m^2] centre j to centre i (pairs)
   double lever_i[kBatch], lever_j[kBatch];  // [m] centre to contact point
@@ -84,7 +86,7 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
   const std::int32_t* material = s.material.data();
   DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
-    const std::int32_t i = batch.owner[c], j = batch.other[c];
+    const std::int64_t i = batch.owner[c], j = batch.other[c];
     const double ri = radius[i], rj = radius[j];
     const double dist = std::sqrt(batch.dist2[c]);
     // Four reciprocals from one division (the divider is the slow unit here): 1/dist, and those
@@ -109,7 +111,6 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
     b.vn[c] = vn;
     b.vtx[c] = rx - vn * nx, b.vty[c] = ry - vn * ny, b.vtz[c] = rz - vn * nz;
     b.wx[c] = wx[i] - wx[j], b.wy[c] = wy[i] - wy[j], b.wz[c] = wz[i] - wz[j];
-    b.pair_type[c] = material[i] * n_materials + material[j];
     b.overlap[c] = overlap;
     b.radius_i[c] = ri;
     b.radius_j[c] = rj;
@@ -120,6 +121,7 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
     batch.lever_i[c] = lever_i;
     batch.lever_j[c] = lever_j;
   }
+  for (int c = 0; c < b.count; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
 }
 
 /// Evaluates a full batch: adds each contact's force and torque to both bodies' totals, in list
@@ -145,7 +147,8 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   const bool keep_forces = work.keep_pair_forces;
   ContactForces& wf = work.wall_forces;
   for (int c = 0; c < b.count; ++c) {
-    const std::int32_t k = batch.contact[c], i = batch.owner[c];
+    const std::int32_t k = batch.contact[c];
+    const std::int64_t i = batch.owner[c];
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
     const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
@@ -156,7 +159,7 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
     s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
     s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
     if (batch.pair[c]) {
-      const std::int32_t j = batch.other[c];
+      const std::int64_t j = batch.other[c];
       s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
       s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
       s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
@@ -173,14 +176,14 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
 }
 
 /// The outputs the normal stage does not set (effect.h) start at zero; `load` is set after damping.
-void zero_outputs(ContactBatch& b) {
+[[gnu::always_inline]] inline void zero_outputs(ContactBatch& b) {
   for (int c = 0; c < b.count; ++c) {
     b.gamma_n[c] = b.gamma_t[c] = 0.0;
     b.ftx[c] = b.fty[c] = b.ftz[c] = b.mx[c] = b.my[c] = b.mz[c] = b.energy_dissipated[c] = 0.0;
   }
 }
 
-void set_load(ContactBatch& b) {
+[[gnu::always_inline]] inline void set_load(ContactBatch& b) {
   for (int c = 0; c < b.count; ++c) b.load[c] = b.fn[c] > 0.0 ? b.fn[c] : 0.0;
 }
 
@@ -285,7 +288,7 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
                                        overlap, r, r, 1.0 / s.inv_mass[i], 1.4 * r * r / s.inv_mass[i], dist};
     b.history[c] = s.wall_pairs.history.data() + static_cast<size_t>(k) * width;
     batch.contact[c] = k;
-    batch.owner[c] = batch.other[c] = static_cast<std::int32_t>(i);
+    batch.owner[c] = batch.other[c] = i;
     batch.pair[c] = false;
     batch.dx[c] = batch.dy[c] = batch.dz[c] = 0.0, batch.dist2[c] = 1.0;  // (pair_geometry's values are replaced)
     if (++b.count == kBatch) flush(model, batch, s, work);
@@ -412,10 +415,41 @@ DEM_KERNEL void clear_loads(State& s, long begin, long end) {
 
 }  // namespace
 
-void evaluate_effects(const Model& model, ContactBatch& b) {
-  const int width = model.history_width;
-  for (int c = 0; c < b.count; ++c)
-    for (int q = 0; q < width; ++q) b.hist[q][c] = b.history[c][q];
+namespace {
+
+/// Each contact's history row into the batch's columns (kIn) or back (!kIn), for a width known
+/// when compiled: unrolled, without a loop over the width per contact.
+template <int kWidth, bool kIn>
+[[gnu::always_inline]] inline void copy_history(ContactBatch& b) {
+  for (int c = 0; c < b.count; ++c) {
+    double* row = b.history[c];
+    for (int q = 0; q < kWidth; ++q) {
+      if constexpr (kIn) b.hist[q][c] = row[q];
+      else row[q] = b.hist[q][c];
+    }
+  }
+}
+
+template <bool kIn>
+[[gnu::always_inline]] inline void copy_histories(ContactBatch& b, int width) {
+  static_assert(kHistoryMax == 8);
+  switch (width) {
+    case 0: return;
+    case 1: return copy_history<1, kIn>(b);
+    case 2: return copy_history<2, kIn>(b);
+    case 3: return copy_history<3, kIn>(b);
+    case 4: return copy_history<4, kIn>(b);
+    case 5: return copy_history<5, kIn>(b);
+    case 6: return copy_history<6, kIn>(b);
+    case 7: return copy_history<7, kIn>(b);
+    default: return copy_history<8, kIn>(b);
+  }
+}
+
+}  // namespace
+
+DEM_KERNEL void evaluate_effects(const Model& model, ContactBatch& b) {
+  copy_histories<true>(b, model.history_width);
   zero_outputs(b);
   bool load_set = false;
   for (const ActiveEffect& e : model.effects) {
@@ -425,8 +459,7 @@ void evaluate_effects(const Model& model, ContactBatch& b) {
     e.spec->kernel(ctx, b);
   }
   if (!load_set) set_load(b);
-  for (int c = 0; c < b.count; ++c)
-    for (int q = 0; q < width; ++q) b.history[c][q] = b.hist[q][c];
+  copy_histories<false>(b, model.history_width);
 }
 
 void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
