@@ -132,35 +132,39 @@ DriftLimits drift_limits(const Model& model, const State& s, const Workspace& wo
   return limits;
 }
 
+namespace {
+
+// The loop for the limits at hand. Called, not chosen through a pointer: the loops are inlined
+// here and these into each clone of the kernels below; a pointer to a loop would be compiled
+// once, for the baseline instruction set.
+template <bool kAllFree>
+[[gnu::always_inline]] inline int kick_drift_for(State& s, const DriftLimits& limits, long begin, long end, double h, double dt) {
+  if (!limits.x_built) return kick_drift_loop<kAllFree, false, false>(s, limits, begin, end, h, dt);
+  if (!limits.x_near) return kick_drift_loop<kAllFree, true, false>(s, limits, begin, end, h, dt);
+  return kick_drift_loop<kAllFree, true, true>(s, limits, begin, end, h, dt);
+}
+
+template <bool kAllFree>
+[[gnu::always_inline]] inline int gravity_kick_for(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* ahead,
+                                                   double dt) {
+  if (!ahead || h == 0.0) return gravity_kick_loop<kAllFree, false, false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
+  const int flags = untested(*ahead);
+  if (!ahead->x_built) return flags | gravity_kick_loop<kAllFree, true, false, false>(gravity, s, *ahead, begin, end, h, dt);
+  if (!ahead->x_near) return flags | gravity_kick_loop<kAllFree, true, true, false>(gravity, s, *ahead, begin, end, h, dt);
+  return flags | gravity_kick_loop<kAllFree, true, true, true>(gravity, s, *ahead, begin, end, h, dt);
+}
+
+}  // namespace
+
 DEM_KERNEL int kick_drift_range(State& s, const DriftLimits& limits, long begin, long end, double h, double dt) {
   const int flags = untested(limits);
-  if (all_free(s, begin, end)) {
-    if (!limits.x_built) return flags | kick_drift_loop<true, false, false>(s, limits, begin, end, h, dt);
-    if (!limits.x_near) return flags | kick_drift_loop<true, true, false>(s, limits, begin, end, h, dt);
-    return flags | kick_drift_loop<true, true, true>(s, limits, begin, end, h, dt);
-  }
-  if (!limits.x_built) return flags | kick_drift_loop<false, false, false>(s, limits, begin, end, h, dt);
-  if (!limits.x_near) return flags | kick_drift_loop<false, true, false>(s, limits, begin, end, h, dt);
-  return flags | kick_drift_loop<false, true, true>(s, limits, begin, end, h, dt);
+  if (all_free(s, begin, end)) return flags | kick_drift_for<true>(s, limits, begin, end, h, dt);
+  return flags | kick_drift_for<false>(s, limits, begin, end, h, dt);
 }
 
 DEM_KERNEL int gravity_kick_range(const double* gravity, State& s, long begin, long end, double h, const DriftLimits* ahead, double dt) {
-  // (Each loop is called, not chosen through a pointer: a pointer to it would be compiled once,
-  // for the baseline instruction set, instead of within each clone of this kernel.)
-  const bool all = all_free(s, begin, end);
-  if (!ahead || h == 0.0) {
-    if (all) return gravity_kick_loop<true, false, false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
-    return gravity_kick_loop<false, false, false, false>(gravity, s, DriftLimits{}, begin, end, h, dt);
-  }
-  const int flags = untested(*ahead);
-  if (all) {
-    if (!ahead->x_built) return flags | gravity_kick_loop<true, true, false, false>(gravity, s, *ahead, begin, end, h, dt);
-    if (!ahead->x_near) return flags | gravity_kick_loop<true, true, true, false>(gravity, s, *ahead, begin, end, h, dt);
-    return flags | gravity_kick_loop<true, true, true, true>(gravity, s, *ahead, begin, end, h, dt);
-  }
-  if (!ahead->x_built) return flags | gravity_kick_loop<false, true, false, false>(gravity, s, *ahead, begin, end, h, dt);
-  if (!ahead->x_near) return flags | gravity_kick_loop<false, true, true, false>(gravity, s, *ahead, begin, end, h, dt);
-  return flags | gravity_kick_loop<false, true, true, true>(gravity, s, *ahead, begin, end, h, dt);
+  if (all_free(s, begin, end)) return gravity_kick_for<true>(gravity, s, begin, end, h, ahead, dt);
+  return gravity_kick_for<false>(gravity, s, begin, end, h, ahead, dt);
 }
 
 }  // namespace dem
