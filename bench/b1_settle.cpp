@@ -125,12 +125,14 @@ std::size_t pair_forces_bytes(const dem::PairForces& f) {
   return bytes(f.fx) + bytes(f.fy) + bytes(f.fz) + bytes(f.active);
 }
 
-/// The buffers a rebuild keeps between calls: partners and mesh candidates per thread, the sort's gathers.
+/// The buffers a rebuild keeps between calls: partners and mesh candidates per thread, the sort's gathers,
+/// the histories by id.
 std::size_t scratch_bytes(const dem::Workspace& w) {
   std::size_t b = 0;
   for (const auto& v : w.partner_scratch) b += bytes(v);
   for (const auto& v : w.candidate_scratch) b += bytes(v);
   const dem::PermuteScratch& p = w.permute_scratch;
+  for (const dem::HistoryRows* h : {&w.old_pairs, &w.old_walls}) b += bytes(h->a) + bytes(h->b) + bytes(h->rows);
   return b + bytes(p.f64) + bytes(p.slots_f64) + bytes(p.history) + bytes(p.i32) + bytes(p.slots_i32) + bytes(p.i64) +
          bytes(p.u8);
 }

@@ -29,35 +29,10 @@
 
 namespace dem {
 
-/// Contact histories keyed by particle ids, seen from particle `a` (`b` is the other particle's
-/// id, or the wall index for a plane-wall contact), `width` doubles each.
-struct HistoryRows {
-  std::vector<std::int64_t> a, b;
-  std::vector<double> rows;
-  std::size_t size() const { return a.size(); }
-  void add(std::int64_t id_a, std::int64_t id_b, const double* row, int width) {
-    a.push_back(id_a), b.push_back(id_b);
-    rows.insert(rows.end(), row, row + width);
-  }
-  void append(const HistoryRows& more) {
-    a.insert(a.end(), more.a.begin(), more.a.end());
-    b.insert(b.end(), more.b.begin(), more.b.end());
-    rows.insert(rows.end(), more.rows.begin(), more.rows.end());
-  }
-  /// Row q as doubles (a, b, history) at the end of `out`, for a message between ranks.
-  void pack(std::size_t q, int width, std::vector<double>& out) const {
-    out.push_back(static_cast<double>(a[q])), out.push_back(static_cast<double>(b[q]));
-    out.insert(out.end(), rows.begin() + static_cast<std::ptrdiff_t>(q * width), rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
-  }
-  /// Appends `count` packed rows from `in`; returns the position after them.
-  const double* unpack(const double* in, std::size_t count, int width) {
-    for (std::size_t k = 0; k < count; ++k, in += 2 + width) add(static_cast<std::int64_t>(in[0]), static_cast<std::int64_t>(in[1]), in + 2, width);
-    return in;
-  }
-};
-
 /// The non-zero histories of a contact list keyed by particle ids (wall contacts: b is the wall).
 HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls);
+/// The same into `out`, whose blocks are reused.
+void histories_by_id(const ContactList& list, const State& state, int width, bool walls, HistoryRows& out);
 
 class Domain {
  public:

@@ -250,7 +250,13 @@ void ContactForces::resize(std::size_t n) {
 
 HistoryRows histories_by_id(const ContactList& list, const State& state, int width, bool walls) {
   HistoryRows out;
-  if (width == 0) return out;
+  histories_by_id(list, state, width, walls, out);
+  return out;
+}
+
+void histories_by_id(const ContactList& list, const State& state, int width, bool walls, HistoryRows& out) {
+  out.a.clear(), out.b.clear(), out.rows.clear();
+  if (width == 0) return;
   // Counted first and sized exactly (grown by doubling, these rows, tens of MiB in a large bed,
   // would hold up to twice their size at the rebuild's peak); both passes in pieces shared by
   // the threads, each piece's rows written from its own start: the rows in list order.
@@ -270,7 +276,8 @@ HistoryRows histories_by_id(const ContactList& list, const State& state, int wid
 #pragma omp single
     {
       for (long piece = 0; piece < pieces; ++piece) start[piece + 1] += start[piece];
-      out.a.resize(start[pieces]), out.b.resize(start[pieces]), out.rows.resize(start[pieces] * width);
+      resize_discarding(out.a, start[pieces]), resize_discarding(out.b, start[pieces]);
+      resize_discarding(out.rows, start[pieces] * width);
     }
 #pragma omp for schedule(static)
     for (long piece = 0; piece < pieces; ++piece) {
@@ -284,7 +291,6 @@ HistoryRows histories_by_id(const ContactList& list, const State& state, int wid
       }
     }
   }
-  return out;
 }
 
 void drop_ghosts(State& s) {
@@ -394,8 +400,9 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, do
 
 void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const int width = model.history_width;
-  HistoryRows old_pairs = histories_by_id(s.pairs, s, width, false);
-  HistoryRows old_walls = histories_by_id(s.wall_pairs, s, width, true);
+  HistoryRows &old_pairs = work.old_pairs, &old_walls = work.old_walls;
+  histories_by_id(s.pairs, s, width, false, old_pairs);
+  histories_by_id(s.wall_pairs, s, width, true, old_walls);
   Domain* domain = work.domain;
 
   drop_ghosts(s);
@@ -541,7 +548,6 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     carry(old_pairs, false, s.pairs, work.pair_begin);
     carry(old_walls, true, s.wall_pairs, work.wall_begin);
   }
-  old_pairs = {}, old_walls = {};
 
   find_mesh_candidates(model, s, work, reach);
   s.lists_drift_velocity = lists_follow_drift(model, work) ? common_velocity(s) : std::array<double, 3>{0.0, 0.0, 0.0};
