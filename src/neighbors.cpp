@@ -255,8 +255,10 @@ HistoryRows histories_by_id(const ContactList& list, const State& state, int wid
 }
 
 void histories_by_id(const ContactList& list, const State& state, int width, bool walls, HistoryRows& out) {
-  out.a.clear(), out.b.clear(), out.rows.clear();
-  if (width == 0) return;
+  if (width == 0) {
+    out.a.clear(), out.b.clear(), out.rows.clear();
+    return;
+  }
   // Counted first and sized exactly (grown by doubling, these rows, tens of MiB in a large bed,
   // would hold up to twice their size at the rebuild's peak); both passes in pieces shared by
   // the threads, each piece's rows written from its own start: the rows in list order.
@@ -276,6 +278,8 @@ void histories_by_id(const ContactList& list, const State& state, int width, boo
 #pragma omp single
     {
       for (long piece = 0; piece < pieces; ++piece) start[piece + 1] += start[piece];
+      // Every row is written below: from the last call's size on, the vectors' elements are not
+      // set to zero first (one thread's pass over MiB while the other waits).
       resize_discarding(out.a, start[pieces]), resize_discarding(out.b, start[pieces]);
       resize_discarding(out.rows, start[pieces] * width);
     }
@@ -518,8 +522,16 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   // Carry histories to the new lists by particle id: each old row finds its pair in the new
   // list's row of the lower slot (a handful of partners), so the carry needs no index of its own.
   // Each old row has a new row of its own (or none), so the threads share the old rows.
-  assign_discarding(s.pairs.history, n_pairs * width, 0.0);
-  s.wall_pairs.history.assign(s.wall_pairs.size() * width, 0.0);
+  // The new lists' histories start at zero, set by the threads together (MiB: 0.4 ms of a
+  // B1 20k rebuild on one thread).
+  resize_discarding(s.pairs.history, n_pairs * width);
+  s.wall_pairs.history.resize(s.wall_pairs.size() * width);
+  for (std::vector<double>* history : {&s.pairs.history, &s.wall_pairs.history}) {
+    const long size = static_cast<long>(history->size());
+    double* h = history->data();
+#pragma omp parallel for schedule(static) if (size >= kParallelMin)
+    for (long begin = 0; begin < size; begin += kChunk) std::fill(h + begin, h + std::min(size, begin + kChunk), 0.0);
+  }
   if (width > 0 && (old_pairs.size() > 0 || old_walls.size() > 0)) {
     std::vector<std::int32_t> slot_of(static_cast<size_t>(s.next_id), -1);
     for (size_t p = 0; p < n; ++p) slot_of[s.id[p]] = static_cast<std::int32_t>(p);
