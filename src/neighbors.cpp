@@ -17,10 +17,12 @@ namespace dem {
 
 namespace {
 
+/// Without a branch per value: whether a row is zero is a coin toss to the branch predictor
+/// (B1 20k: 40 % of the listed pairs touch).
 bool row_is_zero(const double* row, int width) {
-  for (int k = 0; k < width; ++k)
-    if (row[k] != 0.0) return false;
-  return true;
+  bool any = false;
+  for (int k = 0; k < width; ++k) any |= row[k] != 0.0;
+  return !any;
 }
 
 /// Finds the spheres that left the domain (along non-periodic axes) or entered an outlet, with
