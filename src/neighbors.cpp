@@ -280,8 +280,8 @@ void histories_by_id(const ContactList& list, const State& state, int width, boo
 #pragma omp single
     {
       for (long piece = 0; piece < pieces; ++piece) start[piece + 1] += start[piece];
-      // Every row is written below: from the last call's size on, the vectors' elements are not
-      // set to zero first (one thread's pass over MiB while the other waits).
+      // Every row is written below, so the rows are not cleared first: resizing sets only those
+      // beyond the last call's count to zero (not MiB by one thread while the others wait).
       resize_discarding(out.a, start[pieces]), resize_discarding(out.b, start[pieces]);
       resize_discarding(out.rows, start[pieces] * width);
     }
