@@ -225,7 +225,7 @@ std::vector<Row> run_size(long n, std::optional<std::int64_t> phase1, std::optio
   std::vector<Row> rows;
   using Clock = std::chrono::steady_clock;
   auto run_phase = [&](const std::string& name, std::int64_t steps) {
-    const std::int64_t rebuilds_before = work.rebuilds, ahead_before = work.drifts_ahead;
+    const std::int64_t rebuilds_before = work.rebuilds, ahead_before = work.drifts_ahead, scans_before = work.near_refreshes;
     const auto start = Clock::now();
     dem::advance(model, state, work, steps);
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -255,10 +255,10 @@ std::vector<Row> run_size(long n, std::optional<std::int64_t> phase1, std::optio
     r.engine_bytes_per_particle = static_cast<double>(engine) / np;
     r.peak_reset = peak_reset;
     rows.push_back(r);
-    fmt::print("  {}: {} steps ({} drifted ahead by the step before) to t = {:.4g} s in {:.2f} s; {} contacts ({} particle-particle "
-               "listed pairs, {} wall pairs), kinetic energy {:.4g} J; engine memory {:.0f} B/particle (particles {:.0f}, contact "
-               "lists {:.0f}, workspace {:.0f})\n",
-               name, steps, work.drifts_ahead - ahead_before, state.time, seconds, sc.contacts, state.pairs.size(), state.wall_pairs.size(), r.kinetic,
+    fmt::print("  {}: {} steps ({} drifted ahead by the step before, {} full scans of the pair list) to t = {:.4g} s in {:.2f} s; {} "
+               "contacts ({} particle-particle listed pairs, {} wall pairs), kinetic energy {:.4g} J; engine memory {:.0f} B/particle "
+               "(particles {:.0f}, contact lists {:.0f}, workspace {:.0f})\n",
+               name, steps, work.drifts_ahead - ahead_before, work.near_refreshes - scans_before, state.time, seconds, sc.contacts, state.pairs.size(), state.wall_pairs.size(), r.kinetic,
                r.engine_bytes_per_particle, static_cast<double>(held) / np,
                static_cast<double>(contact_list_bytes(state.pairs) + contact_list_bytes(state.wall_pairs)) / np,
                static_cast<double>(workspace_bytes(work)) / np);

@@ -485,6 +485,9 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
     else if (pairs.age > 16) pairs.margin = std::max(pairs.margin / 1.5, 0.05 * model.skin);
   }
   work.near.age = near ? work.near.age + 1 : 0;
+  // A full scan takes the positions at the meshes' time (place_meshes); before the drift ahead's
+  // limits, which measure the common drift from it.
+  if (!near) work.near.time = work.mesh_time;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
   // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon

@@ -131,8 +131,9 @@ void one_step(const Model& model, State& state, Workspace& work, bool next_follo
   }
   work.loads_cleared = !rebuilt;
   // The contact pass may read the near pairs alone when the lists were not rebuilt (a rebuild
-  // clears near.valid) and no free sphere moved half the margin since the last full scan.
-  work.near.trusted = !(moved & kRescan);
+  // clears near.valid) and no free sphere moved half the margin since the last full scan, or
+  // none did from where the lists' common drift carried it (verlet.h, Moved).
+  work.near.trusted = !((moved & kRescan) && (moved & kRescanDrift));
   ForcePass pass;
   pass.kick = 0.5 * dt;
   pass.drift_ahead = next_follows && !work.domain && state.bodies.size() == 0 && !model.has_attached;

@@ -25,7 +25,9 @@ template <bool kCheck, bool kNear>
   if constexpr (kCheck) flags |= (free & outside_skin(l, p, x, y, z)) * kRebuild;
   if constexpr (kNear) {
     const double ex = (x - l.x_built[p]) - l.x_near[p], ey = (y - l.y_built[p]) - l.y_near[p], ez = (z - l.z_built[p]) - l.z_near[p];
+    const double fx = ex - l.scan_cx, fy = ey - l.scan_cy, fz = ez - l.scan_cz;
     flags |= (free & (ex * ex + ey * ey + ez * ez > l.near2)) * kRescan;
+    flags |= (free & (fx * fx + fy * fy + fz * fz > l.near2)) * kRescanDrift;
   }
   return flags;
 }
@@ -104,7 +106,7 @@ template <bool kAllFree, bool kAhead, bool kCheck, bool kNear>
 
 }  // namespace
 
-int untested(const DriftLimits& limits) { return (limits.x_built ? 0 : kRebuild) | (limits.x_near ? 0 : kRescan); }
+int untested(const DriftLimits& limits) { return (limits.x_built ? 0 : kRebuild) | (limits.x_near ? 0 : kRescan | kRescanDrift); }
 
 DriftLimits drift_limits(const Model& model, const State& s, const Workspace& work, bool near_valid, double time) {
   DriftLimits limits;
@@ -129,6 +131,9 @@ DriftLimits drift_limits(const Model& model, const State& s, const Workspace& wo
   // the skin, is taken off the margin, so that the test stays on the safe side.
   const double half_margin = 0.5 * work.near.margin - 1e-6 * model.skin;
   limits.near2 = half_margin * half_margin;
+  const double since_scan = time - work.near.time;  // [s] (the drift velocity is 0 where the lists do not follow it)
+  limits.scan_cx = s.lists_drift_velocity[0] * since_scan, limits.scan_cy = s.lists_drift_velocity[1] * since_scan;
+  limits.scan_cz = s.lists_drift_velocity[2] * since_scan;
   return limits;
 }
 

@@ -12,8 +12,11 @@ namespace dem {
 
 /// What the drift found: a free sphere used up its share of the skin since the lists were built
 /// (kRebuild, DriftLimits), or moved more than half the near margin since the last full scan of
-/// the pair list (kRescan).
-enum Moved : int { kRebuild = 1, kRescan = 2 };
+/// the pair list (kRescan), or more than half the margin from where the lists' common drift
+/// carried it since that scan (kRescanDrift). The near pairs hold every pair that can touch
+/// unless both kRescan and kRescanDrift are set: a pair's gap shrinks by at most |e_i - c| +
+/// |e_j - c| for any one vector c (e: displacement since the scan), c = 0 or the drift.
+enum Moved : int { kRebuild = 1, kRescan = 2, kRescanDrift = 4 };
 
 /// What the drift measures a free sphere's new position against. A flag whose positions are
 /// missing (null) is always set.
@@ -34,6 +37,7 @@ struct DriftLimits {
   double cx = 0, cy = 0, cz = 0;  ///< [m] c, the common drift since the build
   double wall2 = 0.0;             ///< [m^2] how far from the build position itself: skin^2 with static walls, a domain or outlets ((8 skin)^2 without any), else (skin/2)^2
   double near2 = 0.0;             ///< [m^2] (near margin/2)^2
+  double scan_cx = 0, scan_cy = 0, scan_cz = 0;  ///< [m] the common drift since the last full scan (0 where the lists do not follow it)
 };
 
 /// Whether the sphere in slot p, at (x, y, z), has left what the lists cover for it.

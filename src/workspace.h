@@ -118,6 +118,7 @@ struct Workspace {
     /// precision is plenty for an offset of at most 8 skins (verlet.cpp)
     std::vector<float> x, y, z;
     double margin = 0.0;             ///< [m] gap below which a pair is kept (0.05-0.5 Model::skin, adapted: forces.cpp)
+    double time = 0.0;               ///< [s] time of the positions at the last full scan
     int age = 0;                     ///< contact passes over the near pairs since the last full scan
     bool valid = false;              ///< rows and positions are those of the current list
     bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since

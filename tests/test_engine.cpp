@@ -303,6 +303,42 @@ TEST(Neighbors, ListsThatFollowTheCommonDriftStayCompleteAndAreRebuiltAsAtRest) 
   EXPECT_LT(static_cast<double>(flown), 0.5 * travel / (0.5 * flying.model.skin)) << "far fewer than the flight's skin/2 steps";
 }
 
+TEST(Neighbors, NearPairsOfAFlyingCloudFollowTheDriftAndGiveTheRunOfWholeScans) {
+  // The near pairs stay complete while every sphere is within half the margin of where it was at
+  // the last full scan, or every sphere is within half the margin of where the lists' common
+  // drift carried it since (verlet.h, Moved). The elastic gas without its box flying at 5 m/s
+  // must give the run of a copy that scans every listed pair at every step, to the last bit, and
+  // its near pairs must cost what they cost the cloud at rest: about as many full scans with as
+  // small a margin (with |e| <= margin/2 alone the flight, 0.04 skin a step, needs a full scan
+  // every 2 steps at the rest's margin, or a margin three times as wide).
+  const auto cloud = [](double u) {
+    CaseSpec spec = load_case("elastic_gas.yaml");
+    spec.planes.clear();
+    for (ParticleSetSpec& set : spec.particles) set.velocity.x() += u;
+    return spec;
+  };
+  Sim rest(cloud(0.0)), near(cloud(5.0)), whole(cloud(5.0));
+  ASSERT_TRUE(lists_follow_drift(near.model, near.work));
+  const int steps = 1500;
+  const std::int64_t rest_before = rest.work.near_refreshes, near_before = near.work.near_refreshes;
+  double rest_margin = 0.0, near_margin = 0.0;  // [m] summed over the steps
+  for (int k = 0; k < steps; ++k) {
+    rest.advance(), near.advance();
+    whole.work.near.valid = false;  // the next contact pass scans every listed pair
+    whole.advance();
+    rest_margin += rest.work.near.margin, near_margin += near.work.near.margin;
+  }
+  const std::int64_t at_rest = rest.work.near_refreshes - rest_before, flying = near.work.near_refreshes - near_before;
+  const double skin = near.model.skin;
+  std::printf("%d steps: %lld full scans flying, %lld at rest; mean margin %.3g skin flying, %.3g at rest\n", steps,
+              static_cast<long long>(flying), static_cast<long long>(at_rest), near_margin / steps / skin, rest_margin / steps / skin);
+  for (auto column : {&State::x, &State::y, &State::z, &State::vx, &State::vy, &State::vz, &State::wx, &State::wy, &State::wz})
+    EXPECT_EQ(near.state.*column, whole.state.*column);
+  EXPECT_EQ(near.state.pairs.history, whole.state.pairs.history);
+  EXPECT_LE(flying, at_rest * 5 / 4 + 10) << "the flight scans the whole list about as often as the cloud at rest";
+  EXPECT_LE(near_margin, 1.25 * rest_margin) << "with about as small a margin";
+}
+
 TEST(Neighbors, ListsThatFollowTheDriftHoldEveryBridgeAndWallOfASettlingBed) {
   // The settling bed (static box, liquid bridges acting beyond contact, rolling resistance):
   // spheres fall, bounce and pack while the lists follow their drift; at every step the pair
