@@ -270,19 +270,21 @@ std::pair<size_t, size_t> pairs_acting_and_missing(const State& s, double range)
   return {acting, missing};
 }
 
+/// The elastic gas without its box, all of it moving at u [m/s] along x besides its own motion.
+CaseSpec gas_cloud(double u) {
+  CaseSpec spec = load_case("elastic_gas.yaml");
+  spec.planes.clear();
+  for (ParticleSetSpec& set : spec.particles) set.velocity.x() += u;
+  return spec;
+}
+
 TEST(Neighbors, ListsThatFollowTheCommonDriftStayCompleteAndAreRebuiltAsAtRest) {
   // With static walls the lists follow the spheres' common drift (DriftLimits, verlet.h): only
   // the spheres' motion relative to it uses up the skin. The elastic gas without its box, once at
   // rest as a whole and once flying at 5 m/s, must be rebuilt about as often, less than half as
   // often as |d| <= skin/2 would ask for the flight alone, and its pair list must hold every
   // pair within reach at every step (checked against all 79,800 pairs).
-  const auto cloud = [](double u) {
-    CaseSpec spec = load_case("elastic_gas.yaml");
-    spec.planes.clear();
-    for (ParticleSetSpec& set : spec.particles) set.velocity.x() += u;
-    return spec;
-  };
-  Sim rest(cloud(0.0)), flying(cloud(5.0));
+  Sim rest(gas_cloud(0.0)), flying(gas_cloud(5.0));
   ASSERT_TRUE(lists_follow_drift(flying.model, flying.work));
   const int steps = 1500;
   const std::int64_t rest_before = rest.work.rebuilds, flying_before = flying.work.rebuilds;
@@ -311,13 +313,7 @@ TEST(Neighbors, NearPairsOfAFlyingCloudFollowTheDriftAndGiveTheRunOfWholeScans) 
   // its near pairs must cost what they cost the cloud at rest: about as many full scans with as
   // small a margin (with |e| <= margin/2 alone the flight, 0.04 skin a step, needs a full scan
   // every 2 steps at the rest's margin, or a margin three times as wide).
-  const auto cloud = [](double u) {
-    CaseSpec spec = load_case("elastic_gas.yaml");
-    spec.planes.clear();
-    for (ParticleSetSpec& set : spec.particles) set.velocity.x() += u;
-    return spec;
-  };
-  Sim rest(cloud(0.0)), near(cloud(5.0)), whole(cloud(5.0));
+  Sim rest(gas_cloud(0.0)), near(gas_cloud(5.0)), whole(gas_cloud(5.0));
   ASSERT_TRUE(lists_follow_drift(near.model, near.work));
   const int steps = 1500;
   const std::int64_t rest_before = rest.work.near_refreshes, near_before = near.work.near_refreshes;
