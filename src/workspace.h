@@ -121,7 +121,7 @@ struct Workspace {
     double time = 0.0;               ///< [s] time of the positions at the last full scan
     int age = 0;                     ///< contact passes over the near pairs since the last full scan
     bool valid = false;              ///< rows and positions are those of the current list
-    bool trusted = false;            ///< set by step() when no free sphere moved margin/2 since
+    bool trusted = false;            ///< set by step() unless a free sphere moved margin/2 since, with and without the common drift (verlet.h, Moved)
   } near;
   std::int64_t near_refreshes = 0;   ///< full scans of the pair list
   /// The Moved flags (verlet.h) of the next step's opening kick and drift when the closing kick of
