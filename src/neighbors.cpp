@@ -359,7 +359,7 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   Workspace::NearPairs& near = work.near;
   for (auto* c : {&near.k, &near.i, &near.j}) resize_discarding(*c, s.pairs.size());
   for (auto* c : {&near.x, &near.y, &near.z}) resize_discarding(*c, s.owned());
-  resize_discarding(near.end, s.owned());
+  resize_discarding(near.end, (s.owned() + work.block - 1) / work.block);
   near.margin = near.margin > 0 ? std::clamp(near.margin, 0.05 * model.skin, 0.5 * model.skin) : 0.1 * model.skin;
   near.valid = near.trusted = false;  // the next contact pass scans the whole list
   // A contact with a history counts as active until it is next evaluated: the contact loop

@@ -111,8 +111,7 @@ struct Workspace {
   /// fraction of the distance tests (forces.cpp).
   struct NearPairs {
     std::vector<std::int32_t> k, i, j;  ///< pair index, owner and partner
-    /// End of the near pairs up to slot p, for the slots with plane walls (whose wall contacts
-    /// follow their pairs) and the last slot of each block; not set for the others.
+    /// End of each block's run of near pairs (a run starts where the block's pairs do).
     std::vector<std::int32_t> end;
     /// [m] positions at the last full scan less the build positions (State::x_built): single
     /// precision is plenty for an offset of at most 8 skins (verlet.cpp)
