@@ -138,8 +138,7 @@ std::size_t scratch_bytes(const dem::Workspace& w) {
 }
 
 std::size_t workspace_bytes(const dem::Workspace& w) {
-  return bytes(w.pair_begin) + bytes(w.wall_rows) + bytes(w.mesh_rows) +
-         bytes(w.wall_begin) + pair_forces_bytes(w.pair_forces) +
+  return bytes(w.pair_begin) + bytes(w.wall_begin) + bytes(w.mesh_rows) + pair_forces_bytes(w.pair_forces) +
          contact_forces_bytes(w.wall_forces) + bytes(w.cell_of) + bytes(w.cell_start) + bytes(w.order) +
          bytes(w.members) + bytes(w.ghost_owners) + scratch_bytes(w) + bytes(w.near.k) + bytes(w.near.i) + bytes(w.near.j) + bytes(w.near.end) +
          bytes(w.near.x) + bytes(w.near.y) + bytes(w.near.z) + bytes(w.block_work) + bytes(w.block_time) +

@@ -261,20 +261,24 @@ void list_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
   batch.b.count = c;
 }
 
-void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, long i) {
+/// The plane-wall pairs [begin, end) of the wall list (a block's, in slot order), in one loop.
+void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, std::int32_t begin, std::int32_t end) {
   const int width = model.history_width;
   const double range = model.interaction_range;
   ContactBatch& b = batch.b;
-  for (std::int32_t k = work.wall_begin[i]; k < work.wall_begin[i + 1]; ++k) {
-    const std::int32_t w = s.wall_pairs.j[k];
+  const std::int32_t *owner = s.wall_pairs.i.data(), *wall_of = s.wall_pairs.j.data();
+  std::uint8_t* active = work.wall_forces.active.data();
+  for (std::int32_t k = begin; k < end; ++k) {
+    const std::int32_t i = owner[k], w = wall_of[k];
     const PlaneWall& wall = model.planes[w];
     const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
     double normal[3];
     const double dist = wall.distance(at, x, normal);
     const double nx = normal[0], ny = normal[1], nz = normal[2];
-    const double overlap = s.radius[i] - dist;
+    const double r = s.radius[i];
+    const double overlap = r - dist;
     if (overlap <= -range || dist <= 0.0) {
-      forget(s.wall_pairs, work.wall_forces.active[k], k, width);
+      forget(s.wall_pairs, active[k], k, width);
       continue;
     }
     const int c = b.count;
@@ -283,15 +287,15 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     const double ry = s.vy[i] - dist * (s.wz[i] * nx - s.wx[i] * nz) - s.walls.vy[w];
     const double rz = s.vz[i] - dist * (s.wx[i] * ny - s.wy[i] * nx) - s.walls.vz[w];
     const double vn = rx * nx + ry * ny + rz * nz;
-    const double r = s.radius[i];
-    batch.walls[batch.wall_count++] = {c, model.pair_type(s.material[i], wall.material), nx, ny, nz, vn,
-                                       rx - vn * nx, ry - vn * ny, rz - vn * nz, s.wx[i], s.wy[i], s.wz[i],
-                                       overlap, r, r, 1.0 / s.inv_mass[i], 1.4 * r * r / s.inv_mass[i], dist};
+    batch.walls[batch.wall_count] = {c, model.pair_type(s.material[i], wall.material), nx, ny, nz, vn,
+                                     rx - vn * nx, ry - vn * ny, rz - vn * nz, s.wx[i], s.wy[i], s.wz[i],
+                                     overlap, r, r, 1.0 / s.inv_mass[i], 1.4 * r * r / s.inv_mass[i], dist};
     b.history[c] = s.wall_pairs.history.data() + static_cast<size_t>(k) * width;
     batch.contact[c] = k;
     batch.owner[c] = batch.other[c] = i;
     batch.pair[c] = false;
     batch.dx[c] = batch.dy[c] = batch.dz[c] = 0.0, batch.dist2[c] = 1.0;  // (pair_geometry's values are replaced)
+    ++batch.wall_count;
     if (++b.count == kBatch) flush(model, batch, s, work);
   }
 }
@@ -358,9 +362,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
     const std::int32_t to = kScan == Scan::kNear ? near.end[b] : work.pair_begin[last];
     list_contacts<kPeriodic, kGhosts, kScan>(model, s, work, batch, work.pair_begin[first], to, 0, owned, kept);
     if constexpr (kScan == Scan::kRefresh) near.end[b] = kept;
-    const std::vector<std::int32_t>& rows = work.wall_rows;
-    for (auto r = std::lower_bound(rows.begin(), rows.end(), first); r != rows.end() && *r < last; ++r)
-      wall_contacts(model, s, work, batch, *r);
+    wall_contacts(model, s, work, batch, work.wall_begin[first], work.wall_begin[last]);
     if constexpr (kScan == Scan::kRefresh)
       for (long i = first; i < last; ++i)
         near.x[i] = static_cast<float>(s.x[i] - s.x_built[i]), near.y[i] = static_cast<float>(s.y[i] - s.y_built[i]),

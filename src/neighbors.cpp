@@ -316,9 +316,6 @@ void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr_of_rows(work.pair_begin, s.pairs.i, n);
   build_csr_of_rows(work.wall_begin, s.wall_pairs.i, n);
-  work.wall_rows.clear();
-  for (size_t p = 0; p < s.owned(); ++p)
-    if (work.wall_begin[p] != work.wall_begin[p + 1]) work.wall_rows.push_back(static_cast<std::int32_t>(p));
   work.mesh_rows.clear();
   if (!model.meshes.empty()) {
     if (s.candidate_begin.size() != s.owned() + 1 || s.mesh_contacts.count.size() < s.owned())

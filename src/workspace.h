@@ -83,7 +83,6 @@ struct Workspace {
   // Contact-list indexing (n + 1 entries each): pairs owned by slot p are
   // [pair_begin[p], pair_begin[p+1]); wall contacts likewise.
   std::vector<std::int32_t> pair_begin, wall_begin;
-  std::vector<std::int32_t> wall_rows;  ///< owned slots with plane-wall pairs, ascending
   /// Owned slots with mesh candidates or mesh contacts when the lists were indexed, ascending:
   /// the others cannot touch a mesh before the next build (mesh_contacts.cpp).
   std::vector<std::int32_t> mesh_rows;
