@@ -51,34 +51,27 @@ namespace dem {
 
 namespace {
 
-/// The inputs of a plane-wall contact, found as the list is scanned and put into the batch's
-/// columns after pair_geometry has filled every entry as if it were a pair.
-struct WallInputs {
-  int entry, pair_type;
-  double nx, ny, nz, vn, vtx, vty, vtz, wx, wy, wz, overlap, radius, r_eff, m_eff, inertia_eff, lever;
-};
-
 /// Per-thread batch plus where each entry goes. Particle pairs and plane-wall contacts share the
 /// batch, a block's pairs in list order and then its walls, so what a particle receives is
-/// summed in an order fixed by the data alone, whatever the batch boundaries.
+/// summed in an order fixed by the data alone, whatever the batch boundaries. A batch holds a run
+/// of pairs, then a run of walls (the last wall_count entries): each block's batch is flushed at
+/// its end.
 struct Batch {
   ContactBatch b;
   std::int32_t contact[kBatch];  // index in the pair or wall list
   // Slots as 64-bit integers, so that pair_geometry's loop has no 32-bit column: mixed with
   // doubles those made GCC take 16 contacts an iteration, two registers a quantity, and spill.
   std::int64_t owner[kBatch];    // slot of body i
-  std::int64_t other[kBatch];    // slot of body j (for a wall entry: i, so the gathers stay in range)
-  bool pair[kBatch];             // particle pair, else plane wall
+  std::int64_t other[kBatch];    // slot of body j (pairs)
   double dx[kBatch], dy[kBatch], dz[kBatch], dist2[kBatch];  // [m], [m^2] centre j to centre i (pairs)
   double lever_i[kBatch], lever_j[kBatch];  // [m] centre to contact point
-  WallInputs walls[kBatch];
-  int wall_count = 0;
+  int wall_count = 0;            // plane-wall contacts: the last entries
 };
 
-/// The contact geometry of a batch of particle pairs from the distances the list pass found:
-/// normal, overlap, levers, relative motion, effective radius, mass and inertia. Gathers the
-/// bodies' columns by slot; vectorised (DEM_KERNEL).
-DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
+/// The contact geometry of the batch's particle pairs (its first `pairs` entries) from the
+/// distances the list pass found: normal, overlap, levers, relative motion, effective radius,
+/// mass and inertia. Gathers the bodies' columns by slot; vectorised (DEM_KERNEL).
+DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int pairs) {
   ContactBatch& b = batch.b;
   const double* radius = s.radius.data();
   const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
@@ -86,7 +79,7 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
   const double *wx = s.wx.data(), *wy = s.wy.data(), *wz = s.wz.data();
   const std::int32_t* material = s.material.data();
   DEM_VECTOR_LOOP
-  for (int c = 0; c < b.count; ++c) {
+  for (int c = 0; c < pairs; ++c) {
     const std::int64_t i = batch.owner[c], j = batch.other[c];
     const double ri = radius[i], rj = radius[j];
     const double dist = std::sqrt(batch.dist2[c]);
@@ -122,7 +115,7 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch) {
     batch.lever_i[c] = lever_i;
     batch.lever_j[c] = lever_j;
   }
-  for (int c = 0; c < b.count; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
+  for (int c = 0; c < pairs; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
 }
 
 /// Evaluates a full batch: adds each contact's force and torque to both bodies' totals, in list
@@ -131,25 +124,15 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   ContactBatch& b = batch.b;
   if (!b.count) return;
   const int width = model.history_width;
-  for (int c = 0; c < b.count; ++c)
-    if (batch.pair[c]) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
-  pair_geometry(s, model.n_materials(), batch);
-  for (int e = 0; e < batch.wall_count; ++e) {
-    const WallInputs& w = batch.walls[e];
-    const int c = w.entry;
-    b.nx[c] = w.nx, b.ny[c] = w.ny, b.nz[c] = w.nz, b.vn[c] = w.vn;
-    b.vtx[c] = w.vtx, b.vty[c] = w.vty, b.vtz[c] = w.vtz, b.wx[c] = w.wx, b.wy[c] = w.wy, b.wz[c] = w.wz;
-    b.pair_type[c] = w.pair_type, b.overlap[c] = w.overlap, b.radius_i[c] = w.radius, b.radius_j[c] = 0.0;
-    b.r_eff[c] = w.r_eff, b.m_eff[c] = w.m_eff, b.inertia_eff[c] = w.inertia_eff;
-    batch.lever_i[c] = w.lever, batch.lever_j[c] = 0.0;
-  }
+  const int pairs = b.count - batch.wall_count;
+  for (int c = 0; c < pairs; ++c) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
+  pair_geometry(s, model.n_materials(), batch, pairs);
   evaluate_effects(model, b);
   PairForces& pf = work.pair_forces;
   const bool keep_forces = work.keep_pair_forces;
-  ContactForces& wf = work.wall_forces;
-  for (int c = 0; c < b.count; ++c) {
+  for (int c = 0; c < pairs; ++c) {
     const std::int32_t k = batch.contact[c];
-    const std::int64_t i = batch.owner[c];
+    const std::int64_t i = batch.owner[c], j = batch.other[c];
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
     const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
@@ -159,18 +142,27 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
     s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
     s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
     s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
-    if (batch.pair[c]) {
-      const std::int64_t j = batch.other[c];
-      s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
-      s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
-      s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
-      s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
-      pf.active[k] = 1;
-      if (keep_forces) pf.fx[k] = fx, pf.fy[k] = fy, pf.fz[k] = fz;
-    } else {
-      wf.active[k] = 1;
-      wf.fx[k] = fx, wf.fy[k] = fy, wf.fz[k] = fz;
-    }
+    s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
+    s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
+    s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
+    s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
+    pf.active[k] = 1;
+    if (keep_forces) pf.fx[k] = fx, pf.fy[k] = fy, pf.fz[k] = fz;
+  }
+  ContactForces& wf = work.wall_forces;
+  for (int c = pairs; c < b.count; ++c) {
+    const std::int32_t k = batch.contact[c];
+    const std::int64_t i = batch.owner[c];
+    const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
+    const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
+    const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
+    const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
+    s.fx[i] += fx, s.fy[i] += fy, s.fz[i] += fz;
+    s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
+    s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
+    s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
+    wf.active[k] = 1;
+    wf.fx[k] = fx, wf.fy[k] = fy, wf.fz[k] = fz;
   }
   b.count = 0;
   batch.wall_count = 0;
@@ -215,6 +207,7 @@ enum class Scan { kAll, kRefresh, kNear };
 /// kPeriodic: the model wraps an axis (minimum image); kGhosts: partners outside [lo, hi) are
 /// skipped (without ghosts every partner is an owned slot, and the test is left out).
 /// kRefresh: the pairs kept as near pairs are written from `next_near` on, which is advanced.
+/// The batch holds no wall entries yet (a batch's pairs come first).
 template <bool kPeriodic, bool kGhosts, Scan kScan>
 void list_contacts(const Model& model, State& s, Workspace& work, Batch& batch, std::int32_t begin, std::int32_t end,
                    std::int32_t lo, std::int32_t hi, std::int32_t& next_near) {
@@ -242,7 +235,6 @@ void list_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     batch.dx[c] = d[0], batch.dy[c] = d[1], batch.dz[c] = d[2], batch.dist2[c] = dist2;
     batch.contact[c] = k;
     batch.owner[c] = i, batch.other[c] = j;
-    batch.pair[c] = true;
     if constexpr (kScan == Scan::kRefresh) {
       const double keep_reach = reach + near.margin;
       const bool keep = (dist2 < keep_reach * keep_reach) | (body[i] >= 0) | (attached[i] >= 0) | (body[j] >= 0) | (attached[j] >= 0);
@@ -287,14 +279,16 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     const double ry = s.vy[i] - dist * (s.wz[i] * nx - s.wx[i] * nz) - s.walls.vy[w];
     const double rz = s.vz[i] - dist * (s.wx[i] * ny - s.wy[i] * nx) - s.walls.vz[w];
     const double vn = rx * nx + ry * ny + rz * nz;
-    batch.walls[batch.wall_count] = {c, model.pair_type(s.material[i], wall.material), nx, ny, nz, vn,
-                                     rx - vn * nx, ry - vn * ny, rz - vn * nz, s.wx[i], s.wy[i], s.wz[i],
-                                     overlap, r, r, 1.0 / s.inv_mass[i], 1.4 * r * r / s.inv_mass[i], dist};
+    b.nx[c] = nx, b.ny[c] = ny, b.nz[c] = nz, b.vn[c] = vn;
+    b.vtx[c] = rx - vn * nx, b.vty[c] = ry - vn * ny, b.vtz[c] = rz - vn * nz;
+    b.wx[c] = s.wx[i], b.wy[c] = s.wy[i], b.wz[c] = s.wz[i];
+    b.pair_type[c] = model.pair_type(s.material[i], wall.material);
+    b.overlap[c] = overlap, b.radius_i[c] = r, b.radius_j[c] = 0.0, b.r_eff[c] = r;
+    b.m_eff[c] = 1.0 / s.inv_mass[i], b.inertia_eff[c] = 1.4 * r * r / s.inv_mass[i];
     b.history[c] = s.wall_pairs.history.data() + static_cast<size_t>(k) * width;
+    batch.lever_i[c] = dist;
     batch.contact[c] = k;
-    batch.owner[c] = batch.other[c] = i;
-    batch.pair[c] = false;
-    batch.dx[c] = batch.dy[c] = batch.dz[c] = 0.0, batch.dist2[c] = 1.0;  // (pair_geometry's values are replaced)
+    batch.owner[c] = i;
     ++batch.wall_count;
     if (++b.count == kBatch) flush(model, batch, s, work);
   }
