@@ -118,21 +118,18 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int
   for (int c = 0; c < pairs; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
 }
 
-/// Evaluates a full batch: adds each contact's force and torque to both bodies' totals, in list
-/// order, and keeps the force on i by contact.
-void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
-  ContactBatch& b = batch.b;
-  if (!b.count) return;
-  const int width = model.history_width;
-  const int pairs = b.count - batch.wall_count;
-  for (int c = 0; c < pairs; ++c) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
-  pair_geometry(s, model.n_materials(), batch, pairs);
-  evaluate_effects(model, b);
+/// Adds the loads of batch entries [begin, end) to the bodies' totals in entry order: of the
+/// particle pairs to both bodies (kPairs), else of the plane walls to their spheres; and keeps
+/// each contact's force on i.
+template <bool kPairs>
+[[gnu::always_inline]] inline void add_loads(const Batch& batch, State& s, Workspace& work, int begin, int end) {
+  const ContactBatch& b = batch.b;
   PairForces& pf = work.pair_forces;
-  const bool keep_forces = work.keep_pair_forces;
-  for (int c = 0; c < pairs; ++c) {
+  ContactForces& wf = work.wall_forces;
+  const bool keep_forces = !kPairs || work.keep_pair_forces;
+  for (int c = begin; c < end; ++c) {
     const std::int32_t k = batch.contact[c];
-    const std::int64_t i = batch.owner[c], j = batch.other[c];
+    const std::int64_t i = batch.owner[c];
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
     const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
@@ -142,28 +139,35 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
     s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
     s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
     s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
-    s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
-    s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
-    s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
-    s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
-    pf.active[k] = 1;
-    if (keep_forces) pf.fx[k] = fx, pf.fy[k] = fy, pf.fz[k] = fz;
+    const auto record = [&](auto& out) {
+      out.active[k] = 1;
+      if (keep_forces) out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
+    };
+    if constexpr (kPairs) {
+      const std::int64_t j = batch.other[c];
+      s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
+      s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
+      s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
+      s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
+      record(pf);
+    } else {
+      record(wf);
+    }
   }
-  ContactForces& wf = work.wall_forces;
-  for (int c = pairs; c < b.count; ++c) {
-    const std::int32_t k = batch.contact[c];
-    const std::int64_t i = batch.owner[c];
-    const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
-    const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
-    const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
-    const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
-    s.fx[i] += fx, s.fy[i] += fy, s.fz[i] += fz;
-    s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
-    s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
-    s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
-    wf.active[k] = 1;
-    wf.fx[k] = fx, wf.fy[k] = fy, wf.fz[k] = fz;
-  }
+}
+
+/// Evaluates a full batch: adds each contact's force and torque to both bodies' totals (a wall's
+/// to its sphere), in batch order, and keeps the force on i by contact.
+void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
+  ContactBatch& b = batch.b;
+  if (!b.count) return;
+  const int width = model.history_width;
+  const int pairs = b.count - batch.wall_count;
+  for (int c = 0; c < pairs; ++c) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
+  pair_geometry(s, model.n_materials(), batch, pairs);
+  evaluate_effects(model, b);
+  add_loads<true>(batch, s, work, 0, pairs);
+  add_loads<false>(batch, s, work, pairs, b.count);
   b.count = 0;
   batch.wall_count = 0;
 }
