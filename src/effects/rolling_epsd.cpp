@@ -48,7 +48,10 @@ DEM_KERNEL void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double scale = cap_to_limit(magnitude2, limit);
     x *= scale, y *= scale, z *= scale;
     const double damping_on = ctx.param(b, c, kRollingDamping) * 2.0 * std::sqrt(b.inertia_eff[c] * k_roll);
-    const double damping = full | !acting ? 0.0 : damping_on;
+    // A product, not a choice: GCC 12 did not vectorise the loop with `full | !acting ? 0 :
+    // damping_on` (the main job's rolling friction ran scalar). damping_on is finite: the
+    // normal stage's kn and the inertia are.
+    const double damping = damping_on * static_cast<double>(!full & acting);
     x = acting ? x : 0.0, y = acting ? y : 0.0, z = acting ? z : 0.0;
     sx[c] = x, sy[c] = y, sz[c] = z;
     b.mx[c] += x - damping * rx;
