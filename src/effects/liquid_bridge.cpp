@@ -20,7 +20,7 @@ namespace dem::effects {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-enum Param { kLiquidContent, kSurfaceTension, kContactAngle, kBridgesPerParticle };
+enum Param { kLiquidContent, kSurfaceTension, kContactAngle, kBridgesPerParticle, kCosAngle /* derived */ };
 
 constexpr ParamSpec kParams[] = {
     {"liquid_content", "-", 0.0, 0.0, 0.5, Mixing::arithmetic, true,
@@ -34,32 +34,37 @@ constexpr ParamSpec kParams[] = {
 };
 constexpr HistorySpec kHistory[] = {{"bridge_formed", 1}};
 
-double bridge_volume(double liquid, double bridges, double ri, double rj) {
+/// cos(theta), so that the kernel calls no libm function and vectorises.
+void derive_cos_angle(double* p) { p[kCosAngle] = std::cos(p[kContactAngle] * kPi / 180.0); }
+
+[[gnu::always_inline]] inline double bridge_volume(double liquid, double bridges, double ri, double rj) {
   const double vi = 4.0 / 3.0 * kPi * ri * ri * ri;
   const double vj = 4.0 / 3.0 * kPi * rj * rj * rj;
   return liquid * (vi + vj) / bridges;
 }
 
-void bridge_kernel(const EffectContext& ctx, ContactBatch& b) {
-  double* formed_column = ctx.hist(b, 0);  // 1 while a bridge joins the pair, else 0
+/// Without branches, so that it vectorises: the rupture test compares cubes (S^3 > S_c^3, no
+/// cube root), the bridge state and the force are chosen, not jumped to.
+DEM_KERNEL void bridge_kernel(const EffectContext& ctx, ContactBatch& b) {
+  double* formed = ctx.hist(b, 0);  // 1 while a bridge joins the pair, else 0
+  DEM_VECTOR_LOOP
   for (int c = 0; c < b.count; ++c) {
-    double* formed = &formed_column[c];
     const double liquid = ctx.param(b, c, kLiquidContent);
-    if (liquid <= 0.0) continue;
+    const bool wet = liquid > 0.0;
     const double separation = -b.overlap[c];  // [m]
-    if (separation <= 0.0) formed[0] = 1.0;
-    if (formed[0] == 0.0) continue;
     const double theta = ctx.param(b, c, kContactAngle) * kPi / 180.0;
     const double volume = bridge_volume(liquid, ctx.param(b, c, kBridgesPerParticle), b.radius_i[c], b.radius_j[c]);
-    if (separation > (1.0 + 0.5 * theta) * std::cbrt(volume)) {
-      formed[0] = 0.0;
-      continue;
-    }
+    const double reach = 1.0 + 0.5 * theta;  // S_c / V^(1/3)
+    const bool ruptured = separation * separation * separation > reach * reach * reach * volume;
+    const bool was_formed = formed[c] != 0.0;
+    const bool holds = wet & ((separation <= 0.0) | was_formed) & !ruptured;
     const double radius = 2.0 * b.r_eff[c];
-    const double s_plus = separation > 0.0 ? 0.5 * separation * std::sqrt(radius / volume) : 0.0;
-    const double force = 2.0 * kPi * radius * ctx.param(b, c, kSurfaceTension) * std::cos(theta) /
+    const double sqrt_ratio = std::sqrt(radius / (wet ? volume : 1.0));
+    const double s_plus = separation > 0.0 ? 0.5 * separation * sqrt_ratio : 0.0;
+    const double force = 2.0 * kPi * radius * ctx.param(b, c, kSurfaceTension) * ctx.param(b, c, kCosAngle) /
                          (1.0 + 2.1 * s_plus + 10.0 * s_plus * s_plus);
-    b.fn[c] -= force;
+    b.fn[c] -= holds ? force : 0.0;
+    formed[c] = static_cast<double>(holds | (!wet & was_formed));  // dry pairs keep their state
   }
 }
 
@@ -82,8 +87,8 @@ extern const EffectSpec liquid_bridge{
     .history = kHistory,
     .kernel = bridge_kernel,
     .range = bridge_range,
-    .derived_count = 0,
-    .derive = nullptr,
+    .derived_count = 1,
+    .derive = derive_cos_angle,
     .requires_normal = "",
 };
 
