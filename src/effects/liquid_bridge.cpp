@@ -20,7 +20,7 @@ namespace dem::effects {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-enum Param { kLiquidContent, kSurfaceTension, kContactAngle, kBridgesPerParticle, kCosAngle /* derived */ };
+enum Param { kLiquidContent, kSurfaceTension, kContactAngle, kBridgesPerParticle, kCosAngle, kReachCubed /* derived */ };
 
 constexpr ParamSpec kParams[] = {
     {"liquid_content", "-", 0.0, 0.0, 0.5, Mixing::arithmetic, true,
@@ -34,8 +34,14 @@ constexpr ParamSpec kParams[] = {
 };
 constexpr HistorySpec kHistory[] = {{"bridge_formed", 1}};
 
-/// cos(theta), so that the kernel calls no libm function and vectorises.
-void derive_cos_angle(double* p) { p[kCosAngle] = std::cos(p[kContactAngle] * kPi / 180.0); }
+/// cos(theta) and (S_c / V^(1/3))^3 = (1 + theta/2)^3 of a pair row, so that the kernel calls no
+/// libm function and vectorises.
+void derive_angle_terms(double* p) {
+  const double theta = p[kContactAngle] * kPi / 180.0;
+  const double reach = 1.0 + 0.5 * theta;
+  p[kCosAngle] = std::cos(theta);
+  p[kReachCubed] = reach * reach * reach;
+}
 
 [[gnu::always_inline]] inline double bridge_volume(double liquid, double bridges, double ri, double rj) {
   const double vi = 4.0 / 3.0 * kPi * ri * ri * ri;
@@ -52,10 +58,8 @@ DEM_KERNEL void bridge_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double liquid = ctx.param(b, c, kLiquidContent);
     const bool wet = liquid > 0.0;
     const double separation = -b.overlap[c];  // [m]
-    const double theta = ctx.param(b, c, kContactAngle) * kPi / 180.0;
     const double volume = bridge_volume(liquid, ctx.param(b, c, kBridgesPerParticle), b.radius_i[c], b.radius_j[c]);
-    const double reach = 1.0 + 0.5 * theta;  // S_c / V^(1/3)
-    const bool ruptured = separation * separation * separation > reach * reach * reach * volume;
+    const bool ruptured = separation * separation * separation > ctx.param(b, c, kReachCubed) * volume;
     const bool was_formed = formed[c] != 0.0;
     const bool holds = wet & ((separation <= 0.0) | was_formed) & !ruptured;
     const double radius = 2.0 * b.r_eff[c];
@@ -87,8 +91,8 @@ extern const EffectSpec liquid_bridge{
     .history = kHistory,
     .kernel = bridge_kernel,
     .range = bridge_range,
-    .derived_count = 1,
-    .derive = derive_cos_angle,
+    .derived_count = 2,
+    .derive = derive_angle_terms,
     .requires_normal = "",
 };
 
