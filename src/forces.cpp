@@ -124,35 +124,36 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int
 template <bool kPairs>
 [[gnu::always_inline]] inline void add_loads(const Batch& batch, State& s, Workspace& work, int begin, int end) {
   const ContactBatch& b = batch.b;
-  PairForces& pf = work.pair_forces;
+  // The columns' addresses held in locals: the byte stored to `active` may alias anything, so
+  // read through the vectors they would be loaded again after it, a dozen loads a contact.
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
   ContactForces& wf = work.wall_forces;
+  PairForces& pf = work.pair_forces;
+  std::uint8_t* active = kPairs ? pf.active.data() : wf.active.data();
+  double *kept_x = kPairs ? pf.fx.data() : wf.fx.data(), *kept_y = kPairs ? pf.fy.data() : wf.fy.data(),
+         *kept_z = kPairs ? pf.fz.data() : wf.fz.data();
   const bool keep_forces = !kPairs || work.keep_pair_forces;
   for (int c = begin; c < end; ++c) {
     const std::int32_t k = batch.contact[c];
     const std::int64_t i = batch.owner[c];
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
-    const double fx = b.fn[c] * nx + ftx, fy = b.fn[c] * ny + fty, fz = b.fn[c] * nz + ftz;
+    const double f_x = b.fn[c] * nx + ftx, f_y = b.fn[c] * ny + fty, f_z = b.fn[c] * nz + ftz;
     // Torque of the tangential force about each centre: (-lever n) x ft; plus rolling torque.
     const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
-    s.fx[i] += fx, s.fy[i] += fy, s.fz[i] += fz;
-    s.tx[i] += -batch.lever_i[c] * cx + b.mx[c];
-    s.ty[i] += -batch.lever_i[c] * cy + b.my[c];
-    s.tz[i] += -batch.lever_i[c] * cz + b.mz[c];
-    const auto record = [&](auto& out) {
-      out.active[k] = 1;
-      if (keep_forces) out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
-    };
+    fx[i] += f_x, fy[i] += f_y, fz[i] += f_z;
+    tx[i] += -batch.lever_i[c] * cx + b.mx[c];
+    ty[i] += -batch.lever_i[c] * cy + b.my[c];
+    tz[i] += -batch.lever_i[c] * cz + b.mz[c];
     if constexpr (kPairs) {
       const std::int64_t j = batch.other[c];
-      s.fx[j] -= fx, s.fy[j] -= fy, s.fz[j] -= fz;
-      s.tx[j] += -batch.lever_j[c] * cx - b.mx[c];
-      s.ty[j] += -batch.lever_j[c] * cy - b.my[c];
-      s.tz[j] += -batch.lever_j[c] * cz - b.mz[c];
-      record(pf);
-    } else {
-      record(wf);
+      fx[j] -= f_x, fy[j] -= f_y, fz[j] -= f_z;
+      tx[j] += -batch.lever_j[c] * cx - b.mx[c];
+      ty[j] += -batch.lever_j[c] * cy - b.my[c];
+      tz[j] += -batch.lever_j[c] * cz - b.mz[c];
     }
+    active[k] = 1;
+    if (keep_forces) kept_x[k] = f_x, kept_y[k] = f_y, kept_z[k] = f_z;
   }
 }
 
