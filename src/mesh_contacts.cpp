@@ -107,22 +107,29 @@ struct MeshBatch {
 void flush(const Model& model, MeshBatch& mb, State& s, ContactForces& out, MeshSlotResults& slot_results) {
   ContactBatch& b = mb.b;
   evaluate_effects(model, b);
+  // The columns' addresses in locals: the byte stored to `active` may alias anything, and the
+  // vectors' data pointers would be loaded again after it for every contact (forces.cpp).
+  double *fx_sum = s.fx.data(), *fy_sum = s.fy.data(), *fz_sum = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  double *out_x = out.fx.data(), *out_y = out.fy.data(), *out_z = out.fz.data();
+  std::uint8_t* active = out.active.data();
+  double *fn = slot_results.fn.data(), *shear_power = slot_results.shear_power.data(), *wall_power = slot_results.wall_power.data();
+  double *px = slot_results.cx.data(), *py = slot_results.cy.data(), *pz = slot_results.cz.data();
   for (int c = 0; c < b.count; ++c) {
     const std::int32_t k = mb.result[c];
     const std::size_t p = static_cast<std::size_t>(mb.slot[c]) / kSlots;
     const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
     const double fx = b.fn[c] * nx + b.ftx[c], fy = b.fn[c] * ny + b.fty[c], fz = b.fn[c] * nz + b.ftz[c];
-    out.fx[k] = fx, out.fy[k] = fy, out.fz[k] = fz;
+    out_x[k] = fx, out_y[k] = fy, out_z[k] = fz;
     const double cx = ny * b.ftz[c] - nz * b.fty[c], cy = nz * b.ftx[c] - nx * b.ftz[c], cz = nx * b.fty[c] - ny * b.ftx[c];
-    s.fx[p] += fx, s.fy[p] += fy, s.fz[p] += fz;
-    s.tx[p] += -mb.lever[c] * cx + b.mx[c];
-    s.ty[p] += -mb.lever[c] * cy + b.my[c];
-    s.tz[p] += -mb.lever[c] * cz + b.mz[c];
-    out.active[k] = 1;
-    slot_results.fn[k] = b.fn[c];
-    slot_results.shear_power[k] = std::abs(b.ftx[c] * b.vtx[c] + b.fty[c] * b.vty[c] + b.ftz[c] * b.vtz[c]);
-    slot_results.cx[k] = mb.point[c][0], slot_results.cy[k] = mb.point[c][1], slot_results.cz[k] = mb.point[c][2];
-    slot_results.wall_power[k] = fx * mb.wall_v[c][0] + fy * mb.wall_v[c][1] + fz * mb.wall_v[c][2];
+    fx_sum[p] += fx, fy_sum[p] += fy, fz_sum[p] += fz;
+    tx[p] += -mb.lever[c] * cx + b.mx[c];
+    ty[p] += -mb.lever[c] * cy + b.my[c];
+    tz[p] += -mb.lever[c] * cz + b.mz[c];
+    active[k] = 1;
+    fn[k] = b.fn[c];
+    shear_power[k] = std::abs(b.ftx[c] * b.vtx[c] + b.fty[c] * b.vty[c] + b.ftz[c] * b.vtz[c]);
+    px[k] = mb.point[c][0], py[k] = mb.point[c][1], pz[k] = mb.point[c][2];
+    wall_power[k] = fx * mb.wall_v[c][0] + fy * mb.wall_v[c][1] + fz * mb.wall_v[c][2];
   }
   b.count = 0;
 }
