@@ -65,6 +65,8 @@ struct Batch {
   std::int64_t other[kBatch];    // slot of body j (pairs)
   double dx[kBatch], dy[kBatch], dz[kBatch], dist2[kBatch];  // [m], [m^2] centre j to centre i (pairs)
   double lever_i[kBatch], lever_j[kBatch];  // [m] centre to contact point
+  // What each contact adds (load_terms): force on i [N], torques on i and on j [N m].
+  double force[3][kBatch], torque_i[3][kBatch], torque_j[3][kBatch];
   int wall_count = 0;            // plane-wall contacts: the last entries
 };
 
@@ -118,12 +120,31 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int
   for (int c = 0; c < pairs; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
 }
 
-/// Adds the loads of batch entries [begin, end) to the bodies' totals in entry order: of the
-/// particle pairs to both bodies (kPairs), else of the plane walls to their spheres; and keeps
-/// each contact's force on i.
+/// The loads of batch entries [begin, end), vectorised (DEM_KERNEL): the force on i, F = fn n +
+/// ft, and the torques of ft about each centre, (-lever n) x ft, plus the rolling torque (on j:
+/// minus it).
+DEM_KERNEL void load_terms(Batch& batch, int begin, int end) {
+  const ContactBatch& b = batch.b;
+  DEM_VECTOR_LOOP
+  for (int c = begin; c < end; ++c) {
+    const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
+    const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
+    batch.force[0][c] = b.fn[c] * nx + ftx, batch.force[1][c] = b.fn[c] * ny + fty, batch.force[2][c] = b.fn[c] * nz + ftz;
+    const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
+    batch.torque_i[0][c] = -batch.lever_i[c] * cx + b.mx[c];
+    batch.torque_i[1][c] = -batch.lever_i[c] * cy + b.my[c];
+    batch.torque_i[2][c] = -batch.lever_i[c] * cz + b.mz[c];
+    batch.torque_j[0][c] = -batch.lever_j[c] * cx - b.mx[c];
+    batch.torque_j[1][c] = -batch.lever_j[c] * cy - b.my[c];
+    batch.torque_j[2][c] = -batch.lever_j[c] * cz - b.mz[c];
+  }
+}
+
+/// Adds the loads of batch entries [begin, end) (load_terms) to the bodies' totals in entry
+/// order: of the particle pairs to both bodies (kPairs), else of the plane walls to their
+/// spheres; and keeps each contact's force on i. Scalar: a body can appear twice in a batch.
 template <bool kPairs>
 [[gnu::always_inline]] inline void add_loads(const Batch& batch, State& s, Workspace& work, int begin, int end) {
-  const ContactBatch& b = batch.b;
   // The columns' addresses held in locals: the byte stored to `active` may alias anything, so
   // read through the vectors they would be loaded again after it, a dozen loads a contact.
   double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
@@ -133,24 +154,17 @@ template <bool kPairs>
   double *kept_x = kPairs ? pf.fx.data() : wf.fx.data(), *kept_y = kPairs ? pf.fy.data() : wf.fy.data(),
          *kept_z = kPairs ? pf.fz.data() : wf.fz.data();
   const bool keep_forces = !kPairs || work.keep_pair_forces;
+  const auto &force = batch.force, &torque_i = batch.torque_i, &torque_j = batch.torque_j;
   for (int c = begin; c < end; ++c) {
     const std::int32_t k = batch.contact[c];
     const std::int64_t i = batch.owner[c];
-    const double nx = b.nx[c], ny = b.ny[c], nz = b.nz[c];
-    const double ftx = b.ftx[c], fty = b.fty[c], ftz = b.ftz[c];
-    const double f_x = b.fn[c] * nx + ftx, f_y = b.fn[c] * ny + fty, f_z = b.fn[c] * nz + ftz;
-    // Torque of the tangential force about each centre: (-lever n) x ft; plus rolling torque.
-    const double cx = ny * ftz - nz * fty, cy = nz * ftx - nx * ftz, cz = nx * fty - ny * ftx;  // n x ft
+    const double f_x = force[0][c], f_y = force[1][c], f_z = force[2][c];
     fx[i] += f_x, fy[i] += f_y, fz[i] += f_z;
-    tx[i] += -batch.lever_i[c] * cx + b.mx[c];
-    ty[i] += -batch.lever_i[c] * cy + b.my[c];
-    tz[i] += -batch.lever_i[c] * cz + b.mz[c];
+    tx[i] += torque_i[0][c], ty[i] += torque_i[1][c], tz[i] += torque_i[2][c];
     if constexpr (kPairs) {
       const std::int64_t j = batch.other[c];
       fx[j] -= f_x, fy[j] -= f_y, fz[j] -= f_z;
-      tx[j] += -batch.lever_j[c] * cx - b.mx[c];
-      ty[j] += -batch.lever_j[c] * cy - b.my[c];
-      tz[j] += -batch.lever_j[c] * cz - b.mz[c];
+      tx[j] += torque_j[0][c], ty[j] += torque_j[1][c], tz[j] += torque_j[2][c];
     }
     active[k] = 1;
     if (keep_forces) kept_x[k] = f_x, kept_y[k] = f_y, kept_z[k] = f_z;
@@ -167,6 +181,7 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   for (int c = 0; c < pairs; ++c) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
   pair_geometry(s, model.n_materials(), batch, pairs);
   evaluate_effects(model, b);
+  load_terms(batch, 0, b.count);
   add_loads<true>(batch, s, work, 0, pairs);
   add_loads<false>(batch, s, work, pairs, b.count);
   b.count = 0;
