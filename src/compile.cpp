@@ -79,6 +79,7 @@ void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, in
   if (model.history_width > kHistoryMax)
     throw std::logic_error(fmt::format("contact history of {} doubles exceeds kHistoryMax = {} (src/effect.h)", model.history_width, kHistoryMax));
   param_cursor += static_cast<int>(spec->params.size()) + spec->derived_count;
+  model.spin_inputs |= spec->reads_spin;
   model.effects.push_back(active);
 }
 

@@ -82,7 +82,9 @@ struct ContactBatch {
   double nx[kBatch], ny[kBatch], nz[kBatch];  ///< unit normal, from body j towards body i
   double vn[kBatch];                  ///< [m/s] normal relative velocity (v_i - v_j)·n, < 0 approaching
   double vtx[kBatch], vty[kBatch], vtz[kBatch];  ///< [m/s] tangential relative velocity at the contact
-  double wx[kBatch], wy[kBatch], wz[kBatch];     ///< [rad/s] relative angular velocity w_i - w_j
+  /// [rad/s] relative angular velocity w_i - w_j; with inertia_eff, set for particle pairs only
+  /// when an effect reads them (EffectSpec::reads_spin)
+  double wx[kBatch], wy[kBatch], wz[kBatch];
   double radius_i[kBatch];            ///< [m]
   double radius_j[kBatch];            ///< [m] 0 for a wall (flat, infinite radius)
   double r_eff[kBatch];               ///< [m] R* = R_i R_j/(R_i + R_j), R_i for a wall
@@ -147,6 +149,9 @@ struct EffectSpec {
   void (*derive)(double* row_params) = nullptr;
   /// Effects this one is written for (e.g. JKR adds to Hertz); empty: any.
   std::string_view requires_normal;
+  /// Reads the batch's spin inputs (wx, wy, wz, inertia_eff), which the particle pairs' geometry
+  /// computes only when an active effect reads them (forces.cpp).
+  bool reads_spin = false;
 };
 
 /// The checked-in table of every effect (src/effect_table.cpp).

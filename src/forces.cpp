@@ -72,8 +72,12 @@ struct Batch {
 
 /// The contact geometry of the batch's particle pairs (its first `pairs` entries) from the
 /// distances the list pass found: normal, overlap, levers, relative motion, effective radius,
-/// mass and inertia. Gathers the bodies' columns by slot; vectorised (DEM_KERNEL).
-DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int pairs) {
+/// mass and inertia. Gathers the bodies' columns by slot; vectorised (DEM_KERNEL below).
+/// kSpin: also the relative spin and the reduced moment of inertia, which only some effects
+/// read (EffectSpec::reads_spin; without: two gathers and four stores a contact less, B1 20k
+/// +6 % settle, +3 % dense).
+template <bool kSpin>
+[[gnu::always_inline]] inline void pair_geometry_loop(const State& s, int n_materials, Batch& batch, int pairs) {
   ContactBatch& b = batch.b;
   const double* radius = s.radius.data();
   const double *inv_mass = s.inv_mass.data(), *inv_inertia = s.inv_inertia.data();
@@ -87,10 +91,10 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int
     const double dist = std::sqrt(batch.dist2[c]);
     // Four reciprocals from one division (the divider is the slow unit here): 1/dist, and those
     // of the sums of radii, inverse masses and inverse moments of inertia.
-    const double sum_r = ri + rj, sum_m = inv_mass[i] + inv_mass[j], sum_ii = inv_inertia[i] + inv_inertia[j];
-    const double dr = dist * sum_r, mi = sum_m * sum_ii;
+    const double sum_r = ri + rj, sum_m = inv_mass[i] + inv_mass[j], sum_ii = kSpin ? inv_inertia[i] + inv_inertia[j] : 1.0;
+    const double dr = dist * sum_r, mi = kSpin ? sum_m * sum_ii : sum_m;
     const double q = 1.0 / (dr * mi);
-    const double inv_dist = q * sum_r * mi, inv_sum_r = q * dist * mi, inv_sum_m = q * dr * sum_ii, inv_sum_ii = q * dr * sum_m;
+    const double inv_dist = q * sum_r * mi, inv_sum_r = q * dist * mi, inv_sum_m = kSpin ? q * dr * sum_ii : q * dr, inv_sum_ii = q * dr * sum_m;
     const double nx = batch.dx[c] * inv_dist, ny = batch.dy[c] * inv_dist, nz = batch.dz[c] * inv_dist;
     const double overlap = ri + rj - dist;
     const double lever_i = ri - 0.5 * overlap, lever_j = rj - 0.5 * overlap;
@@ -106,18 +110,23 @@ DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int
     b.nx[c] = nx, b.ny[c] = ny, b.nz[c] = nz;
     b.vn[c] = vn;
     b.vtx[c] = rx - vn * nx, b.vty[c] = ry - vn * ny, b.vtz[c] = rz - vn * nz;
-    b.wx[c] = wx[i] - wx[j], b.wy[c] = wy[i] - wy[j], b.wz[c] = wz[i] - wz[j];
+    if constexpr (kSpin) b.wx[c] = wx[i] - wx[j], b.wy[c] = wy[i] - wy[j], b.wz[c] = wz[i] - wz[j];
     b.overlap[c] = overlap;
     b.radius_i[c] = ri;
     b.radius_j[c] = rj;
     b.r_eff[c] = ri * rj * inv_sum_r;
     b.m_eff[c] = inv_sum_m;
     // Moments of inertia about the contact point, 7/5 m R^2 = 3.5 I for a sphere (I = 2/5 m R^2).
-    b.inertia_eff[c] = 3.5 * inv_sum_ii;
+    if constexpr (kSpin) b.inertia_eff[c] = 3.5 * inv_sum_ii;
     batch.lever_i[c] = lever_i;
     batch.lever_j[c] = lever_j;
   }
   for (int c = 0; c < pairs; ++c) b.pair_type[c] = material[batch.owner[c]] * n_materials + material[batch.other[c]];
+}
+
+DEM_KERNEL void pair_geometry(const State& s, int n_materials, Batch& batch, int pairs) { pair_geometry_loop<true>(s, n_materials, batch, pairs); }
+DEM_KERNEL void pair_geometry_without_spin(const State& s, int n_materials, Batch& batch, int pairs) {
+  pair_geometry_loop<false>(s, n_materials, batch, pairs);
 }
 
 /// The loads of batch entries [begin, end), vectorised (DEM_KERNEL): the force on i, F = fn n +
@@ -179,7 +188,7 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   const int width = model.history_width;
   const int pairs = b.count - batch.wall_count;
   for (int c = 0; c < pairs; ++c) b.history[c] = s.pairs.history.data() + static_cast<size_t>(batch.contact[c]) * width;
-  pair_geometry(s, model.n_materials(), batch, pairs);
+  (model.spin_inputs ? pair_geometry : pair_geometry_without_spin)(s, model.n_materials(), batch, pairs);
   evaluate_effects(model, b);
   load_terms(batch, 0, b.count);
   add_loads<true>(batch, s, work, 0, pairs);

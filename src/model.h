@@ -120,6 +120,7 @@ struct Model {
   // Contact law: effects in stage order, parameters per material pair.
   std::vector<ActiveEffect> effects;
   int history_width = 0;           ///< doubles of history per contact
+  bool spin_inputs = false;        ///< some effect reads the batch's spin inputs (EffectSpec::reads_spin)
   std::vector<std::uint8_t> history_odd;  ///< per history double: 1 when it changes sign as i and j swap
   int pair_stride = 0;             ///< doubles per pair row: E*, G*, then each effect's params
   std::vector<double> pair_table;  ///< (n_materials^2 x pair_stride)

@@ -250,7 +250,10 @@ TEST(DomainMpi, ClumpPourMatchesTheSingleRankRun) {
   EXPECT_LT(worst, 1e-12) << "a sphere left its clump";
   EXPECT_NEAR(b.wall_normal_force[0], weight, 0.05 * weight) << "the floor carries the clumps";
   EXPECT_NEAR(zb, za, 0.03 * za) << "mean height of the clumps";
-  EXPECT_NEAR(static_cast<double>(b.contacts), static_cast<double>(a.contacts), 0.05 * a.contacts) << "contacts";
+  // The pile still moves at 0.3 s, and its contacts come and go: four runs that differ in the
+  // last bits only (whole and split, each with two roundings of the pair geometry) had 860,
+  // 906, 913 and 932 (a spread of 3 %), so two runs may differ by 5 % and more by chance.
+  EXPECT_NEAR(static_cast<double>(b.contacts), static_cast<double>(a.contacts), 0.12 * a.contacts) << "contacts";
 }
 
 TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {

@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <set>
@@ -430,6 +432,24 @@ TEST(Effects, EveryEffectTogetherFitsTheBatchHistoryColumns) {
     for (const HistorySpec& h : e->history) width += h.width;
   EXPECT_GT(width, 0);
   EXPECT_LE(width, kHistoryMax);
+}
+
+// The particle pairs' geometry leaves the spin inputs (relative spin, reduced moment of
+// inertia) unset unless an active effect declares that it reads them (EffectSpec::reads_spin):
+// an effect that read them undeclared would see garbage. Each effect is one file of
+// src/effects/ (its name its table entry's); the files that index those columns must declare it.
+TEST(Effects, EffectsThatReadTheSpinInputsDeclareIt) {
+  int readers = 0;
+  for (const auto& file : std::filesystem::directory_iterator(DEMDESIGN_SOURCE_DIR "/src/effects")) {
+    if (file.path().extension() != ".cpp") continue;
+    std::ifstream in(file.path());
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bool reads = false;
+    for (const char* column : {"b.wx[", "b.wy[", "b.wz[", "b.inertia_eff["}) reads |= text.find(column) != std::string::npos;
+    readers += reads;
+    EXPECT_EQ(reads, text.find(".reads_spin = true") != std::string::npos) << file.path() << " reads the spin inputs: declare .reads_spin = true";
+  }
+  EXPECT_GE(readers, 2) << "the rolling-resistance effects read them";
 }
 
 TEST(Particles, DiscreteDistributionHonoursMassFractions) {

@@ -52,6 +52,7 @@ extern const EffectSpec rolling_cdt{
     .derived_count = 0,
     .derive = nullptr,
     .requires_normal = "",
+    .reads_spin = true,
 };
 
 }  // namespace dem::effects

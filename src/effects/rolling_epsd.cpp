@@ -76,6 +76,7 @@ extern const EffectSpec rolling_epsd{
     .derived_count = 0,
     .derive = nullptr,
     .requires_normal = "",
+    .reads_spin = true,
 };
 
 }  // namespace dem::effects
