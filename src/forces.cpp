@@ -92,10 +92,11 @@ template <bool kSpin>
     const double dist = std::sqrt(batch.dist2[c]);
     // Four reciprocals from one division (the divider is the slow unit here): 1/dist, and those
     // of the sums of radii, inverse masses and inverse moments of inertia.
+    // Without spin, sum_ii = 1 (a product by 1 is exact: the other reciprocals are unchanged).
     const double sum_r = ri + rj, sum_m = inv_mass[i] + inv_mass[j], sum_ii = kSpin ? inv_inertia[i] + inv_inertia[j] : 1.0;
-    const double dr = dist * sum_r, mi = kSpin ? sum_m * sum_ii : sum_m;
+    const double dr = dist * sum_r, mi = sum_m * sum_ii;
     const double q = 1.0 / (dr * mi);
-    const double inv_dist = q * sum_r * mi, inv_sum_r = q * dist * mi, inv_sum_m = kSpin ? q * dr * sum_ii : q * dr, inv_sum_ii = q * dr * sum_m;
+    const double inv_dist = q * sum_r * mi, inv_sum_r = q * dist * mi, inv_sum_m = q * dr * sum_ii, inv_sum_ii = q * dr * sum_m;
     const double nx = batch.dx[c] * inv_dist, ny = batch.dy[c] * inv_dist, nz = batch.dz[c] * inv_dist;
     const double overlap = ri + rj - dist;
     const double lever_i = ri - 0.5 * overlap, lever_j = rj - 0.5 * overlap;
