@@ -185,7 +185,7 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
     for (const auto& c : in.diagnosis->candidates) {
       std::string adds;
       for (const auto& a : c.adds) adds += (adds.empty() ? "" : ", ") + esc(a.key);
-      h += row({esc(c.name), adds, fmt::format("{:.0f} %", 100 * c.explained), c.confirmed ? num(c.fit.after.chi2_per_n(), 3) : "&ndash;",
+      h += row({esc(c.name) + "<br><small>" + esc(c.title) + "</small>", adds, fmt::format("{:.0f} %", 100 * c.explained), c.confirmed ? num(c.fit.after.chi2_per_n(), 3) : "&ndash;",
                 c.confirmed ? num(c.bic, 4) : "&ndash;", c.confirmed ? num(c.delta_bic, 3) : "&ndash;", esc(c.description)});
     }
     h += "</table>\n<p class=\"note\">explains: fraction of the calibrated model's chi&sup2; that a least-squares multiple of the effect's signature "
@@ -194,7 +194,7 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
     h += comparison_section(in.diagnosis->base.before, "The starting model", dir, "start");
     h += calibration_section(in.diagnosis->base, dir, "base", "The model as it is, calibrated");
     for (const auto& c : in.diagnosis->candidates)
-      if (c.confirmed) h += calibration_section(c.fit, dir, "cand_" + c.name, "With " + c.name + ", recalibrated");
+      if (c.confirmed) h += calibration_section(c.fit, dir, "cand_" + c.name, "With " + c.title + " (" + c.name + "), recalibrated");
   } else if (in.calibration) {
     h += comparison_section(in.calibration->before, "Before calibration", dir, "before");
     h += calibration_section(*in.calibration, dir, "fit", "Calibration");

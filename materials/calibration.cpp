@@ -143,10 +143,7 @@ std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::
       continue;
     }
     (void)get_parameter(model, key);  // throws for an unknown key
-    const ParamSpec* spec = nullptr;
-    for (const EffectSpec* e : effect_table())
-      for (const ParamSpec& p : e->params)
-        if (p.key == key) spec = &p;
+    const ParamSpec* spec = find_param(key);
     if (!spec || !spec->tunable)
       throw std::invalid_argument(fmt::format("'{}' has no calibration range: declare it under `tunable:` in the material file", key));
     out.push_back({key, spec->min_value, spec->max_value});

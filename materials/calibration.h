@@ -88,7 +88,7 @@ struct CalibrationOptions {
   /// Raftery 1995).
   double rival_margin = 6.0;
   int confirm_candidates = 2;       ///< leading candidates confirmed by recalibration
-  /// Effects diagnose considers (names of missing_effects); empty: every effect the model lacks.
+  /// Effects diagnose considers (names of candidate_names()); empty: every effect the model lacks.
   std::vector<std::string> effects;
   /// Progress lines (with time left); empty: quiet.
   std::function<void(const std::string&)> progress;
@@ -240,7 +240,9 @@ ContourMap contour_map(const CalibrationResult& result, int px, int py, int grid
 // ---- diagnosis ----------------------------------------------------------------------------
 
 struct CandidateResult {
-  std::string name, description;
+  std::string name, title, description;
+  std::string why;        ///< why its signature fits a misfit (the effect's own words)
+  std::string switch_on;  ///< the YAML that switches it on
   std::vector<FitParameter> adds;    ///< parameters the effect adds to the fit
   std::vector<double> signature;     ///< per term of the base comparison: change in units of its sigma
   double explained = 0;              ///< fraction of the base chi^2 the signature could remove
@@ -271,7 +273,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
 /// One model version with its error on every experiment.
 struct LedgerEntry {
   int version = 0;
-  std::string label;   ///< "start", "calibrated", "+ liquid_bridges", ...
+  std::string label;   ///< "start", "calibrated", "+ liquid_bridge", ...
   std::string time;    ///< local time of the run
   std::vector<std::string> effects;               ///< contact effects switched on (and clump shape)
   std::map<std::string, double> parameters;       ///< fitted (or tunable) parameter values

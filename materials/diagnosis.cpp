@@ -25,19 +25,6 @@ using detail::simulate_experiments;
 
 double bic(double chi2, int k, int n) { return chi2 + k * std::log(static_cast<double>(std::max(n, 1))); }
 
-namespace {
-
-/// Why an effect fits the residual pattern, in words.
-std::string physics_words(const std::string& effect) {
-  if (effect == "rolling_resistance") return "heaps and drum beds stand steeper than spheres allow while single contacts fit: resistance to rolling (particle shape, roughness)";
-  if (effect == "liquid_bridges") return "strength that does not come from the load (steeper heaps, looser packing, slower or blocked discharge, a yield locus offset by a constant): cohesion (liquid bridges)";
-  if (effect == "jkr_cohesion") return "strength that does not come from the load: cohesion (van der Waals, JKR adhesion)";
-  if (effect == "clump_shape") return "interlocking of non-spherical particles (steeper heaps, higher shear strength, looser packing)";
-  return "the effect's signature matches the residuals";
-}
-
-}  // namespace
-
 Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& options) {
   Diagnosis d;
   if (parameters.empty()) parameters = fit_parameters(model);
@@ -70,6 +57,10 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   }
   // The candidates: every effect the model lacks, or those options.effects names.
   std::vector<EffectCandidate> effects;
+  const std::vector<std::string> known = candidate_names();
+  for (const std::string& name : options.effects)
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw std::invalid_argument(fmt::format("--effects: '{}' is not a candidate effect; valid: {}", name, join(known, ", ")));
   for (EffectCandidate& c : missing_effects(d.base.fitted))
     if (options.effects.empty() || std::find(options.effects.begin(), options.effects.end(), c.name) != options.effects.end())
       effects.push_back(std::move(c));
@@ -107,7 +98,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     }
     d.candidates.push_back(std::move(cr));
   }
-  std::sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
+  std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
 
   if (fits) {
     d.words.push_back(fmt::format("No effect recommended: the model as it is fits within the noise after calibration (chi^2/n = {:.2f} <= {:.2g}).",
@@ -147,10 +138,10 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       std::vector<std::string> misfits;
       for (const Pattern& p : d.base.after.patterns)
         if (p.kind != "fits") misfits.push_back(p.words);
-      d.words.push_back(fmt::format("Most likely missing: {}. {} It could explain {:.0f} % of the weighted residual of the calibrated model; "
+      d.words.push_back(fmt::format("Most likely missing: {} ({}; switch it on with `{}`). Why: {}. It could explain {:.0f} % of the weighted residual of the calibrated model; "
                                     "added and recalibrated, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} "
                                     "(by {:.1f} > margin {:.0f}, with {} more parameter{}).",
-                                    best->name, "Why: " + physics_words(best->name) + ".", 100 * best->explained, base.chi2_per_n(),
+                                    best->name, best->title, best->switch_on, best->why, 100 * best->explained, base.chi2_per_n(),
                                     best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
                                     best->adds.size() == 1 ? "" : "s"));
       if (!misfits.empty()) d.words.push_back("Where the model without it fails: " + join(misfits, " "));
@@ -160,7 +151,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
           d.words.push_back(fmt::format("These data do not tell {} from {}: added instead and recalibrated, {} reaches BIC {:.1f}, only "
                                         "{:.1f} above (< {:.0f}, no strong evidence). Measure where the two act differently to decide ({}: {}; {}: {}).",
                                         best->name, c.name, c.name, c.bic, c.bic - best->bic, options.rival_margin, best->name,
-                                        physics_words(best->name), c.name, physics_words(c.name)));
+                                        best->why, c.name, c.why));
         }
     } else {
       d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}) but no candidate lowers BIC by more than {:.0f}{}.",

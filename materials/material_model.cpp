@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <type_traits>
 
 #include "effect.h"
 #include "library.h"
@@ -21,13 +22,6 @@ namespace dem::materials {
 namespace {
 
 namespace fs = std::filesystem;
-
-const ParamSpec* find_param_spec(const std::string& key) {
-  for (const EffectSpec* e : effect_table())
-    for (const ParamSpec& p : e->params)
-      if (p.key == key) return &p;
-  return nullptr;
-}
 
 std::vector<std::string> parameter_keys() {
   std::vector<std::string> keys = {"density", "youngs_modulus", "poisson_ratio", "clump_aspect_ratio"};
@@ -46,7 +40,7 @@ std::string wall_library_file(const fs::path& dir, const std::string& name) {
 double param_value(const std::map<std::string, double>& params, const std::string& key) {
   const auto it = params.find(key);
   if (it != params.end()) return it->second;
-  const ParamSpec* p = find_param_spec(key);
+  const ParamSpec* p = find_param(key);
   return p ? p->default_value : std::nan("");
 }
 
@@ -173,12 +167,12 @@ double get_parameter(const MaterialModel& model, const std::string& key) {
   const auto dot = key.find('.');
   if (dot != std::string::npos) {
     const std::string wall = key.substr(0, dot), param = key.substr(dot + 1);
-    if (!find_param_spec(param)) unknown_key(key);
+    if (!find_param(param)) unknown_key(key);
     for (const InteractionSpec& in : model.wall_pairs)
       if (wall == "wall" || in.material_a == wall || in.material_b == wall) return param_value(in.params, param);
     throw std::invalid_argument(fmt::format("'{}': the model has no particle-wall pair{}", key, wall == "wall" ? "" : " with " + wall));
   }
-  if (!find_param_spec(key)) unknown_key(key);
+  if (!find_param(key)) unknown_key(key);
   return param_value(model.particle.params, key);
 }
 
@@ -192,14 +186,14 @@ void set_parameter(MaterialModel& model, const std::string& key, double value) {
     model.shape = {two_sphere_clump(value)};
   } else if (const auto dot = key.find('.'); dot != std::string::npos) {
     const std::string wall = key.substr(0, dot), param = key.substr(dot + 1);
-    const ParamSpec* p = find_param_spec(param);
+    const ParamSpec* p = find_param(param);
     if (!p) unknown_key(key);
     bool any = false;
     for (InteractionSpec& in : model.wall_pairs)
       if (wall == "wall" || in.material_a == wall || in.material_b == wall) in.params[param] = std::clamp(value, p->min_value, p->max_value), any = true;
     if (!any) throw std::invalid_argument(fmt::format("'{}': the model has no particle-wall pair{}", key, wall == "wall" ? "" : " with " + wall));
   } else {
-    const ParamSpec* p = find_param_spec(key);
+    const ParamSpec* p = find_param(key);
     if (!p) unknown_key(key);
     if (value < p->min_value || value > p->max_value)
       throw std::invalid_argument(fmt::format("{} = {:g} out of range; valid: [{:g}, {:g}] {}", key, value, p->min_value, p->max_value, p->unit));
@@ -208,64 +202,100 @@ void set_parameter(MaterialModel& model, const std::string& key, double value) {
   model.particle.sources[key] = "calibrated";
 }
 
+namespace {
+
+/// The choices of an additive stage (nullptr for a single one); Contact is ContactSpec, const or not.
+template <class Contact>
+auto* additive_choices(Contact& contact, Stage stage) {
+  return stage == Stage::adhesion ? &contact.adhesion : stage == Stage::extra ? &contact.extra : nullptr;
+}
+
+/// The choice of a single stage (nullptr for an additive one).
+template <class Contact>
+auto* single_choice(Contact& contact, Stage stage) {
+  using Choice = std::remove_reference_t<decltype((contact.normal))>;
+  switch (stage) {
+    case Stage::normal: return &contact.normal;
+    case Stage::damping: return &contact.damping;
+    case Stage::tangential: return &contact.tangential;
+    case Stage::rolling: return &contact.rolling;
+    case Stage::twisting: return &contact.twisting;
+    default: return static_cast<Choice*>(nullptr);
+  }
+}
+
+/// Whether `effect` could be added to the contact model: its stage is free and its normal
+/// model is there.
+bool stage_free(const ContactSpec& contact, const EffectSpec& effect) {
+  if (!effect.requires_normal.empty() && contact.normal.model != effect.requires_normal) return false;
+  if (const auto* choices = additive_choices(contact, effect.stage))
+    return std::none_of(choices->begin(), choices->end(), [&](const ContactSpec::Choice& c) {
+      const EffectSpec* other = find_effect(effect.stage, c.model);
+      return c.model == effect.name || (other && other->candidate);
+    });
+  const ContactSpec::Choice* choice = single_choice(contact, effect.stage);
+  return choice && choice->model == "none";
+}
+
+EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale& scale) {
+  const CandidateSpec& spec = *effect.candidate;
+  const std::string stage(kStageKeys[static_cast<int>(effect.stage)]);
+  EffectCandidate c;
+  c.name = std::string(effect.name);
+  c.title = std::string(spec.title);
+  c.why = std::string(spec.signature);
+  c.switch_on = fmt::format("contact: {{{}: {}}}", stage, effect.name);
+  c.description = fmt::format("{}: {} ({}; {})", c.title, effect.summary, c.switch_on, effect.citation);
+  for (const std::string_view m : spec.moves) c.moves.emplace_back(m);
+  const double factor = spec.scale ? spec.scale(scale) : 1.0;
+  for (const FittedParam& f : spec.fitted) {
+    const ParamSpec* p = find_param(f.key);
+    const double lo = std::max(f.min * factor, p ? p->min_value : -HUGE_VAL);
+    const double hi = std::min(f.max * factor, p ? p->max_value : HUGE_VAL);
+    c.parameters[std::string(f.key)] = {lo, hi};
+    c.start[std::string(f.key)] = std::clamp(f.start * factor, lo, hi);
+  }
+  for (const StartValue& v : spec.also_set) c.start[std::string(v.key)] = v.value;
+  const Stage s = effect.stage;
+  const std::string name(effect.name);
+  c.add = [s, name](MaterialModel& m) {
+    if (auto* choices = additive_choices(m.contact, s)) choices->push_back(ContactSpec::Choice{name, {}, {}});
+    else *single_choice(m.contact, s) = ContactSpec::Choice{name, {}, {}};
+  };
+  return c;
+}
+
+/// Particle shape: not a contact effect, so not in the effect table.
+EffectCandidate clump_candidate() {
+  EffectCandidate c;
+  c.name = "clump_shape";
+  c.title = "particle shape (two-sphere clumps)";
+  c.why = "interlocking of non-spherical particles (steeper heaps, higher shear strength, looser packing)";
+  c.switch_on = "shape: two-sphere clumps of the fitted aspect ratio (clump_aspect_ratio)";
+  c.description = "particle shape as two-sphere clumps (aspect ratio length/width): interlocking that resists rolling and raises dilatancy";
+  c.moves = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg", "bulk_density/bulk_density", "direct_shear/peak_shear_stress"};
+  c.parameters = {{"clump_aspect_ratio", {1.0, 2.0}}};
+  c.start = {{"clump_aspect_ratio", 1.5}};
+  c.add = [](MaterialModel& m) { m.shape = {two_sphere_clump(1.5)}; };
+  return c;
+}
+
+}  // namespace
+
 std::vector<EffectCandidate> missing_effects(const MaterialModel& model) {
   std::vector<EffectCandidate> out;
-  const double d = typical_diameter(model.diameter);
-  const double weight_scale = model.particle.density * 9.81 * d * d;  // [N/m] rho g d^2: gravity per length
-  if (model.contact.rolling.model == "none" && find_effect(Stage::rolling, "epsd")) {
-    EffectCandidate c;
-    c.name = "rolling_resistance";
-    c.description = "rolling resistance (Ai et al. 2011 model C, epsd): a torque against rolling, standing in for non-spherical shape and surface roughness";
-    c.parameters = {{"rolling_friction", {0.0, 0.5}}};
-    c.start = {{"rolling_friction", 0.15}};
-    c.add = [](MaterialModel& m) {
-      m.contact.rolling = ContactSpec::Choice{"epsd", {}, {}};
-      if (!m.particle.params.count("rolling_friction")) m.particle.params["rolling_friction"] = 0.15;
-    };
-    out.push_back(std::move(c));
-  }
-  const auto has_extra = [&](const std::string& name) {
-    return std::any_of(model.contact.extra.begin(), model.contact.extra.end(), [&](const ContactSpec::Choice& c) { return c.model == name; });
-  };
-  const bool has_adhesion = !model.contact.adhesion.empty();
-  if (!has_extra("liquid_bridge") && find_effect(Stage::extra, "liquid_bridge")) {
-    EffectCandidate c;
-    c.name = "liquid_bridges";
-    c.description = "liquid bridges (Willett et al. 2000 capillary force): cohesion from moisture, independent of the normal load";
-    c.parameters = {{"liquid_content", {0.0, 0.05}}};
-    c.start = {{"liquid_content", 0.01}, {"contact_angle_deg", 20.0}};
-    c.add = [](MaterialModel& m) {
-      m.contact.extra.push_back(ContactSpec::Choice{"liquid_bridge", {}, {}});
-      if (!m.particle.params.count("liquid_content")) m.particle.params["liquid_content"] = 0.01;
-      if (!m.particle.params.count("contact_angle_deg")) m.particle.params["contact_angle_deg"] = 20.0;
-    };
-    out.push_back(std::move(c));
-  }
-  if (!has_adhesion && model.contact.normal.model == "hertz" && find_effect(Stage::adhesion, "jkr")) {
-    // Surface energy that gives a pull-off force of `bond` particle weights: F = 3/2 pi W R*,
-    // W = 2 gamma, R* = d/4, weight = rho pi d^3 g / 6  ->  gamma = bond rho g d^2 / 9.
-    const double per_bond = weight_scale / 9.0;
-    const double start = 3.0 * per_bond, top = std::min(10.0, 30.0 * per_bond);
-    EffectCandidate c;
-    c.name = "jkr_cohesion";
-    c.description = "JKR adhesion (Johnson, Kendall & Roberts 1971): van der Waals cohesion of fine dry particles, growing with contact area";
-    c.parameters = {{"surface_energy", {0.0, top}}};
-    c.start = {{"surface_energy", start}};
-    c.add = [start](MaterialModel& m) {
-      m.contact.adhesion.push_back(ContactSpec::Choice{"jkr", {}, {}});
-      if (!m.particle.params.count("surface_energy")) m.particle.params["surface_energy"] = start;
-    };
-    out.push_back(std::move(c));
-  }
-  if (model.shape.empty()) {
-    EffectCandidate c;
-    c.name = "clump_shape";
-    c.description = "particle shape as two-sphere clumps (aspect ratio length/width): interlocking that resists rolling and raises dilatancy";
-    c.parameters = {{"clump_aspect_ratio", {1.0, 2.0}}};
-    c.start = {{"clump_aspect_ratio", 1.5}};
-    c.add = [](MaterialModel& m) { m.shape = {two_sphere_clump(1.5)}; };
-    out.push_back(std::move(c));
-  }
+  const ParticleScale scale{model.particle.density, typical_diameter(model.diameter)};
+  for (const EffectSpec* e : effect_table())
+    if (e->candidate && stage_free(model.contact, *e)) out.push_back(contact_candidate(*e, scale));
+  if (model.shape.empty()) out.push_back(clump_candidate());
+  return out;
+}
+
+std::vector<std::string> candidate_names() {
+  std::vector<std::string> out;
+  for (const EffectSpec* e : effect_table())
+    if (e->candidate) out.emplace_back(e->name);
+  out.emplace_back("clump_shape");
   return out;
 }
 

@@ -26,17 +26,26 @@ void apply_measured(MaterialModel& model, const MeasurementSet& measured);
 double get_parameter(const MaterialModel& model, const std::string& key);
 void set_parameter(MaterialModel& model, const std::string& key, double value);
 
-/// A physical effect the model does not use, and how to add it.
+/// A physical effect the model does not use, and how to add it: a contact effect whose file
+/// declares a CandidateSpec (src/effect.h), or particle shape as clumps.
 struct EffectCandidate {
-  std::string name;         ///< "rolling_resistance", "liquid_bridges", "jkr_cohesion", "clump_shape", ...
+  std::string name;         ///< the effect's name in the table ("epsd", "liquid_bridge", "jkr", ...) or "clump_shape"
+  std::string title;        ///< in words: "rolling resistance"
   std::string description;  ///< one line for the report: what physics it adds
+  std::string why;          ///< why its signature fits a misfit (the effect's own words)
+  std::string switch_on;    ///< the YAML that switches it on: "contact: {rolling: epsd}"
+  std::vector<std::string> moves;  ///< observables it is expected to move ("test/observable")
   /// Switches the effect on in `model` with its parameters at their starting values.
   std::function<void(MaterialModel&)> add;
   std::map<std::string, std::pair<double, double>> parameters;  ///< key -> [min, max] it adds to the fit
   std::map<std::string, double> start;                          ///< key -> starting value
 };
 
-/// The candidates the model does not yet use, from the effect table.
+/// The candidates the model does not yet use: every effect of the table that declares itself a
+/// candidate and whose stage is free (a single stage at `none`; an additive stage without
+/// another candidate of it), then clump shape for spheres. In table order.
 std::vector<EffectCandidate> missing_effects(const MaterialModel& model);
+/// Every candidate name there is (for checking `--effects`).
+std::vector<std::string> candidate_names();
 
 }  // namespace dem::materials

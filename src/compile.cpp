@@ -478,6 +478,15 @@ std::string describe_effects() {
       out += fmt::format("    option {}: {} (default {}): {}\n", o.key, values, o.values[0], o.doc);
     }
     for (const HistorySpec& hs : e->history) out += fmt::format("    history: {} ({} values)\n", hs.name, hs.width);
+    if (const CandidateSpec* c = e->candidate) {
+      std::string fitted, moves;
+      for (const FittedParam& f : c->fitted)
+        fitted += fmt::format("{}{} from {:g} in [{:g}, {:g}]{}", fitted.empty() ? "" : ", ", f.key, f.start, f.min, f.max,
+                              c->scale ? " (x the material's scale)" : "");
+      for (const std::string_view m : c->moves) moves += (moves.empty() ? "" : ", ") + std::string(m);
+      out += fmt::format("    diagnosis candidate ({}): fits {}\n      signature: {}\n      moves: {}\n", c->title, fitted,
+                         c->signature, moves);
+    }
   }
   return out;
 }

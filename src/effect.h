@@ -1,6 +1,7 @@
 // A contact effect is one physical mechanism at a contact (Hertz normal force, restitution
 // damping, Coulomb friction, rolling resistance, a liquid bridge, ...). Each lives in one file
-// under src/effects/ and is registered in one row of src/effect_table.cpp.
+// under src/effects/ (the build compiles every file there) and is registered in one row of
+// src/effect_table.cpp; nothing else names it.
 //
 // An effect declares
 //   - the stage it runs in (stages run in the order of `Stage`),
@@ -9,7 +10,9 @@
 //   - its options (model-wide choices such as the damping convention at the end of contact),
 //   - the per-contact history it needs, by name,
 //   - how far beyond touching it acts (liquid bridges, JKR necks),
-//   - a kernel that runs over a batch of contacts stored as columns.
+//   - a kernel that runs over a batch of contacts stored as columns,
+//   - whether a diagnosis may propose it, with the parameters a calibration then fits, their
+//     ranges and start values, and the words that explain its signature (CandidateSpec).
 //
 // Rejected alternative: composing laws in the type system (LIGGGHTS/MercuryDPM templates).
 // Combinations explode and errors are opaque; a batch loop through a short table of kernels
@@ -133,6 +136,40 @@ using EffectKernel = void (*)(const EffectContext&, ContactBatch&);
 /// `radius_max` the largest particle radius of the case.
 using EffectRange = double (*)(const double* row, const double* params, double radius_max);
 
+/// One parameter a calibration fits when a diagnosis adds the effect.
+struct FittedParam {
+  std::string_view key;  ///< one of the effect's ParamSpec keys
+  double start;          ///< value the effect is added with
+  double min, max;       ///< range the fit searches (clipped to the ParamSpec's range)
+};
+
+/// A parameter given a value (not fitted) when the effect is added.
+struct StartValue {
+  std::string_view key;
+  double value;
+};
+
+/// The particles' scale, for effects whose natural strength depends on it (a cohesion in units
+/// of the particle weight).
+struct ParticleScale {
+  double density;   ///< [kg/m^3]
+  double diameter;  ///< [m] typical (median) diameter
+};
+
+/// What `diagnose` and `calibrate` need to propose an effect a material lacks: the effect's own
+/// file declares it, and materials/ keeps no list of effects.
+struct CandidateSpec {
+  std::string_view title;      ///< in words, e.g. "rolling resistance"
+  /// Why its signature fits a misfit: what the model without it gets wrong, and the physics.
+  std::string_view signature;
+  std::span<const FittedParam> fitted;
+  std::span<const StartValue> also_set;
+  /// Observables it is expected to move, as "test/observable" of the virtual tests.
+  std::span<const std::string_view> moves;
+  /// Multiplies `fitted`'s start, min and max for the material's scale; nullptr: 1.
+  double (*scale)(const ParticleScale&) = nullptr;
+};
+
 struct EffectSpec {
   Stage stage;
   std::string_view name;      ///< the value that selects it in YAML, e.g. "hertz"
@@ -152,11 +189,28 @@ struct EffectSpec {
   /// Reads the batch's spin inputs (wx, wy, wz, inertia_eff), which the particle pairs' geometry
   /// computes only when an active effect reads them (forces.cpp).
   bool reads_spin = false;
+  /// Set when a diagnosis may propose this effect for a material that lacks it.
+  const CandidateSpec* candidate = nullptr;
 };
 
-/// The checked-in table of every effect (src/effect_table.cpp).
+/// Every effect: the rows of src/effect_table.cpp, then any registered by register_effect.
 std::span<const EffectSpec* const> effect_table();
 /// nullptr when no effect of that stage has that name.
 const EffectSpec* find_effect(Stage stage, std::string_view name);
+/// The parameter row of `key` (a parameter two variants of a stage share, such as
+/// rolling_friction of cdt and epsd, is one ParamSpec both list); nullptr when no effect has it.
+const ParamSpec* find_param(std::string_view key);
+
+/// Adds an effect defined outside src/effects/ (a plugin, or an effect of the test tree) to the
+/// table; call before any case is read. Throws std::invalid_argument when its stage already has
+/// an effect of that name, or when one of its parameter keys is another effect's with a
+/// different definition.
+void register_effect(const EffectSpec* effect);
+/// Registration as one line beside the spec: `DEM_REGISTER_EFFECT(my_effect);` in a source file
+/// linked into the program (not into a static library, whose unreferenced objects are dropped).
+struct EffectRegistration {
+  explicit EffectRegistration(const EffectSpec* effect) { register_effect(effect); }
+};
+#define DEM_REGISTER_EFFECT(spec) static const ::dem::EffectRegistration spec##_registration_{&(spec)}
 
 }  // namespace dem

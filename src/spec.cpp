@@ -22,14 +22,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Parameter keys of every effect, for checking material and interaction maps.
-const ParamSpec* find_param(const std::string& key) {
-  for (const EffectSpec* effect : effect_table())
-    for (const ParamSpec& p : effect->params)
-      if (p.key == key) return &p;
-  return nullptr;
-}
-
 std::vector<std::string> all_param_keys() {
   std::vector<std::string> keys;
   for (const EffectSpec* effect : effect_table())

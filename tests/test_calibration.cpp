@@ -138,7 +138,7 @@ TEST(MaterialModel, ReadsALibraryFile) {
   // Gravel already rolls: its candidates are cohesion and shape.
   std::vector<std::string> names;
   for (const auto& c : missing_effects(m)) names.push_back(c.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"liquid_bridges", "jkr_cohesion", "clump_shape"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"jkr", "liquid_bridge", "clump_shape"}));  // in the effect table's order
   // Measured size, density and walls replace the library's.
   const MeasurementSet measured = parse_measurements(kGood, "m.yaml");
   apply_measured(m, measured);
@@ -391,8 +391,8 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
   EXPECT_GT(d.base.after.chi2_per_n(), 5.0);  // the starting model fails visibly
   ASSERT_FALSE(d.candidates.empty());
-  EXPECT_EQ(d.candidates.front().name, "rolling_resistance") << d.words.front();
-  EXPECT_EQ(d.recommended, "rolling_resistance") << d.words.front();
+  EXPECT_EQ(d.candidates.front().name, "epsd") << d.words.front();
+  EXPECT_EQ(d.recommended, "epsd") << d.words.front();
   EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
   EXPECT_GT(d.candidates.front().explained, 0.5);
   // The report: self-contained HTML with the diagnosis, contour maps and the ledger.
@@ -406,7 +406,7 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   const std::string html = report::write_calibration_report(in, dir);
   std::ifstream file(html);
   const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("Most likely missing: rolling_resistance"), std::string::npos);
+  EXPECT_NE(text.find("Most likely missing: epsd"), std::string::npos);
   EXPECT_NE(text.find("Error ledger"), std::string::npos);
   EXPECT_EQ(text.find("http"), std::string::npos);
   if (std::filesystem::exists(dir + "/plots/base_contour0.png")) {
@@ -417,7 +417,8 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
 /// The dry spheres with liquid bridges of this liquid content, at friction 0.5.
 MaterialModel wet_spheres(double liquid_content) {
   MaterialModel m = dry_spheres();
-  missing_effects(m)[1].add(m);  // liquid bridges
+  for (const EffectCandidate& c : missing_effects(m))
+    if (c.name == "liquid_bridge") c.add(m);
   set_parameter(m, "liquid_content", liquid_content), set_parameter(m, "friction", 0.5);
   return m;
 }
@@ -434,7 +435,7 @@ TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
   set = synthesise(set, truth, sim, 5);
   const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
   EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
-  EXPECT_EQ(d.recommended, "liquid_bridges") << d.words.front();
+  EXPECT_EQ(d.recommended, "liquid_bridge") << d.words.front();
   EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
   bool offset_words = false;
   for (const Pattern& p : d.base.before.patterns) offset_words = offset_words || p.words.find("yield locus") != std::string::npos;
@@ -488,12 +489,12 @@ TEST(Ledger, AppendsVersions) {
   c.terms.push_back(t), c.chi2 = 12.25, c.n = 1;
   append_ledger(path, "gravel", {ledger_entry(m, c, "start", {"friction"})});
   c.terms[0].residual = 0.5, c.chi2 = 0.25;
-  const auto all = append_ledger(path, "gravel", {ledger_entry(m, c, "+ rolling_resistance", {"friction"})});
+  const auto all = append_ledger(path, "gravel", {ledger_entry(m, c, "+ epsd", {"friction"})});
   ASSERT_EQ(all.size(), 2u);
   const auto read = read_ledger(path);
   ASSERT_EQ(read.size(), 2u);
   EXPECT_EQ(read[1].version, 2);
-  EXPECT_EQ(read[1].label, "+ rolling_resistance");
+  EXPECT_EQ(read[1].label, "+ epsd");
   EXPECT_DOUBLE_EQ(read[0].residuals.at("aor/angle_deg"), -3.5);
   EXPECT_DOUBLE_EQ(read[1].chi2_per_n(), 0.25);
   EXPECT_DOUBLE_EQ(read[0].parameters.at("friction"), 0.65);

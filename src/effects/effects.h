@@ -1,4 +1,6 @@
-// Declarations of every contact effect; the table in src/effect_table.cpp lists them.
+// What the effect files share: the spec types (effect.h), the parameters that two variants of a
+// stage have in common, and the contact-plane helpers. The effects themselves are declared by
+// their rows in src/effect_table.cpp.
 #pragma once
 
 #include <cmath>
@@ -6,15 +8,11 @@
 #include "effect.h"
 
 namespace dem::effects {
-extern const EffectSpec hertz_normal;
-extern const EffectSpec linear_normal;
-extern const EffectSpec restitution_damping;
-extern const EffectSpec jkr_adhesion;
-extern const EffectSpec sjkr_adhesion;
-extern const EffectSpec mindlin_tangential;
-extern const EffectSpec rolling_cdt;
-extern const EffectSpec rolling_epsd;
-extern const EffectSpec liquid_bridge;
+
+/// mu_r of both rolling variants (cdt, epsd): one row, so the two cannot disagree on its range
+/// or default and a material's value means the same under either.
+inline constexpr ParamSpec kRollingFrictionParam = {"rolling_friction", "-", 0.0, 0.0, 1.0, Mixing::arithmetic, true,
+                                               "rolling friction coefficient mu_r; lever arm of the limiting torque is mu_r R*"};
 
 // Pieces shared by the kernels with a spring in the contact plane (Mindlin, EPSD), written as
 // selects so the kernels' loops stay vectorised, and always inlined: a call left in a loop stops

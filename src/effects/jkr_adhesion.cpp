@@ -72,6 +72,26 @@ double jkr_range(const double* row, const double* params, double radius_max) {
   return work > 0.0 ? -breaking_overlap(work, radius_max, row[0]) : 0.0;
 }
 
+/// Surface energy [J/m^2] that gives a pull-off force of one particle weight between two
+/// particles: F = 3/2 pi W R*, W = 2 gamma, R* = d/4, weight = rho pi d^3 g / 6, so
+/// gamma = rho g d^2 / 9. The fit starts at 3 weights and searches up to 30 (bond numbers of
+/// fine cohesive powders).
+double one_weight_bond(const ParticleScale& s) { return s.density * 9.81 * s.diameter * s.diameter / 9.0; }
+
+constexpr FittedParam kFitted[] = {{"surface_energy", 3.0, 0.0, 30.0}};
+constexpr std::string_view kMoves[] = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg",
+                                       "bulk_density/bulk_density", "hopper_discharge/mass_flow_rate",
+                                       "drop_rebound/restitution", "direct_shear/peak_shear_stress"};
+constexpr CandidateSpec kCandidate{
+    .title = "van der Waals cohesion (JKR)",
+    .signature = "strength that does not come from the load, growing with the contact area: cohesion of fine dry "
+                 "particles (van der Waals, JKR adhesion)",
+    .fitted = kFitted,
+    .also_set = {},
+    .moves = kMoves,
+    .scale = one_weight_bond,
+};
+
 }  // namespace
 
 extern const EffectSpec jkr_adhesion{
@@ -87,6 +107,7 @@ extern const EffectSpec jkr_adhesion{
     .derived_count = 0,
     .derive = nullptr,
     .requires_normal = "hertz",
+    .candidate = &kCandidate,
 };
 
 }  // namespace dem::effects

@@ -79,6 +79,21 @@ double bridge_range(const double* row, const double* p, double radius_max) {
   return (1.0 + 0.5 * theta) * std::cbrt(volume);
 }
 
+constexpr FittedParam kFitted[] = {{"liquid_content", 0.01, 0.0, 0.05}};
+constexpr StartValue kAlsoSet[] = {{"contact_angle_deg", 20.0}};
+constexpr std::string_view kMoves[] = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg",
+                                       "bulk_density/bulk_density", "hopper_discharge/mass_flow_rate",
+                                       "direct_shear/peak_shear_stress", "direct_shear/steady_shear_stress"};
+constexpr CandidateSpec kCandidate{
+    .title = "liquid bridges",
+    .signature = "strength that does not come from the load (steeper heaps, looser packing, slower or blocked discharge, "
+                 "a yield locus offset by a constant): cohesion from moisture, capillary bridges",
+    .fitted = kFitted,
+    .also_set = kAlsoSet,
+    .moves = kMoves,
+    .scale = nullptr,
+};
+
 }  // namespace
 
 extern const EffectSpec liquid_bridge{
@@ -94,6 +109,7 @@ extern const EffectSpec liquid_bridge{
     .derived_count = 2,
     .derive = derive_angle_terms,
     .requires_normal = "",
+    .candidate = &kCandidate,
 };
 
 }  // namespace dem::effects

@@ -13,10 +13,7 @@
 namespace dem::effects {
 namespace {
 
-constexpr ParamSpec kParams[] = {
-    {"rolling_friction", "-", 0.0, 0.0, 1.0, Mixing::arithmetic, true,
-     "rolling friction coefficient mu_r; lever arm of the resisting torque is mu_r R*"},
-};
+constexpr ParamSpec kParams[] = {kRollingFrictionParam};
 
 DEM_KERNEL void cdt_kernel(const EffectContext& ctx, ContactBatch& b) {
   DEM_VECTOR_LOOP

@@ -15,8 +15,7 @@ namespace {
 enum Param { kRollingFriction, kRollingDamping };
 
 constexpr ParamSpec kParams[] = {
-    {"rolling_friction", "-", 0.0, 0.0, 1.0, Mixing::arithmetic, true,
-     "rolling friction coefficient mu_r; lever arm of the limiting torque is mu_r R*"},
+    kRollingFrictionParam,
     {"rolling_damping", "-", 0.3, 0.0, 2.0, Mixing::arithmetic, false,
      "viscous damping ratio eta_r of the rolling spring (Ai et al. use 0.3)"},
 };
@@ -61,6 +60,20 @@ DEM_KERNEL void epsd_kernel(const EffectContext& ctx, ContactBatch& b) {
   }
 }
 
+constexpr FittedParam kFitted[] = {{"rolling_friction", 0.15, 0.0, 0.5}};
+constexpr std::string_view kMoves[] = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg",
+                                       "direct_shear/peak_shear_stress", "direct_shear/steady_shear_stress",
+                                       "bulk_density/bulk_density"};
+constexpr CandidateSpec kCandidate{
+    .title = "rolling resistance",
+    .signature = "heaps and drum beds stand steeper than spheres allow while single contacts fit: resistance to rolling, "
+                 "standing in for particle shape and surface roughness",
+    .fitted = kFitted,
+    .also_set = {},
+    .moves = kMoves,
+    .scale = nullptr,
+};
+
 }  // namespace
 
 extern const EffectSpec rolling_epsd{
@@ -77,6 +90,7 @@ extern const EffectSpec rolling_epsd{
     .derive = nullptr,
     .requires_normal = "",
     .reads_spin = true,
+    .candidate = &kCandidate,
 };
 
 }  // namespace dem::effects
