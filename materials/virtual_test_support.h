@@ -1,4 +1,4 @@
-// Internal to the virtual tests (test_*.cpp): reading a set-up, building the case every test
+// Internal to the virtual tests (lab_*.cpp): reading a set-up, building the case every test
 // starts from (the material model's particle and wall materials, contact law, shape, scaling),
 // small inline meshes (cylinders, discs), a runner that steps a compiled case and measures rest,
 // and the least-squares line the extraction rules fit. Not part of the public API.

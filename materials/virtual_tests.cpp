@@ -1,6 +1,6 @@
-// The table of virtual tests: name, observables, the function that runs it (one file each:
-// test_drop_rebound.cpp, test_bulk_density.cpp, test_angle_of_repose.cpp, test_rotating_drum.cpp,
-// test_hopper_discharge.cpp, direct_shear.cpp). Set-ups and extraction rules:
+// The table of virtual tests: name, observables, the function that runs it (one file each, the
+// virtual laboratory: lab_drop_rebound.cpp, lab_bulk_density.cpp, lab_angle_of_repose.cpp,
+// lab_rotating_drum.cpp, lab_hopper_discharge.cpp, lab_direct_shear.cpp). Set-ups and extraction rules:
 // ../shared/protocols/CALIBRATION_TESTS.md.
 #include "virtual_tests.h"
 
@@ -8,7 +8,7 @@
 
 #include <algorithm>
 
-#include "direct_shear.h"
+#include "lab_direct_shear.h"
 #include "virtual_test_support.h"
 
 namespace dem::materials {

@@ -1,4 +1,4 @@
-// The periodic direct shear test (materials/direct_shear.cpp): plate stresses against the
+// The periodic direct shear test (materials/lab_direct_shear.cpp): plate stresses against the
 // contact stress tensor, a yield locus of a frictional material, and cohesion from liquid
 // bridges raising its intercept. Coarse particles (2 mm, soft), small cells, a fast plate with
 // the inertial number reported: each experiment takes seconds on one core.
@@ -8,7 +8,7 @@
 #include <map>
 #include <numbers>
 
-#include "direct_shear.h"
+#include "lab_direct_shear.h"
 
 namespace dem::materials {
 namespace {

@@ -23,7 +23,7 @@
 // averaged and compared with them (notes). Mass scaling: raised so that the inertial number
 // I = (v/H) d50 / sqrt(sigma_n / rho) is 8e-4 at the lower normal stress (quasi-static, GDR MiDi
 // 2004: I < 1e-3), never lowered below the model's; I is reported.
-#include "direct_shear.h"
+#include "lab_direct_shear.h"
 
 #include <fmt/format.h>
 
