@@ -291,6 +291,7 @@ std::string rank_prefix() {
 
 int main(int argc, char** argv) {
   dem::tune_allocator();
+  dem::materials::use_material_library();  // cases find `library:` materials outside their own folders
   // MPI only when mpirun (or another MPI launcher) started this process; see app/mpi_campaign.h.
   dem::app::mpi::Session mpi_session(&argc, &argv);
   const dem::app::mpi::World& world = dem::app::mpi::world();

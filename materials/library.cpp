@@ -3,11 +3,32 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+
+#include "spec.h"
 
 namespace dem::materials {
 
 std::string library_folder() { return DEMDESIGN_MATERIALS_DIR; }
+
+std::vector<std::string> library_folders() {
+  std::vector<std::string> out;
+  if (const char* env = std::getenv("DEMDESIGN_MATERIALS"); env && *env) out.emplace_back(env);
+  out.push_back(library_folder());
+  return out;
+}
+
+void use_material_library() {
+  set_library_lookup([](const std::string& file, const std::string&, std::string& searched) {
+    for (const std::string& folder : library_folders()) {
+      const std::filesystem::path candidate = std::filesystem::path(folder) / (file + ".yaml");
+      searched += "\n  " + candidate.lexically_normal().string();
+      if (std::filesystem::is_regular_file(candidate)) return candidate;
+    }
+    return std::filesystem::path();
+  });
+}
 
 std::vector<LibraryEntry> list_library(const std::string& folder) {
   std::vector<LibraryEntry> out;

@@ -2,7 +2,8 @@
 // and the C++ that calibrates them against laboratory measurements (virtual tests, comparison,
 // calibration, diagnosis). A case uses a library material with
 //   materials: {ore: {library: gravel}}
-// (src/spec.cpp resolves it); `demdesign materials` lists what is there.
+// (the case reader, src/spec.cpp, reads the file; where it is found is said here:
+// use_material_library). `demdesign materials` lists what is there.
 #pragma once
 
 #include <string>
@@ -22,5 +23,13 @@ std::vector<LibraryEntry> list_library(const std::string& folder = "");
 
 /// The folder of the shipped library.
 std::string library_folder();
+
+/// The folders a case's `library:` name is looked up in after the case's own folders:
+/// $DEMDESIGN_MATERIALS (when set), then the shipped library.
+std::vector<std::string> library_folders();
+
+/// Makes the case reader find library materials in library_folders() (dem::set_library_lookup).
+/// Programs that read cases call it once at start; read_material_model calls it itself.
+void use_material_library();
 
 }  // namespace dem::materials

@@ -32,7 +32,9 @@ std::vector<std::string> parameter_keys() {
 
 /// The library file of a wall material, when one is shipped (steel.yaml, rubber.yaml).
 std::string wall_library_file(const fs::path& dir, const std::string& name) {
-  for (const fs::path& d : {dir, fs::path(library_folder())})
+  std::vector<fs::path> folders = {dir};
+  for (const std::string& f : library_folders()) folders.emplace_back(f);
+  for (const fs::path& d : folders)
     if (fs::is_regular_file(d / (name + ".yaml"))) return (d / (name + ".yaml")).string();
   return "";
 }
@@ -80,6 +82,7 @@ double typical_diameter(const SizeDistributionSpec& d) {
 }  // namespace
 
 MaterialModel read_material_model(const std::string& path) {
+  use_material_library();
   if (!fs::is_regular_file(path)) throw CaseError(fmt::format("{}: cannot open the material file", path));
   const fs::path file = fs::absolute(path).lexically_normal();
   const std::string stem = file.stem().string();

@@ -57,17 +57,21 @@ MaterialSpec read_material(const std::string& name, const YAML::Node& node, cons
   return m;
 }
 
-/// Where `materials: {NAME: {library: gravel}}` looks for gravel.yaml, first match wins: the case's
-/// folder, its `materials/` and `../materials/` folders, $DEMDESIGN_MATERIALS, and the library
-/// shipped with the source tree.
-std::vector<std::filesystem::path> library_folders(const std::string& case_file) {
+LibraryLookup& library_lookup() {
+  static LibraryLookup lookup;
+  return lookup;
+}
+
+/// Where `materials: {NAME: {library: gravel}}` finds gravel.yaml, first match wins: the case's
+/// folder, its `materials/` and `../materials/` folders, then the lookup the material library set.
+std::filesystem::path find_library_file(const std::string& wanted, const std::string& case_file, std::string& searched) {
   const std::filesystem::path dir = std::filesystem::path(case_file).parent_path();
-  std::vector<std::filesystem::path> out = {dir, dir / "materials", dir / ".." / "materials"};
-  if (const char* env = std::getenv("DEMDESIGN_MATERIALS")) out.emplace_back(env);
-#ifdef DEMDESIGN_MATERIALS_DIR
-  out.emplace_back(DEMDESIGN_MATERIALS_DIR);
-#endif
-  return out;
+  for (const std::filesystem::path& folder : {dir, dir / "materials", dir / ".." / "materials"}) {
+    const std::filesystem::path candidate = folder / (wanted + ".yaml");
+    searched += "\n  " + candidate.lexically_normal().string();
+    if (std::filesystem::is_regular_file(candidate)) return candidate;
+  }
+  return library_lookup() ? library_lookup()(wanted, case_file, searched) : std::filesystem::path();
 }
 
 /// A library material: materials/NAME.yaml with `properties` (as a case material), `sources`
@@ -82,16 +86,8 @@ struct LibraryMaterial {
 
 LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file) {
   const std::string wanted = entry.string("library", "");
-  std::filesystem::path found;
   std::string searched;
-  for (const auto& dir : library_folders(case_file)) {
-    const std::filesystem::path candidate = dir / (wanted + ".yaml");
-    searched += "\n  " + candidate.lexically_normal().string();
-    if (std::filesystem::is_regular_file(candidate)) {
-      found = candidate;
-      break;
-    }
-  }
+  const std::filesystem::path found = find_library_file(wanted, case_file, searched);
   if (found.empty()) entry.fail("library", fmt::format("no material file '{}.yaml' found; looked in:{}", wanted, searched));
   std::ifstream in(found);
   std::stringstream text;
@@ -751,6 +747,8 @@ CaseSpec parse_case_text(const std::string& text, const std::string& name) {
     throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
   }
 }
+
+void set_library_lookup(LibraryLookup lookup) { library_lookup() = std::move(lookup); }
 
 CaseSpec parse_case_file(const std::string& path) {
   std::ifstream in(path);

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -268,6 +270,15 @@ struct CaseSpec {
   std::map<std::string, double> wear_coefficients;
   OutputSpec output;
 };
+
+/// Finds the file of a library material (`materials: {NAME: {library: FILE}}`): FILE.yaml for the
+/// case file `case_file`, or an empty path after adding each place it looked to `searched`.
+using LibraryLookup = std::function<std::filesystem::path(const std::string& file, const std::string& case_file, std::string& searched)>;
+/// Where the case reader looks for library materials beyond the case's own folders (the case's
+/// folder, its materials/ and ../materials/, which it always searches first). The engine does
+/// not know where a material library lives: the material library sets this
+/// (dem::materials::use_material_library, materials/library.h). Process-wide; not thread-safe.
+void set_library_lookup(LibraryLookup lookup);
 
 /// Reads and checks a case file. Throws CaseError naming file, line and key.
 CaseSpec parse_case_file(const std::string& path);

@@ -123,7 +123,7 @@ materials:
   steel: {library: steel}
 particles:
   - {material: ore, diameter: 0.02, positions: [[0, 0, 0.1]]}
-)", "case.yaml");
+)", DEMDESIGN_SOURCE_DIR "/cases/case.yaml");  // a case in cases/ finds the library in ../materials
   const MaterialSpec& ore = spec.materials[0];
   EXPECT_EQ(ore.name, "ore");
   EXPECT_DOUBLE_EQ(ore.density, 2650);
