@@ -177,6 +177,12 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
   std::string h = html::head(in.title);
   h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">material {} &middot; measurements {} &middot; {} &middot; demdesign {} &middot; {:.0f} s</p>\n", esc(in.title),
                    esc(in.material_path), esc(in.measurements_path), esc(html::now_text()), esc(in.version), in.wall_seconds);
+  if (in.measured && !in.measured->known.empty()) {
+    h += "<h2>Known inputs</h2>\n<p>Measured directly (the measurement file): inputs of every simulation, never fitted.</p>\n<table>" +
+         row({"parameter", "value", "unit", "where"}, true);
+    for (const materials::KnownValue& k : in.measured->known) h += row({esc(k.key), num(k.value, 4), esc(k.unit), esc(k.location.str())});
+    h += "</table>\n";
+  }
   if (in.diagnosis) {
     h += "<h2>Diagnosis</h2>\n";
     for (const auto& w : in.diagnosis->words) h += "<p><b>" + esc(w) + "</b></p>\n";

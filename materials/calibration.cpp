@@ -137,6 +137,9 @@ std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::
     return out;
   }
   for (const std::string& key : keys) {
+    if (std::find(model.known.begin(), model.known.end(), key) != model.known.end())
+      throw std::invalid_argument(fmt::format("'{}' was measured ({}): it is an input of the model, not fitted; remove it from the "
+                                              "measurement file to calibrate it", key, model.particle.sources.count(key) ? model.particle.sources.at(key) : "measurement file"));
     const auto it = model.tunable.find(key);
     if (it != model.tunable.end()) {
       out.push_back({key, it->second.first, it->second.second});

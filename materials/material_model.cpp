@@ -155,6 +155,28 @@ void apply_measured(MaterialModel& model, const MeasurementSet& measured) {
     if (it != model.walls.end()) *it = w;
     else model.walls.push_back(w);
   }
+  // Measured values are inputs: set, marked as measured, and never fitted.
+  for (const KnownValue& k : measured.known) {
+    const auto dot = k.key.find('.');
+    if (dot != std::string::npos) {
+      const std::string wall = k.key.substr(0, dot);
+      const bool paired = std::any_of(model.wall_pairs.begin(), model.wall_pairs.end(),
+                                      [&](const InteractionSpec& in) { return in.material_a == wall || in.material_b == wall; });
+      if (!paired) {
+        InteractionSpec pair;
+        pair.material_a = model.name, pair.material_b = wall;
+        model.wall_pairs.push_back(pair);
+      }
+    }
+    try {
+      set_parameter(model, k.key, k.value);
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(fmt::format("{}: {}", k.location.str(), e.what()));
+    }
+    model.particle.sources[k.key] = fmt::format("measured ({})", k.location.str());
+    model.tunable.erase(k.key);
+    model.known.push_back(k.key);
+  }
 }
 
 double get_parameter(const MaterialModel& model, const std::string& key) {

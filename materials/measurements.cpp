@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "effect.h"
 #include "yaml_check.h"
 
 namespace dem::materials {
@@ -37,8 +38,25 @@ std::vector<std::string> outcome_names(const std::string& test) {
   return {};
 }
 
-/// Wall materials measured directly: {youngs_modulus, poisson_ratio, density}.
-MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const std::string& file) {
+/// Contact parameters measured directly in `map` (restitution, friction, ...: any effect
+/// parameter), as known values with `prefix` before the key; the valid keys are `fixed` and
+/// every effect parameter.
+void read_known_params(MapReader& map, const std::vector<std::string>& fixed, const std::string& prefix, std::vector<KnownValue>& known) {
+  std::vector<std::string> valid = fixed;
+  for (const EffectSpec* e : effect_table())
+    for (const ParamSpec& p : e->params) valid.emplace_back(p.key);
+  for (const std::string& key : map.keys()) {
+    if (std::find(fixed.begin(), fixed.end(), key) != fixed.end()) continue;
+    const ParamSpec* p = find_param(key);
+    if (!p) continue;  // reported by finish() with the nearest valid key
+    known.push_back({prefix + key, map.number(key, p->default_value, p->min_value, p->max_value, p->unit), std::string(p->unit), map.where(key)});
+  }
+  map.finish(valid);
+}
+
+/// Wall materials measured directly: {youngs_modulus, poisson_ratio, density} and the
+/// particle-wall pair's contact parameters (friction, restitution, ...), known as NAME.KEY.
+MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const std::string& file, std::vector<KnownValue>& known) {
   MapReader map(node, file, "walls." + name);
   MaterialSpec m;
   m.name = name;
@@ -46,7 +64,7 @@ MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const st
   m.youngs_modulus = map.required_number("youngs_modulus", 1e3, 1e15, "Pa");
   m.poisson_ratio = map.number("poisson_ratio", 0.3, -0.99, 0.499, "-");
   m.density = map.number("density", 7800, 1.0, 1e5, "kg/m^3");
-  map.finish();
+  read_known_params(map, {"youngs_modulus", "poisson_ratio", "density"}, name + ".", known);
   return m;
 }
 
@@ -136,11 +154,13 @@ MeasurementSet parse_measurements(const std::string& text, const std::string& na
       MapReader p(particles, name, "particles");
       if (p.has("diameter")) set.diameter = read_size_distribution(p, name), set.has_diameter = true;
       set.density = p.number("density", 0, 1.0, 1e5, "kg/m^3");
-      p.finish();
+      if (p.has("youngs_modulus")) set.known.push_back({"youngs_modulus", p.number("youngs_modulus", 0, 1e3, 1e15, "Pa"), "Pa", p.where("youngs_modulus")});
+      if (p.has("poisson_ratio")) set.known.push_back({"poisson_ratio", p.number("poisson_ratio", 0, -0.99, 0.499, "-"), "-", p.where("poisson_ratio")});
+      read_known_params(p, {"diameter", "density", "youngs_modulus", "poisson_ratio"}, "", set.known);
     }
     if (const YAML::Node walls = top.node("walls")) {
-      if (!walls.IsMap()) top.fail("walls", "must map wall material names to {youngs_modulus, poisson_ratio, density}");
-      for (const auto& kv : walls) set.walls.push_back(read_wall(kv.first.as<std::string>(), kv.second, name));
+      if (!walls.IsMap()) top.fail("walls", "must map wall material names to {youngs_modulus, poisson_ratio, density, friction, ...}");
+      for (const auto& kv : walls) set.walls.push_back(read_wall(kv.first.as<std::string>(), kv.second, name, set.known));
     }
     const YAML::Node experiments = top.node("experiments");
     if (!experiments || !experiments.IsSequence() || experiments.size() == 0)

@@ -27,12 +27,24 @@ struct Experiment {
   SourceLocation location;
 };
 
+/// A value the user measured directly: an input of the model, never fitted.
+struct KnownValue {
+  std::string key;    ///< the model's parameter key: youngs_modulus, steel.friction, ...
+  double value = 0;
+  std::string unit;
+  SourceLocation location;
+};
+
 struct MeasurementSet {
   std::string file;
   std::string material;           ///< free text
   SizeDistributionSpec diameter;  ///< measured particle size
   bool has_diameter = false;      ///< the file gives particles.diameter
   double density = 0;             // [kg/m^3] solid density
+  /// Measured particle properties (particles.youngs_modulus, poisson_ratio, any contact
+  /// parameter such as restitution) and particle-wall pair parameters (walls.steel.friction as
+  /// steel.friction), in file order.
+  std::vector<KnownValue> known;
   std::vector<MaterialSpec> walls;
   std::vector<Experiment> experiments;
 };

@@ -33,6 +33,8 @@ struct MaterialModel {
   std::vector<MaterialSpec> walls;       ///< wall materials by name (steel, ...)
   std::vector<InteractionSpec> wall_pairs;  ///< particle-wall pair parameters
   std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max]
+  /// Keys the measurement file gave as measured (inputs, never fitted), in file order.
+  std::vector<std::string> known;
   double mass_scaling = 1.0, stiffness_scaling = 1.0;  ///< applied to the virtual tests (reported)
 };
 

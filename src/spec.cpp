@@ -236,20 +236,29 @@ SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
     d.min = map.required_number("min", 1e-7, 10, "m");
     d.max = map.required_number("max", d.min, 10, "m");
   } else {
+    // Size classes with their mass fractions (a sieve analysis) or number fractions (a count,
+    // an image analysis); number fractions become mass fractions n_k d_k^3 / sum n d^3.
     d.kind = SizeDistributionSpec::Kind::discrete;
-    const YAML::Node values = map.node("values"), fractions = map.node("mass_fractions");
+    const bool by_number = map.has("number_fractions");
+    if (by_number && map.has("mass_fractions")) map.fail("number_fractions", "give mass_fractions or number_fractions, not both");
+    const std::string key = by_number ? "number_fractions" : "mass_fractions";
+    const YAML::Node values = map.node("values"), fractions = map.node(key);
     if (!values || !values.IsSequence() || values.size() == 0) map.fail("values", "must be a list of diameters [m]");
     if (!fractions || !fractions.IsSequence() || fractions.size() != values.size())
-      map.fail("mass_fractions", "must be a list as long as 'values'");
-    double sum = 0;
+      map.fail(key, "must be a list as long as 'values' (mass_fractions, or number_fractions)");
+    double sum = 0, mass_sum = 0;
     for (size_t k = 0; k < values.size(); ++k) {
       d.values.push_back(MapReader::finite_number(values[k], map, "values"));
-      d.mass_fractions.push_back(MapReader::finite_number(fractions[k], map, "mass_fractions"));
+      d.mass_fractions.push_back(MapReader::finite_number(fractions[k], map, key));
       if (!(d.values.back() > 0 && d.values.back() <= 10)) map.fail("values", "diameters must be in (0, 10] m");
-      if (!(d.mass_fractions.back() >= 0)) map.fail("mass_fractions", "fractions must not be negative");
+      if (!(d.mass_fractions.back() >= 0)) map.fail(key, "fractions must not be negative");
       sum += d.mass_fractions.back();
+      if (by_number) d.mass_fractions.back() *= d.values.back() * d.values.back() * d.values.back();
+      mass_sum += d.mass_fractions.back();
     }
-    if (std::abs(sum - 1.0) > 1e-6) map.fail("mass_fractions", fmt::format("sum to {:g}; they must sum to 1", sum));
+    if (std::abs(sum - 1.0) > 1e-6) map.fail(key, fmt::format("sum to {:g}; they must sum to 1", sum));
+    if (by_number)
+      for (double& f : d.mass_fractions) f /= mass_sum;
   }
   map.finish();
   return d;

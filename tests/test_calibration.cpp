@@ -74,6 +74,51 @@ TEST(Measurements, ReadsTheProtocolExample) {
   EXPECT_EQ(m.experiments[0].location.line, 8);
 }
 
+TEST(Measurements, WhatAUserMeasuredIsAnInputNotAnError) {
+  // Particle stiffness, Poisson's ratio, a restitution, the wall's friction against the
+  // particles, and sieve classes by number: all read, used and never fitted.
+  const std::string text = R"(material: beads
+particles:
+  diameter: {distribution: discrete, values: [0.004, 0.006], number_fractions: [0.5, 0.5]}
+  density: 2500
+  youngs_modulus: 5.0e7
+  poisson_ratio: 0.25
+  restitution: 0.6
+walls:
+  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800, friction: 0.35}
+experiments:
+  - id: drop
+    test: drop_rebound
+    setup: {drop_height: 0.1, plate: steel}
+    observed:
+      restitution: {value: 0.6, sigma: 0.02}
+)";
+  const MeasurementSet m = parse_measurements(text, "m.yaml");
+  ASSERT_EQ(m.known.size(), 4u);
+  EXPECT_EQ(m.known[0].key, "youngs_modulus");
+  EXPECT_EQ(m.known[3].key, "steel.friction");
+  EXPECT_EQ(m.known[3].location.line, 9);
+  // Number fractions 1:1 of 4 and 6 mm are mass fractions 64:216.
+  EXPECT_NEAR(m.diameter.mass_fractions[0], 64.0 / 280.0, 1e-12);
+  MaterialModel model = read_material_model(kMaterials + "/gravel.yaml");
+  apply_measured(model, m);
+  EXPECT_DOUBLE_EQ(get_parameter(model, "youngs_modulus"), 5e7);
+  EXPECT_DOUBLE_EQ(get_parameter(model, "poisson_ratio"), 0.25);
+  EXPECT_DOUBLE_EQ(get_parameter(model, "restitution"), 0.6);
+  EXPECT_DOUBLE_EQ(get_parameter(model, "steel.friction"), 0.35);
+  EXPECT_EQ(model.particle.sources.at("steel.friction").rfind("measured (m.yaml:9:", 0), 0u) << model.particle.sources.at("steel.friction");
+  EXPECT_EQ(model.tunable.count("restitution"), 0u) << "a measured value is not fitted";
+  EXPECT_THROW((void)fit_parameters(model, {"restitution"}), std::invalid_argument);
+  // A misspelt measured key still names the nearest valid one.
+  const std::string bad = std::string(text).replace(text.find("poisson_ratio: 0.25"), 19, "poison_ratio: 0.25");
+  try {
+    (void)parse_measurements(bad, "m.yaml");
+    FAIL() << "accepted a misspelt key";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("poisson_ratio"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Measurements, ErrorsNameFileLineKeyAndWhatIsValid) {
   std::string text = kGood;
   // A misspelt top-level key.
