@@ -62,7 +62,7 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   const SetupReader read(model, setup);
   const double scale = options.size_factor;
   const double diameter = scale * read.number("drum_diameter", 1e-3, 20.0, "m");
-  const double depth = scale * read.number("drum_depth", 1e-3, 20.0, "m");
+  const double depth_asked = scale * read.number("drum_depth", 1e-3, 20.0, "m");
   const double fill = read.number("fill_fraction", 0.05, 0.7, "-");
   const double rpm = read.number("rpm", 0.01, 1000.0, "rev/min");
   const double poured = read.number("poured_solid_fraction", 0.6, 0.2, 0.74, "-");
@@ -71,6 +71,12 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   const SizeFigures size = size_figures(model);
   const double radius = 0.5 * diameter, d50 = size.d50, spacing = 1.05 * size.largest * size.bounding_factor;
   const double omega = rpm * 2 * std::numbers::pi / 60, revolution = 60 / rpm;
+  // A periodic slice must span three neighbour cells of the engine (2 x largest radius + skin
+  // of half the smallest radius + interaction range, model.cpp's check); with 10 % for a
+  // bridge's or neck's reach. The angle is per unit depth, so a thicker slice changes only the
+  // count: a size factor never makes the drum invalid.
+  const double min_periodic_depth = 3.0 * 1.1 * (size.largest * size.bounding_factor + 0.25 * size.largest);
+  const double depth = periodic ? std::max(depth_asked, min_periodic_depth) : depth_asked;
   if (radius < 3 * spacing)
     read.fail("drum_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than six particles across; make it at least {:g} m",
                                            diameter / scale, scale, 6 * spacing / scale));
@@ -137,6 +143,8 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   const double carried = carried_sum / samples;
   out.observables["dynamic_angle_deg"] = used ? angle_sum / used : 0.0;
   if (carried < 0.5) out.flags.push_back("slipping");
+  if (depth > depth_asked)
+    out.notes.push_back(fmt::format("periodic depth {:.4g} m raised to {:.4g} m, three neighbour cells", depth_asked, depth));
   out.notes.push_back(fmt::format("wall layer moves at {:.0f} % of the wall speed; {} of {} samples fitted", 100 * carried, used, samples));
   finish(out, run, clock, particles, options);
   return out;

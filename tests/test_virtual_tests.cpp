@@ -211,28 +211,31 @@ TEST(AngleOfRepose, NoHeapWithoutRollingResistanceAndSteeperWithIt) {
 
 // Rotating drum (periodic axis): a rolling bed at friction 0.5, mu_r 0.1 lies at 20-45 deg
 // (Yang et al. 2003; Wensrich & Katterfeld 2012), steeper with more rolling resistance; a
-// frictionless drum wall lets the bed slide as a block (slipping).
+// frictionless drum wall lets the bed slide as a block (slipping). A periodic slice thinner than
+// the engine's three neighbour cells (1 cm x size factor 0.5) is made thick enough, and said so.
 TEST(RotatingDrum, DynamicAngleInRangeSteeperWithRollingResistanceAndSlipOnASmoothWall) {
-  auto drum = [](double rolling, double wall_friction) {
+  auto drum = [](double rolling, double wall_friction, double depth = 0.04) {
     MaterialModel m = beads(0.5, rolling, 0.3, 0.005);
     m.particle.youngs_modulus = 2e5;
     set_wall(m, "friction", wall_friction);
     TestOptions options;
     options.size_factor = 0.5;
     const SimulatedOutcome out = run_virtual_test(
-        m, setup_of("rotating_drum", {{"drum_diameter", 0.20}, {"drum_depth", 0.04}, {"fill_fraction", 0.35}, {"rpm", 60}},
+        m, setup_of("rotating_drum", {{"drum_diameter", 0.20}, {"drum_depth", depth}, {"fill_fraction", 0.35}, {"rpm", 60}},
                     {{"ends", "periodic"}, {"wall", "steel"}}),
         options);
     print(fmt::format("rotating_drum mu_r {} wall friction {}", rolling, wall_friction), out);
     return out;
   };
-  const SimulatedOutcome base = drum(0.1, 0.5), rough = drum(0.3, 0.5), smooth = drum(0.1, 0.0);
+  const SimulatedOutcome base = drum(0.1, 0.5), rough = drum(0.3, 0.5), smooth = drum(0.1, 0.0, 0.01);
   const double angle = base.observables.at("dynamic_angle_deg");
   EXPECT_GT(angle, 20);
   EXPECT_LT(angle, 45);
   EXPECT_FALSE(flagged(base, "slipping"));
   EXPECT_GT(rough.observables.at("dynamic_angle_deg"), angle + 2);
   EXPECT_TRUE(flagged(smooth, "slipping"));
+  const bool raised = std::any_of(smooth.notes.begin(), smooth.notes.end(), [](const std::string& n) { return n.find("periodic depth 0.005 m raised") != std::string::npos; });
+  EXPECT_TRUE(raised) << "the thin slice is made three cells deep and the report says so";
 }
 
 // Hopper: W = C rho_b sqrt(g) (D0 - k d)^2.5 (Beverloo, Leniger & van de Velde 1961) with C in
