@@ -235,7 +235,8 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
                          ? options.design_points
                          : std::max(basis_size(p) + 1, static_cast<int>(std::ceil(options.design_factor * basis_size(p))) + 2);
   const int rounds = std::max(1, options.rounds);
-  Progress progress{options, "design", rounds * points * static_cast<int>(measured.experiments.size()) + options.replicas * static_cast<int>(measured.experiments.size())};
+  Progress progress{options, "design"};
+  for (const Experiment& e : measured.experiments) progress.plan(e, rounds * points);
   std::vector<FitParameter> box = parameters;
   Eigen::VectorXd x_best(p);
   for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].min, parameters[i].max);
@@ -274,7 +275,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
           if (b.error == BatchOutcome::Error::input) return;
           if (b.error != BatchOutcome::Error::none && options.progress)
             options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, b.message));
-          progress.step(fmt::format("round {} point {} {}", round + 1, k + 1, e.id));
+          progress.step(e, fmt::format("round {} point {} {}", round + 1, k + 1, e.id), b.outcome.wall_seconds);
         },
         [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
     std::vector<int> good;

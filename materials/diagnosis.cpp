@@ -67,10 +67,12 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   // The signature run of each candidate is the candidate model at its start: it serves as the
   // "before" of its confirmation (same packing seed, the base's simulation noise).
   std::map<std::string, Comparison> at_start;
-  Progress progress{options, "signature", static_cast<int>(effects.size() * measured.experiments.size())};
+  Progress progress{options, "signatures"};
+  for (size_t k = 0; k < effects.size(); ++k)
+    for (const Experiment& e : measured.experiments) progress.plan(e);
   for (const EffectCandidate& c : effects) {
     CandidateResult cr;
-    cr.name = c.name, cr.description = c.description;
+    cr.name = c.name, cr.title = c.title, cr.description = c.description, cr.why = c.why, cr.switch_on = c.switch_on;
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
     cr.k = static_cast<int>(parameters.size() + cr.adds.size());
     MaterialModel with = d.base.fitted;

@@ -114,12 +114,12 @@ std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& mod
   std::vector<Job> jobs;
   for (const Experiment& e : experiments)
     for (int r = 0; r < replicas; ++r) jobs.push_back({&model, &e.setup, options.seed + static_cast<std::uint64_t>(r)});
-  std::vector<int> known(experiments.size(), 0);
   const std::vector<BatchOutcome> outcomes = run_batch(
       jobs, options,
       [&](size_t k, const BatchOutcome& b) {
         const size_t e = k / static_cast<size_t>(replicas);
-        if (b.error == BatchOutcome::Error::none && ++known[e] == replicas && progress) progress->step(prefix + experiments[e].id);
+        if (b.error == BatchOutcome::Error::none && progress)
+          progress->step(experiments[e], fmt::format("{}{}, replica {} of {}", prefix, experiments[e].id, k % replicas + 1, replicas), b.outcome.wall_seconds);
       },
       [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
   for (const BatchOutcome& b : outcomes)
