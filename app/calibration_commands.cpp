@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -58,7 +61,8 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
     (*cmd)->add_option("measurements", measurements_, "measurement file (YAML)")->required();
     (*cmd)->add_option("--replicas", replicas_, "packings per experiment (simulation noise)");
     (*cmd)->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] (fewer particles)");
-    (*cmd)->add_option("--threads", threads_, "OpenMP threads");
+    (*cmd)->add_option("--threads", threads_, "OpenMP threads of each simulation (default: 1 when simulations run in parallel)");
+    (*cmd)->add_option("--parallel", parallel_, "simulations run at once in this process, each on its own core (default: the cores; under mpirun the ranks share them instead)");
     (*cmd)->add_option("--seed", seed_, "first packing seed");
     (*cmd)->add_option("--out", out_, "output folder (report, plots, ledger.yaml)");
     (*cmd)->add_flag("--quiet", quiet_, "no progress lines");
@@ -148,6 +152,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.effects = split(effects_);
   options.size_factor = size_factor_;
   options.threads = threads_;
+  options.parallel = parallel_ > 0 ? parallel_ : std::max(1, omp_get_num_procs());
   options.seed = static_cast<std::uint64_t>(seed_);
   // Every rank runs the same calibration in lockstep; the simulations of each batch (a design
   // round, the replicas of a comparison) are shared among the ranks and every rank gets every

@@ -41,7 +41,7 @@ class CalibrationCommands {
   std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_, effects_, synthetic_from_;
   std::vector<std::string> set_;
   double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
-  int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2;
+  int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
   long long noise_seed_ = 1;
   int write_synthetic();
   /// One render of the final state per test type of the measurement file, with `model`.

@@ -72,7 +72,11 @@ struct CalibrationOptions {
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
   int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
   double size_factor = 1.0;     ///< passed to the virtual tests
-  int threads = 0;              ///< OpenMP threads of each simulation; 0: default
+  int threads = 0;              ///< OpenMP threads of each simulation; 0: default (1 when parallel > 1)
+  /// Simulations of a batch run at once in this process when no `batch` runner is set, each on
+  /// its own thread with `threads` OpenMP threads (1 by default): the small apparatus of the lab
+  /// tests keep one core busy each far better than they use two. Outcomes do not depend on it.
+  int parallel = 1;
   std::uint64_t seed = 1;       ///< first packing seed; the design uses this one
   int design_points = 0;        ///< per round; 0: from design_factor
   /// Design points per round when design_points is 0: max(b + 1, ceil(design_factor x b) + 2),

@@ -5,10 +5,15 @@
 
 #include <fmt/format.h>
 
+#include <omp.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 
 #include "diagnostics.h"
 
@@ -99,11 +104,34 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
     return out;
   }
   std::vector<BatchOutcome> out(jobs.size());
-  for (size_t k = 0; k < jobs.size(); ++k) {
-    out[k] = simulate(k);
-    done(k, out[k]);
-    if (fatal(out[k])) break;
+  const size_t workers = std::min(jobs.size(), static_cast<size_t>(std::max(1, options.parallel)));
+  if (workers <= 1) {
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      out[k] = simulate(k);
+      done(k, out[k]);
+      if (fatal(out[k])) break;
+    }
+    return out;
   }
+  // Workers take the jobs in order; after a fatal outcome none starts another, so every job
+  // before the first fatal one has its outcome, as in the serial loop.
+  std::atomic<size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex reporting;
+  const auto work = [&] {
+    omp_set_num_threads(std::max(1, options.threads));  // this thread's own OpenMP setting
+    while (!stop) {
+      const size_t k = next++;
+      if (k >= jobs.size()) break;
+      out[k] = simulate(k);
+      const std::lock_guard<std::mutex> lock(reporting);
+      done(k, out[k]);
+      if (fatal(out[k])) stop = true;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (size_t w = 0; w < workers; ++w) pool.emplace_back(work);
+  for (std::thread& t : pool) t.join();
   return out;
 }
 

@@ -14,6 +14,8 @@
 #include <numbers>
 #include <numeric>
 
+#include "calibration.h"
+#include "measurements.h"
 #include "virtual_tests.h"
 
 namespace dem::materials {
@@ -262,6 +264,38 @@ TEST(HopperDischarge, RateWithinBeverloosRangeAndASmallOrificeBlocks) {
   print("hopper_discharge 2.5 d orifice", arch);
   EXPECT_TRUE(flagged(arch, "blocked"));
   EXPECT_EQ(arch.observables.at("mass_flow_rate"), 0.0);
+}
+
+// Simulations of a batch on two threads at once (CalibrationOptions::parallel, each simulation on
+// one OpenMP thread): the same outcomes, bit for bit, as one after the other, also for tests with
+// triangle meshes (the drum) and random packings (the cup), with two replicas each.
+TEST(Batch, SimulationsInParallelGiveTheSerialOutcomes) {
+  MaterialModel m = beads(0.5, 0.1, 0.5, 0.005);
+  m.particle.youngs_modulus = 2e5;
+  MeasurementSet set;
+  auto add = [&](const std::string& id, TestSetup setup, const std::string& observable) {
+    Experiment e;
+    e.id = id, e.setup = std::move(setup);
+    e.observed[observable] = Observation{1.0, 1.0, {}};
+    set.experiments.push_back(e);
+  };
+  add("drop", setup_of("drop_rebound", {{"drop_height", 0.05}}, {{"plate", "steel"}}), "restitution");
+  add("cup", setup_of("bulk_density", {{"cup_diameter", 0.05}, {"cup_height", 0.04}, {"pour_height", 0.02}}, {{"base", "steel"}}), "bulk_density");
+  add("drum", setup_of("rotating_drum", {{"drum_diameter", 0.20}, {"drum_depth", 0.04}, {"fill_fraction", 0.35}, {"rpm", 60}}, {{"ends", "periodic"}, {"wall", "steel"}}),
+      "dynamic_angle_deg");
+  CalibrationOptions options;
+  options.replicas = 2;
+  options.size_factor = 0.5;
+  options.threads = 1;
+  const Comparison serial = compare(m, set, options);
+  options.parallel = 2;
+  const Comparison parallel = compare(m, set, options);
+  ASSERT_EQ(serial.runs.size(), parallel.runs.size());
+  for (size_t e = 0; e < serial.runs.size(); ++e) {
+    EXPECT_EQ(serial.runs[e].values, parallel.runs[e].values) << serial.runs[e].id;
+    EXPECT_EQ(serial.runs[e].particles, parallel.runs[e].particles) << serial.runs[e].id;
+  }
+  EXPECT_EQ(serial.chi2, parallel.chi2);
 }
 
 }  // namespace
