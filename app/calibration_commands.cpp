@@ -66,6 +66,9 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
     (*cmd)->add_option("--seed", seed_, "first packing seed");
     (*cmd)->add_option("--out", out_, "output folder (report, plots, ledger.yaml)");
     (*cmd)->add_flag("--quiet", quiet_, "no progress lines");
+    (*cmd)->add_flag("--no-renders", no_renders_, "no renders of the final states in the report");
+    (*cmd)->add_flag("--no-store", no_store_,
+                     "run every simulation again: neither take outcomes from OUT/simulations/ (kept there as each simulation finishes) nor keep new ones");
     (*cmd)->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
     if (cmd != &compare_) {
       (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
@@ -153,6 +156,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.size_factor = size_factor_;
   options.threads = threads_;
   options.parallel = parallel_ > 0 ? parallel_ : std::max(1, omp_get_num_procs());
+  if (!no_store_) options.store = (fs::path(out_) / "simulations").string();
   options.seed = static_cast<std::uint64_t>(seed_);
   // Every rank runs the same calibration in lockstep; the simulations of each batch (a design
   // round, the replicas of a comparison) are shared among the ranks and every rank gets every
@@ -220,7 +224,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
     for (const auto& c : diagnosis.candidates)
       if (c.name == diagnosis.recommended && c.confirmed) shown = &c.fit.fitted;
   }
-  input.images = render_tests(*shown, measured, options);
+  if (!no_renders_) input.images = render_tests(*shown, measured, options);
   input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::string html = report::write_calibration_report(input, out_);
   std::cout << fmt::format("report: {} ({:.0f} s)\n", html, input.wall_seconds);

@@ -42,6 +42,7 @@ class CalibrationCommands {
   std::vector<std::string> set_;
   double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
   int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
+  bool no_store_ = false, no_renders_ = false;
   long long noise_seed_ = 1;
   int write_synthetic();
   /// One render of the final state per test type of the measurement file, with `model`.

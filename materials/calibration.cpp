@@ -275,7 +275,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
           if (b.error == BatchOutcome::Error::input) return;
           if (b.error != BatchOutcome::Error::none && options.progress)
             options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, b.message));
-          progress.step(e, fmt::format("round {} point {} {}", round + 1, k + 1, e.id), b.outcome.wall_seconds);
+          progress.step(e, fmt::format("round {} point {} {}{}", round + 1, k + 1, e.id, b.stored ? ", stored" : ""), b.stored ? 0.0 : b.outcome.wall_seconds);
         },
         [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
     std::vector<int> good;

@@ -54,6 +54,7 @@ struct BatchOutcome {
   Error error = Error::not_run;  ///< input: CaseError; numerical: NumericalError; other: any other exception
   std::string message;           ///< what() of the error
   SimulatedOutcome outcome;      ///< when error is none
+  bool stored = false;           ///< taken from the simulation store (CalibrationOptions::store), not run
 };
 
 /// Runs the independent simulations 0..count-1 of one batch (a design round, the replicas of a
@@ -77,6 +78,10 @@ struct CalibrationOptions {
   /// its own thread with `threads` OpenMP threads (1 by default): the small apparatus of the lab
   /// tests keep one core busy each far better than they use two. Outcomes do not depend on it.
   int parallel = 1;
+  /// Folder of the simulation store (simulation_store.h): every finished simulation is kept there
+  /// and one whose inputs match a kept one is not run again. Empty: nothing is kept. Only the
+  /// engine's own virtual tests are stored (not a `simulator` stand-in).
+  std::string store;
   std::uint64_t seed = 1;       ///< first packing seed; the design uses this one
   int design_points = 0;        ///< per round; 0: from design_factor
   /// Design points per round when design_points is 0: max(b + 1, ceil(design_factor x b) + 2),

@@ -70,7 +70,7 @@ class Progress {
   /// Simulation of `experiment` finished (`label` says which: point, replica, candidate).
   void step(const Experiment& experiment, const std::string& label, double seconds) {
     SimulationCosts& costs = SimulationCosts::shared();
-    costs.add(key(experiment), seconds);
+    if (seconds > 0) costs.add(key(experiment), seconds);  // (a stored outcome costs nothing, and says nothing of the cost)
     if (const auto it = std::find(planned_.begin(), planned_.end(), key(experiment)); it != planned_.end()) planned_.erase(it);
     ++done_;
     if (!options_.progress) return;

@@ -12,10 +12,12 @@
 #include <cmath>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
 #include "diagnostics.h"
+#include "simulation_store.h"
 
 namespace dem::materials {
 
@@ -32,13 +34,33 @@ SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, con
   return options.simulator ? options.simulator(model, setup, t) : run_virtual_test(model, setup, t);
 }
 
-/// Runs one job; an exception becomes the outcome's error (a runner must not throw mid-batch:
-/// under MPI every rank has to reach the gather).
+/// Runs one job, or takes its outcome from the store; an exception becomes the outcome's error (a
+/// runner must not throw mid-batch: under MPI every rank has to reach the gather). Failed
+/// simulations are not stored: they run again.
 BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
   BatchOutcome b;
   try {
+    const bool keep = !options.store.empty() && !options.simulator;
+    std::string inputs;
+    if (keep) {
+      TestOptions t;
+      t.seed = job.seed, t.size_factor = options.size_factor;
+      inputs = simulation_inputs(*job.model, *job.setup, t);
+      if (std::optional<SimulatedOutcome> stored = load_simulation(options.store, job.setup->test, inputs)) {
+        b.outcome = std::move(*stored);
+        b.error = BatchOutcome::Error::none, b.stored = true;
+        return b;
+      }
+    }
     b.outcome = run_one(*job.model, *job.setup, options, job.seed);
     b.error = BatchOutcome::Error::none;
+    if (keep) {
+      try {
+        store_simulation(options.store, job.setup->test, inputs, b.outcome);
+      } catch (const std::exception& e) {
+        b.outcome.notes.push_back(fmt::format("not stored: {}", e.what()));  // the outcome itself stands
+      }
+    }
   } catch (const CaseError& e) {
     b.error = BatchOutcome::Error::input, b.message = e.what();
   } catch (const NumericalError& e) {
@@ -147,7 +169,8 @@ std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& mod
       [&](size_t k, const BatchOutcome& b) {
         const size_t e = k / static_cast<size_t>(replicas);
         if (b.error == BatchOutcome::Error::none && progress)
-          progress->step(experiments[e], fmt::format("{}{}, replica {} of {}", prefix, experiments[e].id, k % replicas + 1, replicas), b.outcome.wall_seconds);
+          progress->step(experiments[e], fmt::format("{}{}, replica {} of {}{}", prefix, experiments[e].id, k % replicas + 1, replicas, b.stored ? ", stored" : ""),
+                         b.stored ? 0.0 : b.outcome.wall_seconds);
       },
       [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
   for (const BatchOutcome& b : outcomes)

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -118,6 +119,84 @@ TEST(KillAndResume, SigkillAtRandomMomentsThenResumeReachesTheSameState) {
   std::cout << trials << " kill-and-resume trials (" << killed_mid_run << " killed mid-run), uninterrupted run " << seconds
             << " s; every resumed run ended with state_hash " << expected << "\n";
   EXPECT_GE(killed_mid_run, 2);
+}
+
+/// A soft 5 mm bead (short runs) and a measurement file of two drops and a poured cup.
+fs::path calibration_files() {
+  const fs::path dir = kScratch / "calibration";
+  fs::create_directories(dir);
+  std::ofstream(dir / "soft_beads.yaml") << R"(name: soft_beads
+description: soft 5 mm beads for the calibration crash test
+contact: {normal: hertz, damping: restitution, tangential: mindlin}
+properties: {density: 2500, youngs_modulus: 1.0e6, poisson_ratio: 0.25, restitution: 0.5, friction: 0.5}
+size: 0.005
+walls:
+  steel: {friction: 0.5, restitution: 0.5}
+tunable:
+  friction: [0.2, 0.8]
+)";
+  std::ofstream(dir / "measurements.yaml") << R"(material: soft beads
+particles: {diameter: 0.005, density: 2500}
+walls:
+  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800}
+experiments:
+  - {id: drop_low, test: drop_rebound, setup: {drop_height: 0.02, plate: steel}, observed: {restitution: {value: 0.5, sigma: 0.02}}}
+  - {id: drop_high, test: drop_rebound, setup: {drop_height: 0.1, plate: steel}, observed: {restitution: {value: 0.5, sigma: 0.02}}}
+  - id: cup
+    test: bulk_density
+    setup: {cup_diameter: 0.05, cup_height: 0.04, pour_height: 0.02, base: steel}
+    observed: {bulk_density: {value: 1500, sigma: 30}}
+)";
+  return dir;
+}
+
+/// The compared terms a `compare` printed (measured, simulated with its sigma, residual).
+std::vector<std::string> term_lines(const fs::path& log) {
+  std::vector<std::string> out;
+  std::istringstream in(read_text(log));
+  for (std::string line; std::getline(in, line);)
+    if (line.find(" measured ") != std::string::npos && line.find(" residual ") != std::string::npos) out.push_back(line);
+  return out;
+}
+
+// A compare killed with SIGKILL at seeded random moments and started again with the same command
+// ends with the same numbers as an uninterrupted one, taking every simulation that finished
+// before the kill from OUT/simulations/ instead of running it again.
+TEST(KillAndResume, CalibrationCompareKilledThenRerunEndsWithTheSameNumbers) {
+  const fs::path dir = calibration_files();
+  auto args = [&](const fs::path& out) {
+    return std::vector<std::string>{"compare", (dir / "soft_beads.yaml").string(), (dir / "measurements.yaml").string(), "--replicas", "2",
+                                    "--out", out.string(), "--no-renders", "--quiet"};
+  };
+  const fs::path reference = kScratch / "compare_reference";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start(args(reference), kScratch / "compare_reference.log")), 0) << read_text(kScratch / "compare_reference.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::vector<std::string> expected = term_lines(kScratch / "compare_reference.log");
+  ASSERT_EQ(expected.size(), 3u) << read_text(kScratch / "compare_reference.log");
+  EXPECT_EQ(std::distance(fs::directory_iterator(reference / "simulations"), fs::directory_iterator{}), 6) << "3 experiments x 2 replicas kept";
+  std::mt19937 random(20261203);
+  int killed_mid_run = 0, reused = 0;
+  for (int trial = 0; trial < 3; ++trial) {
+    const fs::path out = kScratch / ("compare_trial" + std::to_string(trial));
+    const pid_t pid = start(args(out), kScratch / "compare_trial.log");
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::uniform_real_distribution<double>(0.2, 0.9)(random) * seconds));
+    const bool running = ::kill(pid, SIGKILL) == 0;
+    killed_mid_run += running && wait_exit(pid) == 128 + SIGKILL;
+    const auto kept = fs::exists(out / "simulations") ? std::distance(fs::directory_iterator(out / "simulations"), fs::directory_iterator{}) : 0;
+    reused += kept > 0;
+    ASSERT_EQ(wait_exit(start(args(out), kScratch / "compare_rerun.log")), 0) << read_text(kScratch / "compare_rerun.log");
+    EXPECT_EQ(term_lines(kScratch / "compare_rerun.log"), expected) << "trial " << trial << ", " << kept << " simulations kept before the kill";
+  }
+  std::cout << killed_mid_run << " of 3 compares killed mid-run, " << reused << " reran with kept simulations; uninterrupted " << seconds << " s\n";
+  EXPECT_GE(killed_mid_run, 1);
+  // A second compare in a folder that holds every simulation runs none of them again (no kept
+  // file is written anew).
+  std::map<std::string, fs::file_time_type> written;
+  for (const auto& f : fs::directory_iterator(reference / "simulations")) written[f.path().string()] = f.last_write_time();
+  ASSERT_EQ(wait_exit(start(args(reference), kScratch / "compare_again.log")), 0);
+  EXPECT_EQ(term_lines(kScratch / "compare_again.log"), expected);
+  for (const auto& f : fs::directory_iterator(reference / "simulations")) EXPECT_EQ(written.at(f.path().string()), f.last_write_time()) << f.path();
 }
 
 TEST(KillAndResume, SigtermWritesACheckpointAndExitsCleanly) {
