@@ -97,7 +97,18 @@ struct CalibrationOptions {
   /// Raftery 1995).
   double rival_margin = 6.0;
   int confirm_candidates = 2;       ///< leading candidates confirmed by recalibration
-  /// Effects diagnose considers (names of candidate_names()); empty: every effect the model lacks.
+  /// Packings of each signature run (at two strengths per candidate); at most `replicas`.
+  int signature_replicas = 2;
+  /// Candidates whose explained fractions lie within this of the leader's cannot be told apart by
+  /// the screen: all of them are confirmed by recalibration (up to confirm_candidates + 2).
+  double screen_margin = 0.1;
+  /// When the data cannot tell two candidates apart, simulate both fitted models on variants of the
+  /// file's experiments and on standard set-ups of the tests it lacks, and name the experiment
+  /// whose predictions lie furthest apart (discrimination.h).
+  bool propose_experiments = true;
+  double separation_needed = 3.0;  ///< [sigma] a proposed experiment decides when the two predictions lie this far apart
+  /// Candidates diagnose considers: effect names (candidate_names()) and wall parameters
+  /// (WALL.KEY); empty: every effect the model lacks and every wall parameter it does not fit.
   std::vector<std::string> effects;
   /// Progress lines (with time left); empty: quiet.
   std::function<void(const std::string&)> progress;
@@ -252,13 +263,29 @@ struct CandidateResult {
   std::string name, title, description;
   std::string why;        ///< why its signature fits a misfit (the effect's own words)
   std::string switch_on;  ///< the YAML that switches it on
+  std::string kind;       ///< "effect", "shape" or "parameter" (EffectCandidate::kind)
   std::vector<FitParameter> adds;    ///< parameters the effect adds to the fit
   std::vector<double> signature;     ///< per term of the base comparison: change in units of its sigma
-  double explained = 0;              ///< fraction of the base chi^2 the signature could remove
+  double explained = 0;              ///< fraction of the base chi^2 the signature could remove (the better of its two strengths)
+  double explained_start = 0, explained_stronger = 0;  ///< at the start values and at the stronger step
+  /// Cosine of the signatures at the two strengths (made orthogonal to the fitted parameters): near 1
+  /// when the effect acts linearly, low when the screen cannot be trusted for it.
+  double agreement = 1;
   bool confirmed = false;
   CalibrationResult fit;             ///< when confirmed
   double chi2 = 0, bic = 0, delta_bic = 0;  ///< confirmed: after recalibration; delta = base BIC - this BIC
   int k = 0;                         ///< fitted parameters
+  std::string words;
+};
+
+/// An experiment that would separate two models (discrimination.h).
+struct Separator {
+  std::string id;          ///< "shear_2000 at normal_stress 8000" or "direct_shear (standard set-up)"
+  TestSetup setup;
+  std::string observable;
+  double predicted_a = 0, predicted_b = 0;  ///< means over replicas
+  double sigma = 0;        ///< lab repeatability assumed plus both simulations' standard errors
+  double separation = 0;   ///< |a - b| / sigma
   std::string words;
 };
 
@@ -268,6 +295,8 @@ struct Diagnosis {
   std::vector<CandidateResult> candidates;  ///< ranked: confirmed by BIC, then by explained fraction
   std::string recommended;                  ///< candidate name, "" for none
   std::vector<std::string> rivals;          ///< confirmed candidates the data cannot tell from the recommended one
+  /// Per rival: the experiments that would tell it from the recommended candidate, best first.
+  std::map<std::string, std::vector<Separator>> separators;
   std::vector<std::string> words;
 };
 

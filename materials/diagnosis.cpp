@@ -14,6 +14,7 @@
 
 #include "calibration.h"
 #include "calibration_support.h"
+#include "discrimination.h"
 
 namespace dem::materials {
 
@@ -24,6 +25,47 @@ using detail::simulate_experiments;
 // ---- diagnosis ----------------------------------------------------------------------------
 
 double bic(double chi2, int k, int n) { return chi2 + k * std::log(static_cast<double>(std::max(n, 1))); }
+
+namespace {
+
+/// Wall parameters the fit leaves out (friction and restitution of each particle-wall pair, the
+/// rolling friction when the model rolls), as candidates: a test that misses because of a wall
+/// points at the wall's parameter, not at missing physics. Measured ones are inputs: not offered.
+std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& model, const std::vector<FitParameter>& fitted) {
+  std::vector<EffectCandidate> out;
+  std::vector<std::string> keys = {"friction", "restitution"};
+  if (model.contact.rolling.model != "none") keys.emplace_back("rolling_friction");
+  const auto listed = [](const std::vector<std::string>& list, const std::string& key) { return std::find(list.begin(), list.end(), key) != list.end(); };
+  std::vector<std::string> fitted_keys;
+  for (const FitParameter& p : fitted) fitted_keys.push_back(p.key);
+  for (const InteractionSpec& pair : model.wall_pairs) {
+    const std::string wall = pair.material_a == model.name ? pair.material_b : pair.material_a;
+    for (const std::string& key : keys) {
+      const std::string full = wall + "." + key;
+      if (listed(fitted_keys, full) || listed(fitted_keys, "wall." + key) || listed(model.known, full)) continue;
+      const ParamSpec* p = find_param(key);
+      if (!p) continue;
+      const double lo = p->min_value, hi = std::min(p->max_value, 1.0);  // friction above 1 is not a wall liner's
+      const double now = std::clamp(get_parameter(model, full), lo, hi), step = 0.2 * (hi - lo);
+      const double start = now + step <= hi ? now + step : now - step;
+      EffectCandidate c;
+      c.name = full;
+      c.kind = "parameter";
+      c.title = fmt::format("the {} of the particles on {}", key, wall);
+      c.why = fmt::format("tests on {} walls miss while the others fit: the particle-wall {} (a parameter, now {:.3g}, not calibrated)", wall, key, now);
+      c.switch_on = fmt::format("calibrate it with the others (--params ...,{})", full);
+      c.description = fmt::format("{}: a wall parameter, not physics the model lacks", c.title);
+      c.parameters = {{full, {lo, hi}}};
+      c.start = {{full, start}};
+      c.stronger = {{full, std::clamp(now + 2.0 * (start - now), lo, hi)}};
+      c.add = [](MaterialModel&) {};
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& options) {
   Diagnosis d;
@@ -55,49 +97,67 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     }
     for (size_t j = 0; j < parameters.size(); ++j) A.col(static_cast<Eigen::Index>(j)) *= (parameters[j].max - parameters[j].min);
   }
-  // The candidates: every effect the model lacks, or those options.effects names.
+  // The candidates: every effect the model lacks and every wall parameter it does not fit, or
+  // those options.effects names.
   std::vector<EffectCandidate> effects;
+  std::vector<EffectCandidate> all = missing_effects(d.base.fitted);
+  for (EffectCandidate& c : wall_parameter_candidates(d.base.fitted, parameters)) all.push_back(std::move(c));
   const std::vector<std::string> known = candidate_names();
   for (const std::string& name : options.effects)
-    if (std::find(known.begin(), known.end(), name) == known.end())
-      throw std::invalid_argument(fmt::format("--effects: '{}' is not a candidate effect; valid: {}", name, join(known, ", ")));
-  for (EffectCandidate& c : missing_effects(d.base.fitted))
+    if (std::find(known.begin(), known.end(), name) == known.end() && name.find('.') == std::string::npos)
+      throw std::invalid_argument(fmt::format("--effects: '{}' is not a candidate; valid: {}, or a wall parameter WALL.KEY", name, join(known, ", ")));
+  for (EffectCandidate& c : all)
     if (options.effects.empty() || std::find(options.effects.begin(), options.effects.end(), c.name) != options.effects.end())
       effects.push_back(std::move(c));
-  // The signature run of each candidate is the candidate model at its start: it serves as the
-  // "before" of its confirmation (same packing seed, the base's simulation noise).
+  // Each candidate's signature at two strengths: its start values with replicas (the base
+  // comparison's first packings: common random numbers; this run is also the "before" of its
+  // confirmation), and a step twice as far with one packing.
   std::map<std::string, Comparison> at_start;
+  const int replicas = std::max(1, std::min(options.replicas, options.signature_replicas));
   Progress progress{options, "signatures"};
   for (size_t k = 0; k < effects.size(); ++k)
-    for (const Experiment& e : measured.experiments) progress.plan(e);
+    for (const Experiment& e : measured.experiments) progress.plan(e, replicas + 1);
+  std::map<std::string, double> floor;
+  for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
+  const auto orthogonal = [&](const Eigen::VectorXd& s) {
+    return A.cols() > 0 && A.norm() > 0 ? Eigen::VectorXd(s - A * A.completeOrthogonalDecomposition().solve(s)) : s;
+  };
+  const auto explained_by = [&](const Eigen::VectorXd& s_perp, const Eigen::VectorXd& s) {
+    const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
+    if (!(ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0)) return 0.0;
+    const double alpha = -s_perp.dot(r) / ss;  // multiple of the added strength that best cancels r
+    return alpha > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
+  };
   for (const EffectCandidate& c : effects) {
     CandidateResult cr;
-    cr.name = c.name, cr.title = c.title, cr.description = c.description, cr.why = c.why, cr.switch_on = c.switch_on;
+    cr.name = c.name, cr.title = c.title, cr.description = c.description, cr.why = c.why, cr.switch_on = c.switch_on, cr.kind = c.kind;
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
     cr.k = static_cast<int>(parameters.size() + cr.adds.size());
-    MaterialModel with = d.base.fitted;
-    c.add(with);
-    for (const auto& [key, v] : c.start) set_parameter(with, key, v);
-    // Signature: the change of every term, one replica each, same packing seed as the base run's first replica.
-    const std::vector<ExperimentRun> runs = simulate_experiments(with, measured.experiments, options, 1, &progress, c.name + " ");
-    std::map<std::string, double> floor;
-    for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
-    const Comparison& changed = at_start[c.name] = compare_runs(measured, runs, options, floor);
-    Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
-    for (int i = 0; i < nt; ++i) {
-      const Term& t = base.terms[i];
-      for (const Term& u : changed.terms)
-        if (u.name() == t.name()) s[i] = (u.simulated - t.simulated) / sig[i];
-      cr.signature.push_back(s[i]);
+    Eigen::VectorXd perp[2];
+    for (int strength = 0; strength < 2; ++strength) {
+      MaterialModel with = d.base.fitted;
+      c.add(with);
+      for (const auto& [key, v] : c.start) {
+        const auto stronger = c.stronger.find(key);
+        set_parameter(with, key, strength == 1 && stronger != c.stronger.end() ? stronger->second : v);
+      }
+      const std::vector<ExperimentRun> runs =
+          simulate_experiments(with, measured.experiments, options, strength == 0 ? replicas : 1, &progress, fmt::format("{} {} ", c.name, strength == 0 ? "start" : "stronger"));
+      const Comparison changed = compare_runs(measured, runs, options, floor);
+      Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
+      for (int i = 0; i < nt; ++i)
+        for (const Term& u : changed.terms)
+          if (u.name() == base.terms[i].name()) s[i] = (u.simulated - base.terms[i].simulated) / sig[i];
+      perp[strength] = orthogonal(s);
+      (strength == 0 ? cr.explained_start : cr.explained_stronger) = explained_by(perp[strength], s);
+      if (strength == 0) {
+        cr.signature.assign(s.data(), s.data() + s.size());
+        at_start[c.name] = changed;
+      }
     }
-    // Remove what the existing parameters can do, then project the residual on what is left.
-    Eigen::VectorXd s_perp = s;
-    if (A.cols() > 0 && A.norm() > 0) s_perp = s - A * A.completeOrthogonalDecomposition().solve(s);
-    const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
-    if (ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0) {
-      const double alpha = -s_perp.dot(r) / ss;  // multiple of the added strength that best cancels r
-      cr.explained = alpha > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
-    }
+    cr.explained = std::max(cr.explained_start, cr.explained_stronger);
+    const double norms = perp[0].norm() * perp[1].norm();
+    cr.agreement = norms > 0 ? perp[0].dot(perp[1]) / norms : 1.0;
     d.candidates.push_back(std::move(cr));
   }
   std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
@@ -112,9 +172,21 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     // projection. When no candidate passes the screen although the model misfits, the leading
     // ones are confirmed anyway: recalibration, not the screen, decides.
     const bool screen_silent = std::none_of(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
+    // Confirmed: the leaders the screen passes, every candidate it cannot tell from the leader
+    // (within screen_margin), and a candidate whose signature changes shape between its two
+    // strengths (the linear screen cannot be trusted for it); at most confirm_candidates + 2.
+    const double leader = d.candidates.empty() ? 0.0 : d.candidates.front().explained;
+    std::vector<std::string> undecided, nonlinear;
+    const auto chosen = [&](const CandidateResult& cr, int rank) {
+      if (rank < options.confirm_candidates && (cr.explained >= 0.05 || screen_silent)) return true;
+      if (cr.explained >= 0.05 && leader - cr.explained <= options.screen_margin) return undecided.push_back(cr.name), true;
+      if (cr.explained >= 0.05 && cr.agreement < 0.5) return nonlinear.push_back(cr.name), true;
+      return false;
+    };
     int confirmed = 0;
-    for (CandidateResult& cr : d.candidates) {
-      if (confirmed >= options.confirm_candidates || (cr.explained < 0.05 && !screen_silent)) break;
+    for (size_t rank = 0; rank < d.candidates.size() && confirmed < options.confirm_candidates + 2; ++rank) {
+      CandidateResult& cr = d.candidates[rank];
+      if (!chosen(cr, static_cast<int>(rank))) continue;
       const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
       MaterialModel with = d.base.fitted;
       it->add(with);
@@ -129,6 +201,13 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       cr.delta_bic = d.base_bic - cr.bic;
       ++confirmed;
     }
+    if (!undecided.empty())
+      d.words.push_back(fmt::format("The signature screen cannot tell {} from {} (their signatures explain within {:.0f} % of each other, "
+                                    "at its noise): each was recalibrated.",
+                                    d.candidates.front().name, join(undecided, ", "), 100 * options.screen_margin));
+    if (!nonlinear.empty())
+      d.words.push_back(fmt::format("The signature of {} changes shape between its two strengths (the linear screen cannot be trusted for "
+                                    "it): recalibrated.", join(nonlinear, ", ")));
     std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) {
       if (a.confirmed != b.confirmed) return a.confirmed;
       return a.confirmed ? a.bic < b.bic : a.explained > b.explained;
@@ -140,12 +219,19 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       std::vector<std::string> misfits;
       for (const Pattern& p : d.base.after.patterns)
         if (p.kind != "fits") misfits.push_back(p.words);
-      d.words.push_back(fmt::format("Most likely missing: {} ({}; switch it on with `{}`). Why: {}. It could explain {:.0f} % of the weighted residual of the calibrated model; "
-                                    "added and recalibrated, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} "
-                                    "(by {:.1f} > margin {:.0f}, with {} more parameter{}).",
-                                    best->name, best->title, best->switch_on, best->why, 100 * best->explained, base.chi2_per_n(),
-                                    best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
-                                    best->adds.size() == 1 ? "" : "s"));
+      if (best->kind == "parameter")
+        d.words.push_back(fmt::format("Not missing physics: {} ({}), which the fit left out, explains the misfit ({}). Calibrated with the "
+                                      "others it comes to {:.3g}, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} (by {:.1f} > "
+                                      "margin {:.0f}). {}; or measure it and state it in the measurement file.",
+                                      best->name, best->title, best->why, get_parameter(best->fit.fitted, best->name), base.chi2_per_n(),
+                                      best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->switch_on));
+      else
+        d.words.push_back(fmt::format("Most likely missing: {} ({}; switch it on with `{}`). Why: {}. It could explain {:.0f} % of the weighted residual of the calibrated model; "
+                                      "added and recalibrated, chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} "
+                                      "(by {:.1f} > margin {:.0f}, with {} more parameter{}).",
+                                      best->name, best->title, best->switch_on, best->why, 100 * best->explained, base.chi2_per_n(),
+                                      best->fit.after.chi2_per_n(), d.base_bic, best->bic, best->delta_bic, options.bic_margin, best->adds.size(),
+                                      best->adds.size() == 1 ? "" : "s"));
       if (!misfits.empty()) d.words.push_back("Where the model without it fails: " + join(misfits, " "));
       for (const CandidateResult& c : d.candidates)
         if (&c != best && c.confirmed && c.delta_bic > options.bic_margin && c.bic - best->bic < options.rival_margin) {
@@ -154,6 +240,17 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                         "{:.1f} above (< {:.0f}, no strong evidence). Measure where the two act differently to decide ({}: {}; {}: {}).",
                                         best->name, c.name, c.name, c.bic, c.bic - best->bic, options.rival_margin, best->name,
                                         best->why, c.name, c.why));
+          // Which experiment would decide: both fitted models simulated on candidates.
+          if (options.propose_experiments) {
+            std::vector<Separator> found = separating_experiments(best->fit.fitted, best->name, c.fit.fitted, c.name, measured, options);
+            if (!found.empty() && found.front().separation >= options.separation_needed)
+              d.words.push_back(fmt::format("To tell {} from {}, measure {}.", best->name, c.name, found.front().words));
+            else
+              d.words.push_back(fmt::format("No experiment tried separates {} from {} by {:.0f} sigma{}.", best->name, c.name, options.separation_needed,
+                                            found.empty() ? "" : fmt::format(" (best: {})", found.front().words)));
+            if (found.size() > 3) found.resize(3);
+            d.separators[c.name] = std::move(found);
+          }
         }
     } else {
       d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}) but no candidate lowers BIC by more than {:.0f}{}.",
@@ -165,9 +262,11 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                         "values); the leading candidates were confirmed by recalibration anyway.");
   }
   for (CandidateResult& cr : d.candidates) {
-    cr.words = cr.confirmed ? fmt::format("{}: explains {:.0f} % of the residual; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).",
-                                          cr.name, 100 * cr.explained, cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
-                            : fmt::format("{}: explains {:.0f} % of the residual (signature only, not confirmed).", cr.name, 100 * cr.explained);
+    const std::string screen = fmt::format("explains {:.0f} % of the residual ({:.0f} % at its start, {:.0f} % at twice the step; agreement {:.2f})",
+                                           100 * cr.explained, 100 * cr.explained_start, 100 * cr.explained_stronger, cr.agreement);
+    cr.words = cr.confirmed ? fmt::format("{}: {}; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).", cr.name, screen,
+                                          cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
+                            : fmt::format("{}: {} (signature only, not confirmed).", cr.name, screen);
   }
   return d;
 }

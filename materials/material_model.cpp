@@ -279,6 +279,7 @@ EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale&
     const double hi = std::min(f.max * factor, p ? p->max_value : HUGE_VAL);
     c.parameters[std::string(f.key)] = {lo, hi};
     c.start[std::string(f.key)] = std::clamp(f.start * factor, lo, hi);
+    c.stronger[std::string(f.key)] = std::clamp(lo + 2.0 * (c.start[std::string(f.key)] - lo), lo, hi);
   }
   for (const StartValue& v : spec.also_set) c.start[std::string(v.key)] = v.value;
   const Stage s = effect.stage;
@@ -294,6 +295,7 @@ EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale&
 EffectCandidate clump_candidate() {
   EffectCandidate c;
   c.name = "clump_shape";
+  c.kind = "shape";
   c.title = "particle shape (two-sphere clumps)";
   c.why = "interlocking of non-spherical particles (steeper heaps, higher shear strength, looser packing)";
   c.switch_on = "shape: two-sphere clumps of the fitted aspect ratio (clump_aspect_ratio)";
@@ -301,6 +303,7 @@ EffectCandidate clump_candidate() {
   c.moves = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg", "bulk_density/bulk_density", "direct_shear/peak_shear_stress"};
   c.parameters = {{"clump_aspect_ratio", {1.0, 2.0}}};
   c.start = {{"clump_aspect_ratio", 1.5}};
+  c.stronger = {{"clump_aspect_ratio", 2.0}};
   c.add = [](MaterialModel& m) { m.shape = {two_sphere_clump(1.5)}; };
   return c;
 }

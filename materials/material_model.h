@@ -35,10 +35,16 @@ struct EffectCandidate {
   std::string why;          ///< why its signature fits a misfit (the effect's own words)
   std::string switch_on;    ///< the YAML that switches it on: "contact: {rolling: epsd}"
   std::vector<std::string> moves;  ///< observables it is expected to move ("test/observable")
+  /// "effect" (a contact effect), "shape" (clumps) or "parameter" (a wall parameter the fit
+  /// leaves out: not missing physics, a value to calibrate or measure).
+  std::string kind = "effect";
   /// Switches the effect on in `model` with its parameters at their starting values.
   std::function<void(MaterialModel&)> add;
   std::map<std::string, std::pair<double, double>> parameters;  ///< key -> [min, max] it adds to the fit
   std::map<std::string, double> start;                          ///< key -> starting value
+  /// key -> the value of a second, stronger step for the signature (twice as far from where the
+  /// candidate changes nothing as `start`).
+  std::map<std::string, double> stronger;
 };
 
 /// The candidates the model does not yet use: every effect of the table that declares itself a
