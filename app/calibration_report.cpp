@@ -194,6 +194,15 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
       h += row({esc(c.name) + "<br><small>" + esc(c.title) + "</small>", adds, fmt::format("{:.0f} %", 100 * c.explained), c.confirmed ? num(c.fit.after.chi2_per_n(), 3) : "&ndash;",
                 c.confirmed ? num(c.bic, 4) : "&ndash;", c.confirmed ? num(c.delta_bic, 3) : "&ndash;", esc(c.description)});
     }
+    for (const auto& [rival, found] : in.diagnosis->separators) {
+      if (found.empty()) continue;
+      h += fmt::format("<h3>Experiments that would tell {} from {}</h3>\n<table>", esc(in.diagnosis->recommended), esc(rival)) +
+           row({"experiment", "observable", esc(in.diagnosis->recommended) + " predicts", esc(rival) + " predicts", "&sigma;", "apart [&sigma;]"}, true);
+      for (const auto& x : found)
+        h += row({esc(x.id), esc(x.observable), num(x.predicted_a), num(x.predicted_b), num(x.sigma, 2), fmt::format("{:.1f}", x.separation)});
+      h += "</table>\n<p class=\"note\">Both fitted models simulated on variants of the file's experiments and on standard set-ups of the tests "
+           "it lacks; &sigma; is a lab's repeatability with both simulations' standard errors.</p>\n";
+    }
     h += "</table>\n<p class=\"note\">explains: fraction of the calibrated model's chi&sup2; that a least-squares multiple of the effect's signature "
          "(made orthogonal to what the fitted parameters can do) removes. BIC = chi&sup2; + k ln n; an effect is recommended when it lowers BIC by "
          "more than the margin and the model without it does not already fit within the noise (chi&sup2;/n &le; 1.5).</p>\n";
