@@ -74,6 +74,9 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
       (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
       (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)");
       (*cmd)->add_option("--design-factor", design_factor_, "design points per round = max(b+1, ceil(factor b)+2), b quadratic coefficients");
+      (*cmd)->add_option("--budget", budget_,
+                         "wall time to fit in, e.g. 30m, 2h, 900s: after the first comparison the rest is planned to fit (fewer rounds, design "
+                         "points, packings, candidates) and the report says what was given up");
     }
     if (cmd == &diagnose_) {
       (*cmd)->add_option("--effects", effects_, "effects to consider, comma separated (default: every effect the material lacks)");
@@ -156,6 +159,19 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.size_factor = size_factor_;
   options.threads = threads_;
   options.parallel = parallel_ > 0 ? parallel_ : std::max(1, omp_get_num_procs());
+  if (!budget_.empty()) {
+    // 30m, 2h, 900s or 900 (seconds).
+    size_t used = 0;
+    double value = -1;
+    try {
+      value = std::stod(budget_, &used);
+    } catch (const std::exception&) {
+    }
+    const std::string unit = budget_.substr(used);
+    const double scale = unit.empty() || unit == "s" ? 1.0 : unit == "m" || unit == "min" ? 60.0 : unit == "h" ? 3600.0 : -1.0;
+    if (!(value > 0) || scale < 0) throw CaseError(fmt::format("--budget {}: write a wall time such as 30m, 2h or 900s", budget_));
+    options.budget_seconds = value * scale;
+  }
   if (!no_store_) options.store = (fs::path(out_) / "simulations").string();
   options.seed = static_cast<std::uint64_t>(seed_);
   // Every rank runs the same calibration in lockstep; the simulations of each batch (a design

@@ -38,6 +38,7 @@ class CalibrationCommands {
   CLI::App* compare_ = nullptr;
   CLI::App* calibrate_ = nullptr;
   CLI::App* diagnose_ = nullptr;
+  std::string budget_;
   std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_, effects_, synthetic_from_;
   std::vector<std::string> set_;
   double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;

@@ -203,8 +203,9 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 }  // namespace
 
 CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& options, const Comparison* before) {
+                            const CalibrationOptions& given, const Comparison* before) {
   const Clock::time_point t0 = Clock::now();
+  CalibrationOptions options = given;  // a budget may reduce it
   CalibrationResult result;
   if (parameters.empty()) parameters = fit_parameters(model);
   if (parameters.empty()) throw std::invalid_argument("nothing to calibrate: the material declares no `tunable:` ranges and none were given");
@@ -215,6 +216,15 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
   // The start, with replicas: its simulation noise stands for the noise everywhere.
   if (before) result.before = *before;
   else result.before = compare(model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+  std::string budget_words;
+  if (options.budget_seconds > 0) {
+    const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0);
+    options = plan.options;
+    options.budget_seconds = 0;
+    budget_words = fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
+                               detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; "));
+    if (options.progress) options.progress(budget_words);
+  }
   std::vector<Term> numeric;
   for (const Term& t : result.before.terms)
     if (!t.is_outcome()) numeric.push_back(t);
@@ -389,6 +399,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
   for (int i = 0; i < p; ++i)
     fitted.push_back(fmt::format("{} = {:.4g} +- {:.2g} (start {:.4g}, range [{:g}, {:g}])", parameters[i].key, result.value[i], result.sigma[i],
                                  result.start[i], parameters[i].min, parameters[i].max));
+  if (!budget_words.empty()) result.words.push_back(budget_words);
   result.words.push_back("Fitted: " + join(fitted, "; ") + ".");
   result.words.push_back(fmt::format("chi^2/n from {:.2f} at the start to {:.2f} at the fit (real simulations, n = {}); the surrogate predicted {:.2f}.",
                                      result.before.chi2_per_n(), result.after.chi2_per_n(), result.after.n,

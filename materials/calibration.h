@@ -107,6 +107,12 @@ struct CalibrationOptions {
   /// whose predictions lie furthest apart (discrimination.h).
   bool propose_experiments = true;
   double separation_needed = 3.0;  ///< [sigma] a proposed experiment decides when the two predictions lie this far apart
+  bool wall_candidates = true;      ///< diagnose also tries the wall parameters the fit leaves out
+  /// [s] wall time the command may take; 0: no limit. After the first comparison (which measures
+  /// what a simulation of each experiment costs) the rest is planned to fit: fewer surrogate
+  /// rounds and design points, fewer packings, fewer candidates, in that order, and the result
+  /// says what was given up (plan_within_budget).
+  double budget_seconds = 0;
   /// Candidates diagnose considers: effect names (candidate_names()) and wall parameters
   /// (WALL.KEY); empty: every effect the model lacks and every wall parameter it does not fit.
   std::vector<std::string> effects;
@@ -299,6 +305,18 @@ struct Diagnosis {
   std::map<std::string, std::vector<Separator>> separators;
   std::vector<std::string> words;
 };
+
+/// The settings of a calibration or diagnosis that fit options.budget_seconds, from the cost of a
+/// pass over the experiments measured by `first` (a comparison of the starting model), with `p`
+/// fitted parameters, `effects` effect candidates and `walls` wall-parameter candidates to
+/// screen (both 0: a calibration). `given_up` says what was reduced, and `seconds` the planned
+/// wall time of what remains.
+struct BudgetPlan {
+  CalibrationOptions options;
+  std::vector<std::string> given_up;
+  double seconds = 0;
+};
+BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls);
 
 /// BIC = chi^2 + k ln n.
 double bic(double chi2, int k, int n);

@@ -67,11 +67,26 @@ std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& mode
 
 }  // namespace
 
-Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& options) {
+Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& given) {
   Diagnosis d;
+  CalibrationOptions options = given;  // a budget may reduce it
   if (parameters.empty()) parameters = fit_parameters(model);
   if (options.progress) options.progress("diagnose: calibrating the model as it is");
-  d.base = calibrate(model, measured, parameters, options);
+  // With a budget: the starting model is compared first (a simulation of each experiment is then
+  // timed) and the rest planned to fit; the calibration uses that comparison as its start.
+  if (options.budget_seconds > 0) {
+    const Comparison first = compare(model, measured, options);
+    const int walls = static_cast<int>(wall_parameter_candidates(model, parameters).size());
+    const BudgetPlan plan = plan_within_budget(options, first, static_cast<int>(parameters.size()), static_cast<int>(missing_effects(model).size()), walls);
+    options = plan.options;
+    options.budget_seconds = 0;  // planned once, for the whole diagnosis
+    d.words.push_back(fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
+                                  detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; ")));
+    if (options.progress) options.progress(d.words.back());
+    d.base = calibrate(model, measured, parameters, options, &first);
+  } else {
+    d.base = calibrate(model, measured, parameters, options);
+  }
   const Comparison& base = d.base.after;
   const int n = base.n;
   d.base_bic = bic(base.chi2, static_cast<int>(parameters.size()), n);
@@ -101,7 +116,8 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   // those options.effects names.
   std::vector<EffectCandidate> effects;
   std::vector<EffectCandidate> all = missing_effects(d.base.fitted);
-  for (EffectCandidate& c : wall_parameter_candidates(d.base.fitted, parameters)) all.push_back(std::move(c));
+  if (options.wall_candidates)
+    for (EffectCandidate& c : wall_parameter_candidates(d.base.fitted, parameters)) all.push_back(std::move(c));
   const std::vector<std::string> known = candidate_names();
   for (const std::string& name : options.effects)
     if (std::find(known.begin(), known.end(), name) == known.end() && name.find('.') == std::string::npos)
@@ -269,6 +285,60 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                             : fmt::format("{}: {} (signature only, not confirmed).", cr.name, screen);
   }
   return d;
+}
+
+// ---- budget -------------------------------------------------------------------------------
+
+BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls) {
+  const int candidates = effects + walls;
+  BudgetPlan plan{options, {}, 0};
+  // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
+  // `parallel` simulations at once.
+  double pass = 0;
+  for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
+  pass /= std::max(1, options.parallel);
+  const auto points = [](const CalibrationOptions& o, int k) {
+    const int b = 1 + k + k * (k + 1) / 2;
+    return o.design_points > 0 ? o.design_points : std::max(b + 1, static_cast<int>(std::ceil(o.design_factor * b)) + 2);
+  };
+  const auto seconds = [&](const CalibrationOptions& o) {
+    const int rounds = std::max(1, o.rounds);
+    double passes = rounds * points(o, p) + o.replicas;  // the calibration and its confirming comparison
+    if (candidates > 0) {
+      const int screened = effects + (o.wall_candidates ? walls : 0);
+      passes += screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);
+      passes += o.confirm_candidates * (rounds * points(o, p + 1) + o.replicas);
+    }
+    return passes * pass;
+  };
+  struct Step {
+    const char* words;
+    void (*apply)(CalibrationOptions&);
+    bool diagnosis_only;
+  };
+  const Step ladder[] = {
+      {"one surrogate round instead of two (no zoom on the optimum)", [](CalibrationOptions& o) { o.rounds = 1; }, false},
+      {"design factor 1 instead of 2 (fewer design points)", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 1.0); }, false},
+      {"wall parameters not screened", [](CalibrationOptions& o) { o.wall_candidates = false; }, true},
+      {"signatures with one packing", [](CalibrationOptions& o) { o.signature_replicas = 1; }, true},
+      {"design factor 0.5", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 0.5); }, false},
+      {"two packings per comparison instead of three", [](CalibrationOptions& o) { o.replicas = std::min(o.replicas, 2); }, false},
+      {"one candidate confirmed instead of two", [](CalibrationOptions& o) { o.confirm_candidates = std::min(o.confirm_candidates, 1); }, true},
+  };
+  plan.seconds = seconds(plan.options);
+  for (const Step& step : ladder) {
+    if (plan.seconds <= options.budget_seconds) break;
+    if (step.diagnosis_only && candidates == 0) continue;
+    CalibrationOptions reduced = plan.options;
+    step.apply(reduced);
+    const double s = seconds(reduced);
+    if (s < plan.seconds) plan.options = reduced, plan.seconds = s, plan.given_up.emplace_back(step.words);
+  }
+  if (plan.seconds > options.budget_seconds)
+    plan.given_up.push_back(fmt::format("still about {} at the least: the budget of {} cannot be met with these experiments (use --size-factor, or "
+                                        "fewer experiments)",
+                                        detail::duration_text(plan.seconds), detail::duration_text(options.budget_seconds)));
+  return plan;
 }
 
 // ---- ledger -------------------------------------------------------------------------------

@@ -579,6 +579,46 @@ TEST(Diagnose, AWallParameterTheFitLeftOutIsNamedAsAParameter) {
   EXPECT_EQ(d.candidates.front().kind, "parameter");
 }
 
+// --budget: from what a pass over the experiments costs, the plan gives up rounds, design
+// points, packings and candidates in that order until it fits, and says so.
+TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
+  Comparison first;
+  for (int e = 0; e < 7; ++e) {
+    ExperimentRun run;
+    run.replicas = 3, run.wall_seconds = 3 * 10.0;  // 10 s a simulation: 70 s a pass
+    first.runs.push_back(run);
+  }
+  CalibrationOptions options;
+  options.parallel = 2;  // 35 s a pass
+  options.budget_seconds = 1e6;
+  const BudgetPlan roomy = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_TRUE(roomy.given_up.empty());
+  // Defaults, 2 parameters: 2 x 14 + 3 passes; 8 candidates x 3; 2 confirmations x (2 x 22 + 3): 149 passes.
+  EXPECT_NEAR(roomy.seconds, 149 * 35.0, 1e-9);
+  options.budget_seconds = 1800;
+  const BudgetPlan tight = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_LE(tight.seconds, 1800);
+  ASSERT_FALSE(tight.given_up.empty());
+  EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
+  EXPECT_EQ(tight.options.rounds, 1);
+  options.budget_seconds = 60;
+  const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
+  EXPECT_EQ(impossible.options.confirm_candidates, 1);
+  // A diagnosis with a budget plans after its first comparison and says so first.
+  const Simulator costly = [](const MaterialModel& m, const TestSetup& s, const TestOptions& o) {
+    SimulatedOutcome out = Analytic{}(m, s, o);
+    out.wall_seconds = 10;
+    return out;
+  };
+  CalibrationOptions budgeted = analytic_options(costly);
+  budgeted.budget_seconds = 1200;
+  const Diagnosis d = diagnose(dry_spheres(), synthesise(flow_tests(), read_material_model(kMaterials + "/gravel.yaml"), costly, 11), {}, budgeted);
+  ASSERT_FALSE(d.words.empty());
+  EXPECT_EQ(d.words.front().rfind("Planned for the budget of 20 min", 0), 0u) << d.words.front();
+  EXPECT_NE(d.words.front().find("given up"), std::string::npos) << d.words.front();
+}
+
 TEST(Ledger, AppendsVersions) {
   const std::string path = (std::filesystem::temp_directory_path() / "demdesign_ledger_test" / "ledger.yaml").string();
   std::filesystem::remove_all(std::filesystem::path(path).parent_path());
