@@ -148,6 +148,8 @@ int CalibrationCommands::run_measured(const std::string& command) {
   const auto t0 = std::chrono::steady_clock::now();
   MaterialModel model = read_material_model(material_);
   const MeasurementSet measured = read_measurements(measurements_);
+  if (mpi::world().rank == 0)
+    for (const std::string& w : measured.warnings) std::cout << "warning: " << w << std::endl;
   apply_measured(model, measured);
   model.stiffness_scaling = stiffness_scaling_;
   CalibrationOptions options;

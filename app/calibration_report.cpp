@@ -177,6 +177,11 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
   std::string h = html::head(in.title);
   h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">material {} &middot; measurements {} &middot; {} &middot; demdesign {} &middot; {:.0f} s</p>\n", esc(in.title),
                    esc(in.material_path), esc(in.measurements_path), esc(html::now_text()), esc(in.version), in.wall_seconds);
+  if (in.measured && !in.measured->warnings.empty()) {
+    h += "<h2>Warnings on the measurement file</h2>\n<ul>";
+    for (const std::string& w : in.measured->warnings) h += "<li>" + esc(w) + "</li>";
+    h += "</ul>\n";
+  }
   if (in.measured && !in.measured->known.empty()) {
     h += "<h2>Known inputs</h2>\n<p>Measured directly (the measurement file): inputs of every simulation, never fitted.</p>\n<table>" +
          row({"parameter", "value", "unit", "where"}, true);

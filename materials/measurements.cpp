@@ -129,6 +129,16 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
     if (outcomes.empty()) map.fail("outcome", fmt::format("{} has no outcomes; remove the key", test));
     e.outcome = map.string("outcome", "", outcomes);
   }
+  // An outcome written as a number: no heap measured as an angle of 0, an arch as no flow.
+  for (const auto& [key, obs] : e.observed) {
+    const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
+    const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
+    if ((no_heap || no_flow) && e.outcome.empty())
+      e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; write it as `outcome: {}` (and leave out the value), "
+                                       "so it is compared as an outcome, not as a number with sigma {:g}",
+                                       obs.location.str(), key, obs.value, no_heap ? "no heap formed" : "the orifice arched",
+                                       no_heap ? "no_heap" : "blocked", obs.sigma));
+  }
   if (e.observed.empty() && e.outcome.empty())
     map.fail("observed", fmt::format("missing: what was observed, e.g. {{{}: {{value: V, sigma: S}}}}{}", observables.front(),
                                      outcome_names(test).empty() ? "" : fmt::format(", or outcome: {}", join(outcome_names(test)))));
@@ -170,6 +180,7 @@ MeasurementSet parse_measurements(const std::string& text, const std::string& na
       Experiment e = read_experiment(experiments[k], name, k, set.walls);
       if (!ids.insert(e.id).second)
         throw CaseError(fmt::format("{}: experiments[{}].id: '{}' is used twice; ids must be unique", e.location.str(), k, e.id));
+      set.warnings.insert(set.warnings.end(), e.warnings.begin(), e.warnings.end());
       set.experiments.push_back(std::move(e));
     }
     top.finish();

@@ -24,6 +24,7 @@ struct Experiment {
   TestSetup setup;                               ///< setup.test names the test
   std::map<std::string, Observation> observed;   ///< observable name -> value
   std::string outcome;                           ///< "" or an observed outcome: blocked, no_heap
+  std::vector<std::string> warnings;             ///< see MeasurementSet::warnings
   SourceLocation location;
 };
 
@@ -47,6 +48,9 @@ struct MeasurementSet {
   std::vector<KnownValue> known;
   std::vector<MaterialSpec> walls;
   std::vector<Experiment> experiments;
+  /// Things in the file that look like a mistake but are not errors (an outcome written as a
+  /// number), with file and line; the commands print them and the report lists them.
+  std::vector<std::string> warnings;
 };
 
 /// Reads a measurement file; throws CaseError naming file, line and key.

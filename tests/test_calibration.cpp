@@ -109,6 +109,19 @@ experiments:
   EXPECT_EQ(model.particle.sources.at("steel.friction").rfind("measured (m.yaml:9:", 0), 0u) << model.particle.sources.at("steel.friction");
   EXPECT_EQ(model.tunable.count("restitution"), 0u) << "a measured value is not fitted";
   EXPECT_THROW((void)fit_parameters(model, {"restitution"}), std::invalid_argument);
+  // An angle of repose of 0 with a small sigma is most likely a heap that did not form.
+  std::string zero = text;
+  zero += R"(  - id: heap
+    test: angle_of_repose_cylinder
+    setup: {cylinder_diameter: 0.05, cylinder_height: 0.05, fill_height: 0.03, lift_speed: 0.05, base: steel}
+    observed:
+      angle_deg: {value: 0, sigma: 0.5}
+)";
+  const MeasurementSet with_zero = parse_measurements(zero, "m.yaml");
+  ASSERT_EQ(with_zero.warnings.size(), 1u);
+  EXPECT_NE(with_zero.warnings[0].find("outcome: no_heap"), std::string::npos) << with_zero.warnings[0];
+  EXPECT_EQ(with_zero.warnings[0].rfind("m.yaml:20:", 0), 0u) << with_zero.warnings[0];
+  EXPECT_TRUE(m.warnings.empty());
   // A misspelt measured key still names the nearest valid one.
   const std::string bad = std::string(text).replace(text.find("poisson_ratio: 0.25"), 19, "poison_ratio: 0.25");
   try {
