@@ -132,6 +132,25 @@ experiments:
   }
 }
 
+// The cross-engine sets (measured by LIGGGHTS, calibration/liggghts/) read as measurement files,
+// say in their first line how they were made, and give the particles' stiffness as known.
+TEST(Measurements, TheCrossEngineSetsReadAndSayHowTheyWereMade) {
+  const std::string dir = std::string(DEMDESIGN_SOURCE_DIR) + "/tests/data/cross_engine/";
+  MaterialModel start = read_material_model(dir + "glass_beads_6mm.yaml");
+  for (const char* set : {"control", "rolling_epsd2", "cohesion_sjkr", "rolling_cdt"}) {
+    const std::string path = dir + set + ".yaml";
+    std::ifstream in(path);
+    std::string first;
+    std::getline(in, first);
+    EXPECT_EQ(first.rfind("# Simulated with LIGGGHTS", 0), 0u) << path;
+    const MeasurementSet m = read_measurements(path);
+    EXPECT_EQ(m.experiments.size(), 7u) << path;
+    MaterialModel model = start;
+    apply_measured(model, m);
+    EXPECT_DOUBLE_EQ(get_parameter(model, "youngs_modulus"), 5e6) << path;
+  }
+}
+
 TEST(Measurements, ErrorsNameFileLineKeyAndWhatIsValid) {
   std::string text = kGood;
   // A misspelt top-level key.
