@@ -218,6 +218,27 @@ int CalibrationCommands::run_measured(const std::string& command) {
     input.ledger = append_ledger(ledger_path, model.name,
                                  {ledger_entry(model, calibration.before, "start", keys), ledger_entry(calibration.fitted, calibration.after, "calibrated", keys)});
   } else {
+    // What the diagnosis knows so far goes into the report folder at each stage: an interrupted
+    // diagnosis still shows it (the ledger is written once, at the end).
+    if (world.rank == 0)
+      options.on_partial = [&](const Diagnosis& partial, const std::string& stage) {
+        if (stage.rfind("the model as it is", 0) == 0) {
+          std::cout << fmt::format("the model as it is, calibrated: chi^2/n = {:.2f}\n", partial.base.after.chi2_per_n());
+          for (const auto& t : partial.base.after.terms)
+            std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured,
+                                     t.sigma_measured, t.simulated, t.sigma_simulated, t.residual);
+          std::cout << std::flush;
+        }
+        report::CalibrationReportInput so_far = input;
+        so_far.title = fmt::format("{} (in progress: {})", input.title, stage);
+        so_far.diagnosis = &partial;
+        so_far.ledger = read_ledger(ledger_path);
+        try {
+          report::write_calibration_report(so_far, out_);
+        } catch (const std::exception& e) {
+          std::cout << "partial report not written: " << e.what() << std::endl;
+        }
+      };
     diagnosis = diagnose(model, measured, params, options);
     if (world.rank != 0) return 0;
     input.diagnosis = &diagnosis;

@@ -68,6 +68,8 @@ using BatchRunner = std::function<std::vector<BatchOutcome>(size_t count, const 
                                                             const std::function<void(size_t, const BatchOutcome&)>& done,
                                                             const std::function<bool(const BatchOutcome&)>& fatal)>;
 
+struct Diagnosis;
+
 struct CalibrationOptions {
   Simulator simulator;          ///< empty: run_virtual_test
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
@@ -118,6 +120,9 @@ struct CalibrationOptions {
   std::vector<std::string> effects;
   /// Progress lines (with time left); empty: quiet.
   std::function<void(const std::string&)> progress;
+  /// A diagnosis so far, at each stage (the model as it is calibrated, the signatures measured,
+  /// each candidate confirmed), so an interrupted diagnosis still shows what it knew; may be empty.
+  std::function<void(const Diagnosis&, const std::string& stage)> on_partial;
   /// Final state of every simulation (the app renders the last); may be empty.
   std::function<void(const Model&, const State&)> on_final;
 };

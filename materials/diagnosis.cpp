@@ -87,6 +87,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   } else {
     d.base = calibrate(model, measured, parameters, options);
   }
+  if (options.on_partial) options.on_partial(d, "the model as it is, calibrated; signatures next");
   const Comparison& base = d.base.after;
   const int n = base.n;
   d.base_bic = bic(base.chi2, static_cast<int>(parameters.size()), n);
@@ -175,6 +176,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     const double norms = perp[0].norm() * perp[1].norm();
     cr.agreement = norms > 0 ? perp[0].dot(perp[1]) / norms : 1.0;
     d.candidates.push_back(std::move(cr));
+    if (options.on_partial) options.on_partial(d, fmt::format("signatures: {} of {} candidates", d.candidates.size(), effects.size()));
   }
   std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
 
@@ -216,6 +218,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);
       cr.delta_bic = d.base_bic - cr.bic;
       ++confirmed;
+      if (options.on_partial) options.on_partial(d, fmt::format("{} confirmed by recalibration", cr.name));
     }
     if (!undecided.empty())
       d.words.push_back(fmt::format("The signature screen cannot tell {} from {} (their signatures explain within {:.0f} % of each other, "
