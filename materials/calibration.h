@@ -186,7 +186,8 @@ struct Comparison {
 ExperimentRun simulate_experiment(const MaterialModel& model, const Experiment& experiment, const CalibrationOptions& options, int replicas);
 
 /// Terms, chi^2 and patterns of simulated runs (one per experiment, in file order).
-/// `sigma_floor`: per term name, a simulation noise to use when a run has none (one replica).
+/// `sigma_floor`: per term name, a simulation noise measured with another model on the same
+/// apparatus: the least noise a term is given (the noise of a one-replica run).
 Comparison compare_runs(const MeasurementSet& measured, const std::vector<ExperimentRun>& runs, const CalibrationOptions& options,
                         const std::map<std::string, double>& sigma_floor = {});
 

@@ -94,10 +94,9 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
       }
       t.simulated = m->second;
       t.sigma_simulated = run.sigma.at(obs);
-      if (run.replicas < 2) {
-        const auto f = sigma_floor.find(t.name());
-        if (f != sigma_floor.end()) t.sigma_simulated = std::max(t.sigma_simulated, f->second);
-      }
+      // Another model's noise on the same apparatus: the noise of a run of one replica, and the
+      // least noise of a few replicas (two that agree by chance must not look sure).
+      if (const auto f = sigma_floor.find(t.name()); f != sigma_floor.end()) t.sigma_simulated = std::max(t.sigma_simulated, f->second);
       t.residual = (t.simulated - t.measured) / std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
       c.terms.push_back(t);
     }
