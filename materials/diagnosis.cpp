@@ -130,6 +130,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   // comparison's first packings: common random numbers; this run is also the "before" of its
   // confirmation), and a step twice as far with one packing.
   std::map<std::string, Comparison> at_start;
+  std::vector<std::string> left_out;  // candidates whose simulations could not run
   const int replicas = std::max(1, std::min(options.replicas, options.signature_replicas));
   Progress progress{options, "signatures"};
   for (size_t k = 0; k < effects.size(); ++k)
@@ -151,15 +152,24 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
     cr.k = static_cast<int>(parameters.size() + cr.adds.size());
     Eigen::VectorXd perp[2];
-    for (int strength = 0; strength < 2; ++strength) {
+    // A candidate the apparatus cannot take (clumps too large to fill a drum from a lattice) is
+    // left out with the reason, not the whole diagnosis.
+    std::string cannot;
+    for (int strength = 0; strength < 2 && cannot.empty(); ++strength) {
       MaterialModel with = d.base.fitted;
       c.add(with);
       for (const auto& [key, v] : c.start) {
         const auto stronger = c.stronger.find(key);
         set_parameter(with, key, strength == 1 && stronger != c.stronger.end() ? stronger->second : v);
       }
-      const std::vector<ExperimentRun> runs =
-          simulate_experiments(with, measured.experiments, options, strength == 0 ? replicas : 1, &progress, fmt::format("{} {} ", c.name, strength == 0 ? "start" : "stronger"));
+      std::vector<ExperimentRun> runs;
+      try {
+        runs = simulate_experiments(with, measured.experiments, options, strength == 0 ? replicas : 1, &progress,
+                                    fmt::format("{} {} ", c.name, strength == 0 ? "start" : "stronger"));
+      } catch (const CaseError& e) {
+        cannot = e.what();
+        break;
+      }
       const Comparison changed = compare_runs(measured, runs, options, floor);
       Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
       for (int i = 0; i < nt; ++i)
@@ -171,6 +181,11 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
         cr.signature.assign(s.data(), s.data() + s.size());
         at_start[c.name] = changed;
       }
+    }
+    if (!cannot.empty()) {
+      left_out.push_back(fmt::format("{} left out: its simulations cannot run in these experiments ({}).", c.name, cannot));
+      if (options.progress) options.progress(left_out.back());
+      continue;
     }
     cr.explained = std::max(cr.explained_start, cr.explained_stronger);
     const double norms = perp[0].norm() * perp[1].norm();
@@ -280,6 +295,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       d.words.push_back("The signatures explained little of the misfit (they are a linear screen from one step to each effect's start "
                         "values); the leading candidates were confirmed by recalibration anyway.");
   }
+  d.words.insert(d.words.end(), left_out.begin(), left_out.end());
   for (CandidateResult& cr : d.candidates) {
     const std::string screen = fmt::format("explains {:.0f} % of the residual ({:.0f} % at its start, {:.0f} % at twice the step; agreement {:.2f})",
                                            100 * cr.explained, 100 * cr.explained_start, 100 * cr.explained_stronger, cr.agreement);
