@@ -137,9 +137,9 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     for (const Experiment& e : measured.experiments) progress.plan(e, replicas + 1);
   std::map<std::string, double> floor;
   for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
-  const auto orthogonal = [&](const Eigen::VectorXd& s) {
-    return A.cols() > 0 && A.norm() > 0 ? Eigen::VectorXd(s - A * A.completeOrthogonalDecomposition().solve(s)) : s;
-  };
+  const bool removable = A.cols() > 0 && A.norm() > 0;
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> fitted_directions(removable ? A : Eigen::MatrixXd::Zero(nt, 1));
+  const auto orthogonal = [&](const Eigen::VectorXd& s) { return removable ? Eigen::VectorXd(s - A * fitted_directions.solve(s)) : s; };
   const auto explained_by = [&](const Eigen::VectorXd& s_perp, const Eigen::VectorXd& s) {
     const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
     if (!(ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0)) return 0.0;

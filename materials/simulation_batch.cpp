@@ -25,13 +25,14 @@ using detail::Job;
 
 namespace {
 
-SimulatedOutcome run_one(const MaterialModel& model, const TestSetup& setup, const CalibrationOptions& options, std::uint64_t seed) {
+/// The options of one virtual test run of a calibration.
+TestOptions test_options(const CalibrationOptions& options, std::uint64_t seed) {
   TestOptions t;
   t.seed = seed;
   t.threads = options.threads;
   t.size_factor = options.size_factor;
   if (options.on_final) t.on_final = options.on_final;
-  return options.simulator ? options.simulator(model, setup, t) : run_virtual_test(model, setup, t);
+  return t;
 }
 
 /// Runs one job, or takes its outcome from the store; an exception becomes the outcome's error (a
@@ -41,10 +42,9 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
   BatchOutcome b;
   try {
     const bool keep = !options.store.empty() && !options.simulator;
+    const TestOptions t = test_options(options, job.seed);
     std::string inputs;
     if (keep) {
-      TestOptions t;
-      t.seed = job.seed, t.size_factor = options.size_factor;
       inputs = simulation_inputs(*job.model, *job.setup, t);
       if (std::optional<SimulatedOutcome> stored = load_simulation(options.store, job.setup->test, inputs)) {
         b.outcome = std::move(*stored);
@@ -52,7 +52,7 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
         return b;
       }
     }
-    b.outcome = run_one(*job.model, *job.setup, options, job.seed);
+    b.outcome = options.simulator ? options.simulator(*job.model, *job.setup, t) : run_virtual_test(*job.model, *job.setup, t);
     b.error = BatchOutcome::Error::none;
     if (keep) {
       try {
