@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -103,10 +104,12 @@ TEST(KillAndResume, SigkillAtRandomMomentsThenResumeReachesTheSameState) {
   int trials = 0, killed_mid_run = 0;
   for (int trial = 0; trial < 4; ++trial) {
     const fs::path out = kScratch / ("trial" + std::to_string(trial));
+    const auto started = std::chrono::steady_clock::now();
     const pid_t pid = start(run_args(c, out), kScratch / "trial.log");
     while (!fs::exists(out / "checkpoint.bin") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(2ms);
-    // A seeded random moment in the rest of the run.
-    std::this_thread::sleep_for(std::chrono::duration<double>(std::uniform_real_distribution<double>(0.0, 0.7)(random) * seconds));
+    // A seeded random moment in the rest of the run (what is left after the first checkpoint).
+    const double left = std::max(0.0, seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::uniform_real_distribution<double>(0.0, 0.7)(random) * left));
     const bool running = ::kill(pid, SIGKILL) == 0;
     const int status = wait_exit(pid);
     killed_mid_run += running && status == 128 + SIGKILL;
