@@ -213,6 +213,8 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
   const int p = static_cast<int>(parameters.size());
   for (const FitParameter& f : parameters) result.start.push_back(get_parameter(model, f.key));
 
+  const int n = static_cast<int>(measured.experiments.size());
+  const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
   // The start, with replicas: its simulation noise stands for the noise everywhere.
   if (before) result.before = *before;
   else result.before = compare(model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
@@ -224,6 +226,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
     budget_words = fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
                                detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; "));
     if (options.progress) options.progress(budget_words);
+    if (command.outermost()) detail::CommandProgress::shared().plan_remaining(n * detail::calibration_passes(options, p));
   }
   std::vector<Term> numeric;
   for (const Term& t : result.before.terms)
@@ -241,9 +244,7 @@ CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& me
   std::map<std::string, int> index;
   for (size_t i = 0; i < names.size(); ++i) index[names[i]] = static_cast<int>(i);
 
-  const int points = options.design_points > 0
-                         ? options.design_points
-                         : std::max(basis_size(p) + 1, static_cast<int>(std::ceil(options.design_factor * basis_size(p))) + 2);
+  const int points = detail::design_points(options, p);
   const int rounds = std::max(1, options.rounds);
   Progress progress{options, "design"};
   for (const Experiment& e : measured.experiments) progress.plan(e, rounds * points);

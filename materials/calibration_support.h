@@ -50,6 +50,13 @@ class SimulationCosts {
     if (it != by_key_.end()) return it->second.first / it->second.second;
     return all_count_ > 0 ? all_sum_ / all_count_ : kNaN;
   }
+  /// Mean seconds of a simulation in a pass over the experiments (each experiment's mean
+  /// weighs alike); NaN when nothing ran yet.
+  double pass_mean() const {
+    double sum = 0;
+    for (const auto& [key, v] : by_key_) sum += v.first / v.second;
+    return by_key_.empty() ? kNaN : sum / static_cast<double>(by_key_.size());
+  }
 
  private:
   std::map<std::string, std::pair<double, int>> by_key_;
@@ -57,8 +64,75 @@ class SimulationCosts {
   int all_count_ = 0;
 };
 
+/// The whole command's count: the simulations planned in all (compare, calibrate and diagnose
+/// each plan theirs when they begin; a diagnosis plans again as it learns how many candidates it
+/// confirms), those done, and when the command began. The outermost command's CommandScope owns
+/// it; the commands it calls run inside its count.
+class CommandProgress {
+ public:
+  static CommandProgress& shared() {
+    static CommandProgress command;
+    return command;
+  }
+  bool active() const { return depth_ > 0; }
+  const std::string& what() const { return what_; }
+  int done() const { return done_; }
+  /// Simulations still planned (at least those of the phase running now).
+  int left() const { return std::max(planned_ - done_, 0); }
+  double elapsed() const { return seconds_since(t0_); }
+  /// From now on `more` simulations remain to be done in all.
+  void plan_remaining(int more) { planned_ = done_ + std::max(more, 0); }
+  void step() { ++done_; }
+
+ private:
+  friend class CommandScope;
+  int depth_ = 0, planned_ = 0, done_ = 0;
+  std::string what_;
+  Clock::time_point t0_;
+};
+
+/// Marks a command's run: the outermost scope starts the command's count with `planned`
+/// simulations; nested scopes (the calibration inside a diagnosis) leave it as it is.
+class CommandScope {
+ public:
+  CommandScope(std::string what, int planned) {
+    CommandProgress& c = CommandProgress::shared();
+    if (c.depth_++ == 0) c.what_ = std::move(what), c.done_ = 0, c.planned_ = planned, c.t0_ = Clock::now();
+    outermost_ = c.depth_ == 1;
+  }
+  ~CommandScope() { --CommandProgress::shared().depth_; }
+  CommandScope(const CommandScope&) = delete;
+  CommandScope& operator=(const CommandScope&) = delete;
+  bool outermost() const { return outermost_; }
+
+ private:
+  bool outermost_ = false;
+};
+
+/// Surrogate design points of one round fitting `k` parameters.
+inline int design_points(const CalibrationOptions& o, int k) {
+  const int b = 1 + k + k * (k + 1) / 2;
+  return o.design_points > 0 ? o.design_points : std::max(b + 1, static_cast<int>(std::ceil(o.design_factor * b)) + 2);
+}
+
+/// Passes over the experiments (a simulation of each) that a calibration of `p` parameters
+/// makes after its first comparison: the design rounds and the confirming comparison.
+inline int calibration_passes(const CalibrationOptions& o, int p) { return std::max(1, o.rounds) * design_points(o, p) + std::max(1, o.replicas); }
+
+/// Passes over the experiments that a diagnosis makes after its first comparison, fitting `p`
+/// parameters and screening `effects` effects and `walls` wall parameters (diagnosis.cpp).
+int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls);
+
+/// Simulations run at once: `parallel` in this process; under a batch runner (MPI ranks) the
+/// count is the runner's, and one is assumed.
+inline int workers(const CalibrationOptions& o, size_t jobs) {
+  return o.batch ? 1 : static_cast<int>(std::clamp<size_t>(jobs, 1, static_cast<size_t>(std::max(1, o.parallel))));
+}
+
 /// A phase's simulations: the planned ones (by experiment), a line as each finishes, and the time
-/// left from what each remaining simulation costs (SimulationCosts), not from the phase's mean.
+/// left from what each remaining simulation costs (SimulationCosts), not from the phase's mean,
+/// shared among the simulations that run at once. When a command is counting
+/// (CommandProgress), the line also gives the whole command's count and time left.
 /// Lines go to options.progress (the app writes them line-buffered, one per line).
 class Progress {
  public:
@@ -73,12 +147,22 @@ class Progress {
     if (seconds > 0) costs.add(key(experiment), seconds);  // (a stored outcome costs nothing, and says nothing of the cost)
     if (const auto it = std::find(planned_.begin(), planned_.end(), key(experiment)); it != planned_.end()) planned_.erase(it);
     ++done_;
+    CommandProgress& command = CommandProgress::shared();
+    if (command.active()) command.step();
     if (!options_.progress) return;
     double left = 0;
     for (const std::string& k : planned_) left += costs.estimate(k);
-    options_.progress(fmt::format("{}: simulation {} of {} done ({}, {:.1f} s); {} elapsed, about {} left", what_, done_,
-                                  done_ + planned_.size(), label, seconds, duration_text(seconds_since(t0_)),
-                                  std::isfinite(left) ? duration_text(left) : std::string("? s")));
+    left /= workers(options_, planned_.size());
+    std::string line = fmt::format("{}: simulation {} of {} done ({}, {:.1f} s); {} elapsed, about {} left", what_, done_, done_ + planned_.size(),
+                                   label, seconds, duration_text(seconds_since(t0_)), std::isfinite(left) ? duration_text(left) : std::string("? s"));
+    if (command.active()) {
+      // Beyond this phase: the command's other planned simulations at the mean cost of one.
+      const int beyond = std::max(command.left() - static_cast<int>(planned_.size()), 0);
+      const double all = left + beyond * costs.pass_mean() / workers(options_, static_cast<size_t>(beyond));
+      line += fmt::format("; {}: simulation {} of about {}, {} elapsed, about {} left", command.what(), command.done(), command.done() + command.left(),
+                          duration_text(command.elapsed()), std::isfinite(all) ? duration_text(all) : std::string("? s"));
+    }
+    options_.progress(line);
   }
 
  private:

@@ -124,6 +124,7 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
 }
 
 Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {
+  const detail::CommandScope command("compare", static_cast<int>(measured.experiments.size()) * std::max(1, options.replicas));
   Progress progress{options, "compare"};
   for (const Experiment& e : measured.experiments) progress.plan(e, std::max(1, options.replicas));
   return compare_runs(measured, simulate_experiments(model, measured.experiments, options, options.replicas, &progress, ""), options);

@@ -71,14 +71,20 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   Diagnosis d;
   CalibrationOptions options = given;  // a budget may reduce it
   if (parameters.empty()) parameters = fit_parameters(model);
+  const int experiments = static_cast<int>(measured.experiments.size()), fitted = static_cast<int>(parameters.size());
+  const int walls = static_cast<int>(wall_parameter_candidates(model, parameters).size());
+  const int lacking = static_cast<int>(missing_effects(model).size());
+  const detail::CommandScope command("diagnose",
+                                     experiments * (std::max(1, options.replicas) + detail::diagnosis_passes(options, fitted, lacking, walls)));
+  detail::CommandProgress& count = detail::CommandProgress::shared();
   if (options.progress) options.progress("diagnose: calibrating the model as it is");
   // With a budget: the starting model is compared first (a simulation of each experiment is then
   // timed) and the rest planned to fit; the calibration uses that comparison as its start.
   if (options.budget_seconds > 0) {
     const Comparison first = compare(model, measured, options);
-    const int walls = static_cast<int>(wall_parameter_candidates(model, parameters).size());
-    const BudgetPlan plan = plan_within_budget(options, first, static_cast<int>(parameters.size()), static_cast<int>(missing_effects(model).size()), walls);
+    const BudgetPlan plan = plan_within_budget(options, first, fitted, lacking, walls);
     options = plan.options;
+    if (command.outermost()) count.plan_remaining(experiments * detail::diagnosis_passes(options, fitted, lacking, walls));
     options.budget_seconds = 0;  // planned once, for the whole diagnosis
     d.words.push_back(fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
                                   detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; ")));
@@ -135,6 +141,9 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   Progress progress{options, "signatures"};
   for (size_t k = 0; k < effects.size(); ++k)
     for (const Experiment& e : measured.experiments) progress.plan(e, replicas + 1);
+  if (command.outermost())
+    count.plan_remaining(experiments * static_cast<int>(effects.size()) * (replicas + 1) +
+                         (fits ? 0 : experiments * options.confirm_candidates * detail::calibration_passes(options, fitted + 1)));
   std::map<std::string, double> floor;
   for (const Term& t : base.terms) floor[t.name()] = t.sigma_simulated;
   const bool removable = A.cols() > 0 && A.norm() > 0;
@@ -216,10 +225,16 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       if (cr.explained >= 0.05 && cr.agreement < 0.5) return nonlinear.push_back(cr.name), true;
       return false;
     };
-    int confirmed = 0;
-    for (size_t rank = 0; rank < d.candidates.size() && confirmed < options.confirm_candidates + 2; ++rank) {
+    std::vector<size_t> confirming;
+    for (size_t rank = 0; rank < d.candidates.size() && static_cast<int>(confirming.size()) < options.confirm_candidates + 2; ++rank)
+      if (chosen(d.candidates[rank], static_cast<int>(rank))) confirming.push_back(rank);
+    if (command.outermost()) {
+      int passes = 0;
+      for (const size_t rank : confirming) passes += detail::calibration_passes(options, d.candidates[rank].k);
+      count.plan_remaining(experiments * passes);
+    }
+    for (const size_t rank : confirming) {
       CandidateResult& cr = d.candidates[rank];
-      if (!chosen(cr, static_cast<int>(rank))) continue;
       const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
       MaterialModel with = d.base.fitted;
       it->add(with);
@@ -232,7 +247,6 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       cr.chi2 = cr.fit.after.chi2;
       cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);
       cr.delta_bic = d.base_bic - cr.bic;
-      ++confirmed;
       if (options.on_partial) options.on_partial(d, fmt::format("{} confirmed by recalibration", cr.name));
     }
     if (!undecided.empty())
@@ -308,6 +322,18 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
 
 // ---- budget -------------------------------------------------------------------------------
 
+namespace detail {
+int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
+  int passes = detail::calibration_passes(o, p);  // the calibration and its confirming comparison
+  if (effects + walls > 0) {
+    const int screened = effects + (o.wall_candidates ? walls : 0);
+    passes += screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);  // two strengths
+    passes += o.confirm_candidates * detail::calibration_passes(o, p + 1);
+  }
+  return passes;
+}
+}  // namespace detail
+
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls) {
   const int candidates = effects + walls;
   BudgetPlan plan{options, {}, 0};
@@ -316,20 +342,7 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   double pass = 0;
   for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
   pass /= std::max(1, options.parallel);
-  const auto points = [](const CalibrationOptions& o, int k) {
-    const int b = 1 + k + k * (k + 1) / 2;
-    return o.design_points > 0 ? o.design_points : std::max(b + 1, static_cast<int>(std::ceil(o.design_factor * b)) + 2);
-  };
-  const auto seconds = [&](const CalibrationOptions& o) {
-    const int rounds = std::max(1, o.rounds);
-    double passes = rounds * points(o, p) + o.replicas;  // the calibration and its confirming comparison
-    if (candidates > 0) {
-      const int screened = effects + (o.wall_candidates ? walls : 0);
-      passes += screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);
-      passes += o.confirm_candidates * (rounds * points(o, p + 1) + o.replicas);
-    }
-    return passes * pass;
-  };
+  const auto seconds = [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls) * pass; };
   struct Step {
     const char* words;
     void (*apply)(CalibrationOptions&);

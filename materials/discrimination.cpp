@@ -99,6 +99,8 @@ std::vector<Separator> separating_experiments(const MaterialModel& a, const std:
   const int replicas = std::max(1, std::min(options.replicas, options.signature_replicas));
   detail::Progress progress{options, fmt::format("experiments that could separate {} from {}", name_a, name_b)};
   for (const Experiment& e : candidates) progress.plan(e, 2 * replicas);
+  detail::CommandProgress& command = detail::CommandProgress::shared();
+  if (command.active()) command.plan_remaining(command.left() + 2 * replicas * static_cast<int>(candidates.size()));
   // A candidate the model cannot run (a set-up out of range for these particles) is skipped.
   std::vector<Separator> out;
   for (const Experiment& e : candidates) {

@@ -651,6 +651,32 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   EXPECT_NE(d.words.front().find("given up"), std::string::npos) << d.words.front();
 }
 
+// Progress over the whole command: every line counts one more of the diagnosis' simulations,
+// the count planned in all is never below those done, and by the end the plan (made again as the
+// diagnosis learns which candidates it confirms) equals what ran.
+TEST(Budget, ProgressCountsTheWholeDiagnosis) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  CalibrationOptions options = analytic_options(sim);
+  std::vector<std::pair<int, int>> counts;  // (done, planned in all)
+  options.progress = [&](const std::string& line) {
+    const auto at = line.find("; diagnose: simulation ");
+    if (at == std::string::npos) return;
+    int done = 0, planned = 0;
+    ASSERT_EQ(std::sscanf(line.c_str() + at, "; diagnose: simulation %d of about %d", &done, &planned), 2) << line;
+    counts.emplace_back(done, planned);
+  };
+  diagnose(start, synthesise(flow_tests(), truth, sim, 11), {}, options);
+  ASSERT_GT(counts.size(), 100u);
+  for (size_t k = 0; k < counts.size(); ++k) {
+    EXPECT_EQ(counts[k].first, static_cast<int>(k) + 1);
+    EXPECT_GE(counts[k].second, counts[k].first);
+  }
+  EXPECT_EQ(counts.back().first, counts.back().second);
+}
+
 TEST(Ledger, AppendsVersions) {
   const std::string path = (std::filesystem::temp_directory_path() / "demdesign_ledger_test" / "ledger.yaml").string();
   std::filesystem::remove_all(std::filesystem::path(path).parent_path());
