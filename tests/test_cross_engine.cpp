@@ -1,0 +1,107 @@
+// Diagnosis on measurements this engine did not make: the cross-engine sets of
+// tests/data/cross_engine/ were simulated by LIGGGHTS 3.8 (calibration/liggghts/) with one effect
+// switched on in each, and are diagnosed from the same starting material (plain Hertz-Coulomb
+// 6 mm beads, friction and restitution guessed) with the command's defaults and a budget of 30
+// minutes, as a user runs `demdesign diagnose MATERIAL SET --budget 30m`. ctest label `long`.
+//
+// DEMDESIGN_CROSS_ENGINE_STORE=DIR keeps the simulations in DIR/SET/ (the simulation store), so a
+// second run of a test replays the first one's simulations; without it each run starts afresh.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "calibration.h"
+#include "material_model.h"
+#include "measurements.h"
+
+namespace dem::materials {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CrossEngineRun {
+  Diagnosis diagnosis;
+  double seconds = 0;
+};
+
+CrossEngineRun diagnose_set(const std::string& set) {
+  const std::string dir = std::string(DEMDESIGN_SOURCE_DIR) + "/tests/data/cross_engine/";
+  MaterialModel model = read_material_model(dir + "glass_beads_6mm.yaml");
+  const MeasurementSet measured = read_measurements(dir + set + ".yaml");
+  apply_measured(model, measured);
+  CalibrationOptions options;  // the command's defaults
+  options.parallel = std::max(1, omp_get_num_procs());
+  options.budget_seconds = 30 * 60;
+  const char* keep = std::getenv("DEMDESIGN_CROSS_ENGINE_STORE");
+  const fs::path store = keep ? fs::path(keep) / set : fs::temp_directory_path() / ("demdesign_cross_engine_" + set);
+  if (!keep) fs::remove_all(store);
+  options.store = (store / "simulations").string();
+  options.progress = [](const std::string& line) { std::printf("%s\n", line.c_str()), std::fflush(stdout); };
+  const auto t0 = std::chrono::steady_clock::now();
+  CrossEngineRun run;
+  run.diagnosis = diagnose(model, measured, {}, options);
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const Diagnosis& d = run.diagnosis;
+  std::printf("%s: %.0f s; plain model chi^2/n %.2f before, %.2f calibrated\n", set.c_str(), run.seconds, d.base.before.chi2_per_n(),
+              d.base.after.chi2_per_n());
+  for (const std::string& w : d.words) std::printf("  %s\n", w.c_str());
+  for (const CandidateResult& c : d.candidates)
+    std::printf("  %-16s explained %3.0f %%%s\n", c.name.c_str(), 100 * c.explained,
+                c.confirmed ? fmt::format(", confirmed: chi^2/n {:.2f}, delta BIC {:+.1f}", c.fit.after.chi2_per_n(), c.delta_bic).c_str() : "");
+  if (!keep) fs::remove_all(store);
+  return run;
+}
+
+const CandidateResult* candidate(const Diagnosis& d, const std::string& name) {
+  const auto c = std::find_if(d.candidates.begin(), d.candidates.end(), [&](const CandidateResult& r) { return r.name == name; });
+  return c == d.candidates.end() ? nullptr : &*c;
+}
+
+/// The effect LIGGGHTS had switched on is recommended, or it is a rival the data cannot rule out
+/// and the diagnosis names an experiment whose two predictions lie at least 3 sigma apart; and,
+/// recalibrated with it, the model fits within the noise (chi^2/n at most 1.5).
+void expect_effect_found(const CrossEngineRun& run, const std::string& effect) {
+  const Diagnosis& d = run.diagnosis;
+  EXPECT_GT(d.base.after.chi2_per_n(), 3.0) << "the plain model should fail visibly on these data";
+  if (d.recommended != effect) {
+    ASSERT_NE(std::find(d.rivals.begin(), d.rivals.end(), effect), d.rivals.end())
+        << effect << " is neither recommended nor named as a rival; recommended: '" << d.recommended << "'";
+    ASSERT_TRUE(d.separators.count(effect) && !d.separators.at(effect).empty()) << "no experiment proposed to tell " << effect << " from " << d.recommended;
+    EXPECT_GE(d.separators.at(effect).front().separation, 3.0) << d.separators.at(effect).front().words;
+  }
+  const CandidateResult* c = candidate(d, effect);
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->confirmed);
+  EXPECT_LE(c->fit.after.chi2_per_n(), 1.5) << effect << " recalibrated";
+}
+
+// Plain Hertz-Mindlin in LIGGGHTS: no effect is missing. A wall parameter may be named (the
+// starting material guesses the steel's friction and restitution), an effect must not be.
+TEST(CrossEngine, ControlGetsNoEffect) {
+  const CrossEngineRun run = diagnose_set("control");
+  const Diagnosis& d = run.diagnosis;
+  const CandidateResult* named = candidate(d, d.recommended);
+  EXPECT_TRUE(d.recommended.empty() || (named && named->kind == "parameter")) << "recommended: " << d.recommended;
+  const double chi2 = named ? named->fit.after.chi2_per_n() : d.base.after.chi2_per_n();
+  EXPECT_LE(chi2, 1.5);
+}
+
+// LIGGGHTS epsd2 rolling friction (mu_r 0.25): demdesign's rolling resistance (epsd).
+TEST(CrossEngine, RollingFrictionEpsd2IsFound) { expect_effect_found(diagnose_set("rolling_epsd2"), "epsd"); }
+
+// LIGGGHTS cdt rolling friction (mu_r 0.25, a constant torque without a spring): rolling resistance.
+TEST(CrossEngine, RollingFrictionCdtIsFound) { expect_effect_found(diagnose_set("rolling_cdt"), "epsd"); }
+
+// LIGGGHTS sjkr cohesion (cohesion energy density 1.5e5 J/m^3, a force on the contact area):
+// van der Waals cohesion (jkr).
+TEST(CrossEngine, CohesionSjkrIsFound) { expect_effect_found(diagnose_set("cohesion_sjkr"), "jkr"); }
+
+}  // namespace
+}  // namespace dem::materials
