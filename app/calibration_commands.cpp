@@ -13,8 +13,10 @@
 #include <filesystem>
 #include <iostream>
 
+#include "calibrated_material.h"
 #include "calibration.h"
 #include "calibration_report.h"
+#include "html.h"
 #include "material_model.h"
 #include "measurements.h"
 #include "mpi_campaign.h"
@@ -262,6 +264,23 @@ int CalibrationCommands::run_measured(const std::string& command) {
     shown = &diagnosis.base.fitted;
     for (const auto& c : diagnosis.candidates)
       if (c.name == diagnosis.recommended && c.confirmed) shown = &c.fit.fitted;
+  }
+  // The calibrated material as a library file a case can name (the fit, its uncertainty and its
+  // effects in one file): the calibration's, or the diagnosis' recommended model (the model as
+  // it is, calibrated, when nothing is recommended).
+  if (command != "compare") {
+    const CalibrationResult* fit = command == "calibrate" ? &calibration : &diagnosis.base;
+    std::string note;
+    if (command == "diagnose")
+      for (const auto& c : diagnosis.candidates)
+        if (c.name == diagnosis.recommended && c.confirmed) fit = &c.fit, note = "with " + c.name + ", the effect it recommended";
+    const std::string path = (fs::path(out_) / (fs::path(material_).stem().string() + "_calibrated.yaml")).string();
+    try {
+      write_calibrated_material(path, *fit, {command, measurements_, html::now_text().substr(0, 10), note});
+      std::cout << fmt::format("calibrated material: {} (a case names it as {{library: {}}})\n", path, fs::path(path).stem().string());
+    } catch (const std::invalid_argument& e) {
+      std::cout << fmt::format("calibrated material not written: {}\n", e.what());
+    }
   }
   if (!no_renders_) input.images = render_tests(*shown, measured, options);
   input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

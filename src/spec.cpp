@@ -13,6 +13,7 @@
 #include <limits>
 #include <numbers>
 
+#include "calibration_record.h"
 #include "effect.h"
 #include "yaml_check.h"
 
@@ -126,6 +127,18 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
   }
   lib.contact = file_map.node("contact");
   file_map.node("size");  // a typical size, for the calibration tests
+  if (const YAML::Node fit = file_map.node("calibration")) {
+    lib.material.calibration = read_calibration_record(fit, lib.file);
+    // The values the file states are the fit's: a file edited after its calibration is refused.
+    const CalibrationRecord& r = *lib.material.calibration;
+    for (size_t k = 0; k < r.parameters.size(); ++k) {
+      const auto given = lib.material.params.find(r.parameters[k]);
+      if (given != lib.material.params.end() && std::abs(given->second - r.value[k]) > 1e-6 * std::max(1.0, std::abs(r.value[k])))
+        throw CaseError(fmt::format("{}: properties.{} is {:g} but calibration.value gives {:g}: the file was edited after its calibration; "
+                                    "calibrate again, or remove the calibration block",
+                                    r.location.str(), r.parameters[k], given->second, r.value[k]));
+    }
+  }
   file_map.finish();
   // Overrides in the case entry, beside `library:`.
   MaterialSpec& m = lib.material;
@@ -704,6 +717,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     for (const std::string& key : w.keys()) spec.wear_coefficients[key] = w.number(key, 0.0, 0.0, 1e-6, "m^3/J");
   }
   top.node("sweep");  // read by the sweep runner (app/sweep.cpp) before the variants are parsed
+  top.node("uncertainty");  // likewise (app/uncertainty.h)
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;

@@ -39,6 +39,24 @@ class CaseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The fit a calibrated library material came from (its file's `calibration:` block, written by
+/// `demdesign calibrate` / `diagnose`): which parameters were fitted, their values and standard
+/// deviations in SI units, their correlation, and how well the model then fitted the measurements.
+/// Design runs draw parameter sets from it (value, sigma, correlation: a normal posterior).
+struct CalibrationRecord {
+  std::string command;       ///< "calibrate" or "diagnose"
+  std::string measurements;  ///< the measurement file, as given to the command
+  std::string date;          ///< YYYY-MM-DD
+  std::string engine;        ///< "demdesign 0.1.0"
+  std::vector<std::string> effects;     ///< the contact effects switched on
+  std::vector<std::string> parameters;  ///< fitted keys: "friction", "steel.friction" (a wall pair)
+  std::vector<double> value, sigma;     ///< per parameter, SI units
+  std::vector<std::vector<double>> correlation;  ///< symmetric, unit diagonal, positive semi-definite
+  double chi2_per_n = 0;     ///< of the calibrated model against the measurements
+  double stiffness_scaling = 1;  ///< factor on Young's modulus the virtual tests used in the fit
+  SourceLocation location;
+};
+
 struct MaterialSpec {
   std::string name;
   double density = 2500.0;        // [kg/m^3]
@@ -52,6 +70,7 @@ struct MaterialSpec {
   std::string description;
   std::map<std::string, std::string> sources;   ///< key -> where its value comes from
   std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max] for calibration
+  std::optional<CalibrationRecord> calibration;  ///< when the library file is a calibrated material
 };
 
 /// Parameters for one unlike pair that replace the mixing rule.

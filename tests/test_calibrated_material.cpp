@@ -1,0 +1,152 @@
+// A calibrated material as a library file: written by calibrate/diagnose, read back by the
+// material library and by a case, refused when edited after its fit, and sampled for design runs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "calibrated_material.h"
+#include "calibration_record.h"
+#include "material_model.h"
+
+namespace dem::materials {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kMaterials = DEMDESIGN_SOURCE_DIR "/materials";
+
+/// A fit of gravel's friction and rolling friction (made by hand: the file is what is tested).
+CalibrationResult gravel_fit() {
+  CalibrationResult r;
+  r.fitted = read_material_model(kMaterials + "/gravel.yaml");
+  r.parameters = {{"friction", 0.1, 0.9}, {"rolling_friction", 0.0, 0.5}, {"steel.friction", 0.1, 0.9}};
+  r.value = {0.537, 0.214, 0.41};
+  r.sigma = {0.021, 0.013, 0.05};
+  r.correlation = {{1, -0.62, 0.1}, {-0.62, 1, 0}, {0.1, 0, 1}};
+  for (size_t k = 0; k < r.parameters.size(); ++k) set_parameter(r.fitted, r.parameters[k].key, r.value[k]);
+  r.after.chi2 = 6.3, r.after.n = 7;
+  return r;
+}
+
+fs::path scratch() {
+  const fs::path dir = fs::temp_directory_path() / "demdesign_calibrated_material";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(CalibratedMaterial, RoundTripsThroughTheLibraryAndACase) {
+  const fs::path dir = scratch();
+  const CalibrationResult fit = gravel_fit();
+  write_calibrated_material((dir / "gravel_calibrated.yaml").string(), fit, {"diagnose", "lab/gravel.yaml", "2026-12-03", "with epsd"});
+  const MaterialModel back = read_material_model((dir / "gravel_calibrated.yaml").string());
+  for (size_t k = 0; k < fit.parameters.size(); ++k)
+    EXPECT_NEAR(get_parameter(back, fit.parameters[k].key), fit.value[k], 1e-9) << fit.parameters[k].key;
+  EXPECT_EQ(back.contact.rolling.model, fit.fitted.contact.rolling.model);
+  EXPECT_EQ(back.tunable, fit.fitted.tunable);
+  ASSERT_TRUE(back.particle.calibration.has_value());
+  const CalibrationRecord& r = *back.particle.calibration;
+  EXPECT_EQ(r.command, "diagnose");
+  EXPECT_EQ(r.measurements, "lab/gravel.yaml");
+  EXPECT_EQ(r.parameters, (std::vector<std::string>{"friction", "rolling_friction", "steel.friction"}));
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(r.value[i], fit.value[i], 1e-12);
+    EXPECT_NEAR(r.sigma[i], fit.sigma[i], 1e-12);
+    for (size_t j = 0; j < 3; ++j) EXPECT_NEAR(r.correlation[i][j], fit.correlation[i][j], 1e-12);
+  }
+  EXPECT_NEAR(r.chi2_per_n, 0.9, 1e-12);
+  EXPECT_NE(std::find(r.effects.begin(), r.effects.end(), "epsd"), r.effects.end());
+  // A case names it from its own folder and gets the fitted values with their record.
+  const CaseSpec spec = parse_case_text(
+      "simulation: {duration: 0.001}\nmaterials:\n  g: {library: gravel_calibrated}\n  steel: {library: steel}\n"
+      "particles:\n  - {material: g, diameter: 0.01, positions: [[0, 0, 0]]}\n",
+      (dir / "case.yaml").string());
+  const auto g = std::find_if(spec.materials.begin(), spec.materials.end(), [](const MaterialSpec& m) { return m.name == "g"; });
+  ASSERT_NE(g, spec.materials.end());
+  ASSERT_TRUE(g->calibration.has_value());
+  EXPECT_NEAR(g->params.at("friction"), 0.537, 1e-12);
+}
+
+TEST(CalibratedMaterial, AFileEditedAfterItsFitOrWithABadCorrelationIsRefused) {
+  const fs::path dir = scratch();
+  const fs::path file = dir / "gravel_calibrated.yaml";
+  write_calibrated_material(file.string(), gravel_fit(), {"calibrate", "lab/gravel.yaml", "2026-12-03", ""});
+  const std::string text = read_text(file);
+  // Friction edited by hand: the record no longer describes the file.
+  std::string edited = text;
+  edited.replace(edited.find("  friction: 0.537"), 17, "  friction: 0.600");
+  std::ofstream(file) << edited;
+  try {
+    read_material_model(file.string());
+    FAIL() << "an edited calibrated material was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("edited after its calibration"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("gravel_calibrated.yaml:"), std::string::npos) << e.what();
+  }
+  // A correlation that no three real parameters can have (pairwise 0.9, 0.9 and -0.9).
+  std::string bad = text;
+  const size_t at = bad.find("  correlation:");
+  const size_t end = bad.find("  chi2_per_n");
+  bad.replace(at, end - at, "  correlation:\n    - [1, 0.9, 0.9]\n    - [0.9, 1, -0.9]\n    - [0.9, -0.9, 1]\n");
+  std::ofstream(file) << bad;
+  try {
+    read_material_model(file.string());
+    FAIL() << "a correlation that is not positive semi-definite was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("calibration.correlation"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("positive semi-definite"), std::string::npos) << e.what();
+  }
+}
+
+// Draws from the record: sample means, standard deviations and correlation match the record
+// within their sampling error (2000 draws: 3 standard errors on the mean, 6 % on sigma, 0.05 on
+// the correlation); each parameter's Latin-hypercube strata are filled once when uncorrelated;
+// clipping keeps every draw in range.
+TEST(CalibratedMaterial, PosteriorSamplesFollowTheRecord) {
+  CalibrationRecord r;
+  r.parameters = {"friction", "restitution"};
+  r.value = {0.5, 0.4};
+  r.sigma = {0.1, 0.02};
+  r.correlation = {{1, 0.8}, {0.8, 1}};
+  const int n = 2000;
+  const auto draws = posterior_samples(r, n, 7);
+  ASSERT_EQ(draws.size(), static_cast<size_t>(n));
+  double m[2] = {}, s[2] = {}, c = 0;
+  for (const auto& d : draws) m[0] += d[0] / n, m[1] += d[1] / n;
+  for (const auto& d : draws) {
+    s[0] += (d[0] - m[0]) * (d[0] - m[0]) / (n - 1), s[1] += (d[1] - m[1]) * (d[1] - m[1]) / (n - 1);
+    c += (d[0] - m[0]) * (d[1] - m[1]) / (n - 1);
+  }
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(m[j], r.value[j], 3 * r.sigma[j] / std::sqrt(n));
+    EXPECT_NEAR(std::sqrt(s[j]), r.sigma[j], 0.06 * r.sigma[j]);
+  }
+  EXPECT_NEAR(c / std::sqrt(s[0] * s[1]), 0.8, 0.05);
+  // Uncorrelated: 16 draws put exactly one in each sixteenth of each marginal.
+  r.correlation = {{1, 0}, {0, 1}};
+  const auto lhs = posterior_samples(r, 16, 3);
+  for (int j = 0; j < 2; ++j) {
+    std::vector<int> filled(16, 0);
+    for (const auto& d : lhs) {
+      const double p = 0.5 * std::erfc(-(d[j] - r.value[j]) / r.sigma[j] / std::sqrt(2.0));
+      ++filled[std::min(15, static_cast<int>(p * 16))];
+    }
+    for (int k = 0; k < 16; ++k) EXPECT_EQ(filled[k], 1) << "parameter " << j << " stratum " << k;
+  }
+  for (const auto& d : posterior_samples(r, 200, 5, {{0.45, 0.55}, {0.0, 1.0}})) {
+    EXPECT_GE(d[0], 0.45);
+    EXPECT_LE(d[0], 0.55);
+  }
+}
+
+}  // namespace
+}  // namespace dem::materials
