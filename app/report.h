@@ -86,6 +86,7 @@ struct SweepReportInput {
   std::string title, case_path, version;
   std::vector<SweepVariant> variants;
   std::vector<Criterion> criteria;
+  std::string extra_html;  ///< a further section after the ranking (the calibration uncertainty)
 };
 
 /// Ranking rule (normalised weighted score): for each criterion, over the variants that ran,

@@ -20,6 +20,7 @@
 #include "mpi_campaign.h"
 #include "report.h"
 #include "spec.h"
+#include "uncertainty.h"
 #include "yaml_check.h"
 
 namespace dem::app {
@@ -82,7 +83,23 @@ std::string SweepPlan::label(size_t k) const {
   return out;
 }
 
+std::string SweepPlan::design_label(size_t k) const {
+  std::string out;
+  for (size_t p = 0; p < design_paths && p < paths.size(); ++p) {
+    if (p) out += ", ";
+    out += fmt::format("{}={}", short_path(paths[p]), YAML::Dump(variants[k][p]));
+  }
+  return out;
+}
+
 SweepPlan read_sweep(const YAML::Node& root, const std::string& file) {
+  SweepPlan plan = read_design_sweep(root, file);
+  plan.design_paths = plan.paths.size();
+  if (root.IsMap() && root["uncertainty"]) add_uncertainty(plan, root, file);
+  return plan;
+}
+
+SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file) {
   SweepPlan plan;
   plan.file = file;
   if (!root.IsMap() || !root["sweep"]) return plan;
@@ -144,6 +161,7 @@ SweepPlan read_sweep(const YAML::Node& root, const std::string& file) {
 YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k) {
   YAML::Node copy = YAML::Clone(root);
   copy.remove("sweep");
+  copy.remove("uncertainty");
   for (size_t p = 0; p < plan.paths.size(); ++p) {
     const std::vector<PathStep> steps = split_path(plan.paths[p]);
     // yaml-cpp nodes are handles: walking with operator[] on a non-const node creates missing
@@ -356,6 +374,19 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
       }
     log << fmt::format("warning: sweep.rank_by metric '{}' is not in any variant's metrics.csv (it scores 0 everywhere); "
                        "metrics: {}\n", c.metric, names);
+  }
+  if (plan.samples > 0) {
+    const UncertaintySummary summary = summarise_uncertainty(plan, input.variants, input.criteria, options.out + "/report");
+    input.extra_html = summary.html;
+    input.title = fmt::format("Design runs with calibration uncertainty: {}", fs::path(options.case_path).filename().string());
+    log << fmt::format("calibration uncertainty ({} parameter sets per design): median [90 % band]\n", plan.samples);
+    for (const std::string& note : plan.held) log << "  " << note << "\n";
+    for (const KpiBand& b : summary.bands)
+      if (b.p95 != b.p05 || b.median != 0)
+        log << fmt::format("  {}{:<34} {:.4g} [{:.4g}, {:.4g}]{}\n", b.design.empty() ? "" : b.design + ": ", b.metric, b.median, b.p05, b.p95,
+                           std::isfinite(b.run_noise) ? fmt::format("  (run noise {:.2g})", b.run_noise) : "");
+    for (const Beats& x : summary.beats)
+      if (x.probability > 0.5) log << fmt::format("  P({} beats {} on {}) = {:.2f} over {} parameter sets\n", x.a, x.b, x.metric, x.probability, x.pairs);
   }
   report::write_sweep_report(input, options.out + "/report");
   const auto ranked = report::rank_variants(input);

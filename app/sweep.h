@@ -38,15 +38,25 @@ struct SweepPlan {
   std::vector<SweepCriterion> criteria;
   int parallel = 0;                                 ///< 0: automatic
   std::string file;
+  /// With `uncertainty:` (app/uncertainty.h): parameter sets per design variant; variant k is
+  /// design k / samples at parameter set k % samples, and the paths after the first
+  /// `design_paths` are the sampled parameters. 0: no uncertainty section.
+  int samples = 0;
+  size_t design_paths = 0;
+  std::vector<std::string> held;  ///< calibrated parameters a case cannot vary, held at their fitted values
+  /// The design part of variant k's label ("" without a sweep).
+  std::string design_label(size_t k) const;
   /// Short name of variant k: "v02".
   std::string name(size_t k) const;
   /// "spoon.radius=0.8, receiving_belt.speed=3.5"
   std::string label(size_t k) const;
 };
 
-/// Reads the `sweep:` section of a case (throws CaseError naming file, line and key); nullopt-like
+/// Reads the `sweep:` section of a case and its `uncertainty:` section (app/uncertainty.h) (throws CaseError naming file, line and key); nullopt-like
 /// empty plan (no variants) when the case has none.
 SweepPlan read_sweep(const YAML::Node& root, const std::string& file);
+/// The `sweep:` section alone.
+SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file);
 
 /// The case of variant k: a deep copy of `root` with the sweep's values set and `sweep` removed.
 /// Throws CaseError when a path cannot be set (a list index out of range, a scalar in the way).

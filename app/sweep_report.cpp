@@ -142,6 +142,7 @@ void write_sweep_report(const SweepReportInput& input, const std::string& dir) {
     h += "</tr>\n";
   }
   h += "</table>\n";
+  h += input.extra_html;
 
   h += "<h2>All metrics</h2>\n<table>\n<tr><th>metric</th>";
   for (const Ranked& r : ranked) h += "<th>" + esc(input.variants[r.variant].name) + "</th>";
