@@ -6,6 +6,7 @@
 //   demdesign render OUT           images of a run's saved frames
 //   demdesign effects              the table of contact effects and their parameters
 //   demdesign materials            the material library
+//   demdesign keys [--markdown]    every key of case, material and measurement files (docs/case-keys.md)
 //   demdesign test | compare | calibrate | diagnose   virtual lab tests and material calibration
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -18,6 +19,7 @@
 
 #include "allocator.h"
 #include "calibration_commands.h"
+#include "case_keys.h"
 #include "diagnostics.h"
 #include "equipment.h"
 #include "flow_images.h"
@@ -338,6 +340,12 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--height", render_options.height, "[px]");
   CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
   CLI::App* materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
+  bool keys_markdown = false;
+  std::string keys_source = dem::app::default_source_dir();
+  CLI::App* keys_cmd = app.add_subcommand("keys", "every key of case, material and measurement files, read from the "
+                                                  "readers themselves (docs/case-keys.md is its --markdown output)");
+  keys_cmd->add_flag("--markdown", keys_markdown, "Markdown tables, as in docs/case-keys.md");
+  keys_cmd->add_option("--source", keys_source, "source tree whose shipped files are read (default: the one built from)");
 
   // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
   dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
@@ -358,6 +366,10 @@ int main(int argc, char** argv) {
       for (const auto& m : dem::materials::list_library())
         std::cout << fmt::format("  {:<20} {}\n", m.name, m.description);
       std::cout << "use in a case: materials: {NAME: {library: FILE_STEM}}\n";
+      return 0;
+    }
+    if (keys_cmd->parsed()) {
+      std::cout << dem::app::case_key_reference(keys_source, keys_markdown);
       return 0;
     }
     if (check_cmd->parsed()) {

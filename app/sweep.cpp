@@ -108,6 +108,7 @@ SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file) {
   if (!parameters || !parameters.IsMap() || parameters.size() == 0)
     map.fail("parameters", "missing: a map of key paths to value lists, e.g. {equipment.transfer_chute.spoon.radius: [0.6, 0.8]}");
   MapReader params(parameters, file, "sweep.parameters");
+  params.keys_are_names("KEY_PATH");
   std::vector<std::vector<YAML::Node>> values;
   for (const std::string& path : params.keys()) {
     if (split_path(path).empty()) params.fail(path, "is not a key path (names separated by dots, list items as [k])");

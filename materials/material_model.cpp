@@ -128,10 +128,8 @@ MaterialModel read_material_model(const std::string& path) {
   }
   // The typical size: `size:` read like a particle set's `diameter:`.
   if (root["size"]) {
-    YAML::Node holder(YAML::NodeType::Map);
-    holder["diameter"] = root["size"];
-    MapReader reader(holder, file.string(), "");
-    model.diameter = read_size_distribution(reader, file.string());
+    MapReader reader(root, file.string(), "");
+    model.diameter = read_size_distribution(reader, file.string(), "size");
   }
   // Tunable keys must be parameters the model knows.
   for (const auto& [key, range] : model.tunable) {

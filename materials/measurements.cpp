@@ -83,6 +83,7 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
   const YAML::Node setup = map.node("setup");
   if (!setup) map.fail("setup", fmt::format("missing: the set-up of the {} test, {{key: value, ...}}", test));
   MapReader s(setup, file, map.key_path("setup"));
+  s.keys_are_names("SETUP_KEY");
   for (const std::string& key : s.keys()) {
     const YAML::Node v = s.node(key);
     if (!v.IsScalar()) s.fail(key, "must be a number (SI units) or a word (a wall material, `periodic`, ...)");
@@ -109,6 +110,7 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
   const std::vector<std::string> observables = observable_names(test);
   if (const YAML::Node observed = map.node("observed")) {
     MapReader o(observed, file, map.key_path("observed"));
+    o.keys_are_names("OBSERVABLE");
     for (const std::string& key : o.keys()) {
       if (std::find(observables.begin(), observables.end(), key) == observables.end())
         o.fail(key, fmt::format("'{}' is not an observable of {}{}; valid: {}", key, test, did_you_mean(key, observables), join(observables)));

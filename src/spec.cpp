@@ -46,8 +46,10 @@ void read_effect_params(MapReader& map, const std::vector<std::string>& fixed, s
   map.finish(valid);
 }
 
-MaterialSpec read_material(const std::string& name, const YAML::Node& node, const std::string& file) {
-  MapReader map(node, file, "materials." + name);
+/// A material's properties: the map under `materials.NAME` of a case, or `properties` of a
+/// material file (`path` names it in errors).
+MaterialSpec read_material(const std::string& name, const YAML::Node& node, const std::string& file, const std::string& path) {
+  MapReader map(node, file, path);
   MaterialSpec m;
   m.name = name;
   m.location = map.location();
@@ -103,16 +105,18 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
   }
   MapReader file_map(root, lib.file, "");
   if (!file_map.has("properties")) file_map.fail("properties", "missing: the material's {density, youngs_modulus, ...}");
-  lib.material = read_material(name, file_map.node("properties"), lib.file);
+  lib.material = read_material(name, file_map.node("properties"), lib.file, "properties");
   lib.material.library_file = lib.file;
   lib.material.description = file_map.string("name", wanted);
   lib.material.description = file_map.string("description", lib.material.description);
   if (const YAML::Node sources = file_map.node("sources")) {
     MapReader s(sources, lib.file, "sources");
+    s.keys_are_names("PARAMETER");
     for (const std::string& key : s.keys()) lib.material.sources[key] = s.string(key, "");
   }
   if (const YAML::Node tunable = file_map.node("tunable")) {
     MapReader t(tunable, lib.file, "tunable");
+    t.keys_are_names("PARAMETER");
     for (const std::string& key : t.keys()) {
       const YAML::Node range = t.node(key);
       if (!range.IsSequence() || range.size() != 2) t.fail(key, "must be a range [min, max]");
@@ -225,16 +229,16 @@ ContactSpec read_contact(const YAML::Node& node, const std::string& file) {
   return contact;
 }
 
-SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
+SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file, const std::string& key = "diameter") {
   SizeDistributionSpec d;
-  const YAML::Node node = parent.node("diameter");
-  if (!node) parent.fail("diameter", "missing: give a diameter [m] or {distribution: normal|uniform|discrete, ...}");
+  const YAML::Node node = parent.node(key);
+  if (!node) parent.fail(key, "missing: give a diameter [m] or {distribution: normal|uniform|discrete, ...}");
   if (node.IsScalar()) {
-    d.value = MapReader::scalar_number(node, parent, "diameter");
-    if (!(d.value > 0 && d.value < 10)) parent.fail("diameter", fmt::format("{:g} m is out of range; valid: (0, 10] m", d.value));
+    d.value = MapReader::scalar_number(node, parent, key);
+    if (!(d.value > 0 && d.value < 10)) parent.fail(key, fmt::format("{:g} m is out of range; valid: (0, 10] m", d.value));
     return d;
   }
-  MapReader map(node, file, parent.key_path("diameter"));
+  MapReader map(node, file, parent.key_path(key));
   const std::string kind = map.string("distribution", "", {"normal", "uniform", "discrete"});
   if (kind.empty()) map.fail("distribution", "missing: normal, uniform or discrete");
   if (kind == "normal") {
@@ -254,22 +258,22 @@ SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file) {
     d.kind = SizeDistributionSpec::Kind::discrete;
     const bool by_number = map.has("number_fractions");
     if (by_number && map.has("mass_fractions")) map.fail("number_fractions", "give mass_fractions or number_fractions, not both");
-    const std::string key = by_number ? "number_fractions" : "mass_fractions";
-    const YAML::Node values = map.node("values"), fractions = map.node(key);
+    const std::string fractions_key = by_number ? "number_fractions" : "mass_fractions";
+    const YAML::Node values = map.node("values"), fractions = map.node(fractions_key);
     if (!values || !values.IsSequence() || values.size() == 0) map.fail("values", "must be a list of diameters [m]");
     if (!fractions || !fractions.IsSequence() || fractions.size() != values.size())
-      map.fail(key, "must be a list as long as 'values' (mass_fractions, or number_fractions)");
+      map.fail(fractions_key, "must be a list as long as 'values' (mass_fractions, or number_fractions)");
     double sum = 0, mass_sum = 0;
     for (size_t k = 0; k < values.size(); ++k) {
       d.values.push_back(MapReader::finite_number(values[k], map, "values"));
-      d.mass_fractions.push_back(MapReader::finite_number(fractions[k], map, key));
+      d.mass_fractions.push_back(MapReader::finite_number(fractions[k], map, fractions_key));
       if (!(d.values.back() > 0 && d.values.back() <= 10)) map.fail("values", "diameters must be in (0, 10] m");
-      if (!(d.mass_fractions.back() >= 0)) map.fail(key, "fractions must not be negative");
+      if (!(d.mass_fractions.back() >= 0)) map.fail(fractions_key, "fractions must not be negative");
       sum += d.mass_fractions.back();
       if (by_number) d.mass_fractions.back() *= d.values.back() * d.values.back() * d.values.back();
       mass_sum += d.mass_fractions.back();
     }
-    if (std::abs(sum - 1.0) > 1e-6) map.fail(key, fmt::format("sum to {:g}; they must sum to 1", sum));
+    if (std::abs(sum - 1.0) > 1e-6) map.fail(fractions_key, fmt::format("sum to {:g}; they must sum to 1", sum));
     if (by_number)
       for (double& f : d.mass_fractions) f /= mass_sum;
   }
@@ -640,7 +644,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
       for (auto& wall : lib.walls) library_walls.push_back({name, {wall.first, wall.second}});
       spec.materials.push_back(std::move(lib.material));
     } else {
-      spec.materials.push_back(read_material(name, kv.second, file));
+      spec.materials.push_back(read_material(name, kv.second, file, "materials." + name));
     }
   }
 
@@ -714,6 +718,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
   if (const YAML::Node wear = top.node("wear_coefficients")) {
     MapReader w(wear, file, "wear_coefficients");
+    w.keys_are_names("MESH");  // a mesh name, or `default`
     for (const std::string& key : w.keys()) spec.wear_coefficients[key] = w.number(key, 0.0, 0.0, 1e-6, "m^3/J");
   }
   top.node("sweep");  // read by the sweep runner (app/sweep.cpp) before the variants are parsed
@@ -753,7 +758,9 @@ double SizeDistributionSpec::smallest() const {
   return value;
 }
 
-SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file) { return read_diameter(parent, file); }
+SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file, const std::string& key) {
+  return read_diameter(parent, file, key);
+}
 
 CaseSpec parse_case_node(const YAML::Node& root, const std::string& file) {
   try {

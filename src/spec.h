@@ -305,9 +305,10 @@ CaseSpec parse_case_file(const std::string& path);
 /// `file` names it in errors and resolves relative paths.
 CaseSpec parse_case_node(const YAML::Node& root, const std::string& file);
 
-/// Reads a size distribution from the map that holds `diameter:` (inlets, particle sets, feeds).
+/// Reads a size distribution from the map that holds it under `key`: `diameter:` of inlets, particle
+/// sets and measurement files, `size:` of a material file.
 class MapReader;
-SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file);
+SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file, const std::string& key = "diameter");
 /// Same for YAML text (tests keep their model inline); `name` stands in for the file name.
 CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>");
 

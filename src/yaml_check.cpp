@@ -40,7 +40,38 @@ std::string format_range(double min, double max) {
   return fmt::format("[{:g}, {:g}]", min, max);
 }
 
+thread_local KeyRecorder* key_recorder = nullptr;
+
 }  // namespace
+
+KeyRecorder* set_key_recorder(KeyRecorder* recorder) {
+  KeyRecorder* previous = key_recorder;
+  key_recorder = recorder;
+  return previous;
+}
+
+void MapReader::record(const std::string& key, std::string_view kind, bool required, std::string fallback,
+                       std::optional<double> min, std::optional<double> max, std::string_view unit,
+                       const std::vector<std::string>& allowed) const {
+  if (!key_recorder) return;
+  KeyRequest r;
+  r.file = file_, r.map_path = path_, r.key = key, r.names = names_, r.kind = kind, r.required = required;
+  r.fallback = std::move(fallback), r.min = min, r.max = max, r.unit = unit, r.allowed = allowed;
+  if (const YAML::Node n = node_[key]) {
+    r.shape = n.IsMap() ? "map" : n.IsSequence() ? "list" : "value";
+    if (n.IsScalar()) {
+      r.value = n.Scalar();
+    } else if (n.IsSequence() && n.size() <= 4) {  // a short list of scalars: a vector, a pair
+      std::string items;
+      for (const auto& item : n) {
+        if (!item.IsScalar()) return key_recorder->record(std::move(r));
+        items += (items.empty() ? "" : ", ") + item.Scalar();
+      }
+      r.value = "[" + items + "]";
+    }
+  }
+  key_recorder->record(std::move(r));
+}
 
 std::string nearest_word(std::string_view word, const std::vector<std::string>& valid) {
   std::string best;
@@ -106,7 +137,7 @@ double MapReader::finite_number(const YAML::Node& n, const MapReader& ctx, const
   return value;
 }
 
-double MapReader::number(const std::string& key, double fallback, double min, double max, std::string_view unit) {
+double MapReader::read_number(const std::string& key, double fallback, double min, double max, std::string_view unit) {
   used_.insert(key);
   const YAML::Node n = node_[key];
   if (!n) return fallback;
@@ -118,21 +149,29 @@ double MapReader::number(const std::string& key, double fallback, double min, do
   return value;
 }
 
+double MapReader::number(const std::string& key, double fallback, double min, double max, std::string_view unit) {
+  record(key, "number", false, fmt::format("{:g}", fallback), min, max, unit);
+  return read_number(key, fallback, min, max, unit);
+}
+
 double MapReader::required_number(const std::string& key, double min, double max, std::string_view unit) {
+  record(key, "number", true, "", min, max, unit);
   if (!has(key)) {
     throw CaseError(fmt::format("{}: {}: missing; give a number in {}{}", at(node_).str(), key_path(key),
                                 format_range(min, max), unit.empty() ? "" : fmt::format(" {}", unit)));
   }
-  return number(key, 0.0, min, max, unit);
+  return read_number(key, 0.0, min, max, unit);
 }
 
 int64_t MapReader::integer(const std::string& key, int64_t fallback, int64_t min, int64_t max) {
-  const double value = number(key, static_cast<double>(fallback), static_cast<double>(min), static_cast<double>(max));
+  record(key, "integer", false, fmt::format("{}", fallback), static_cast<double>(min), static_cast<double>(max));
+  const double value = read_number(key, static_cast<double>(fallback), static_cast<double>(min), static_cast<double>(max), "");
   if (value != std::floor(value)) fail(key, fmt::format("{:g} must be a whole number", value));
   return static_cast<int64_t>(value);
 }
 
 bool MapReader::boolean(const std::string& key, bool fallback) {
+  record(key, "boolean", false, fallback ? "true" : "false");
   used_.insert(key);
   const YAML::Node n = node_[key];
   if (!n) return fallback;
@@ -143,6 +182,11 @@ bool MapReader::boolean(const std::string& key, bool fallback) {
 }
 
 std::string MapReader::string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
+  record(key, allowed.empty() ? "text" : "word", false, fallback, {}, {}, "", allowed);
+  return read_string(key, fallback, allowed);
+}
+
+std::string MapReader::read_string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
   used_.insert(key);
   const YAML::Node n = node_[key];
   if (!n) return fallback;
@@ -157,12 +201,14 @@ std::string MapReader::string(const std::string& key, const std::string& fallbac
 }
 
 std::string MapReader::required_string(const std::string& key, const std::string& what) {
-  const std::string value = string(key, "");
+  record(key, "text", true, "");
+  const std::string value = read_string(key, "", {});
   if (value.empty()) fail(key, "missing: " + what);
   return value;
 }
 
 Vec3 MapReader::vec3(const std::string& key, const Vec3& fallback) {
+  record(key, "vector", false, fmt::format("[{:g}, {:g}, {:g}]", fallback.x(), fallback.y(), fallback.z()));
   used_.insert(key);
   const YAML::Node n = node_[key];
   if (!n) return fallback;
@@ -176,6 +222,7 @@ Vec3 MapReader::vec3(const std::string& key, const Vec3& fallback) {
 }
 
 YAML::Node MapReader::node(const std::string& key) {
+  record(key, "section", false, "");
   used_.insert(key);
   return node_[key];
 }

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <initializer_list>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -17,6 +18,34 @@ namespace dem {
 
 /// The valid word closest to `word` (edit distance), or "" when none is close.
 std::string nearest_word(std::string_view word, const std::vector<std::string>& valid);
+
+/// One key a MapReader was asked for, as `demdesign keys` records it to write the case-key
+/// reference (docs/case-keys.md) from the readers themselves.
+struct KeyRequest {
+  std::string file;      ///< the file being read
+  std::string map_path;  ///< key path of the map ("" at the top), list indices as in the file
+  std::string key;
+  std::string names;     ///< when the map's keys are names (MapReader::keys_are_names): what they name
+  std::string kind;      ///< number, integer, boolean, word, text, vector, section
+  bool required = false;
+  std::string fallback;  ///< the default as text ("" when none)
+  std::optional<double> min, max;
+  std::string unit;
+  std::vector<std::string> allowed;
+  std::string value;     ///< the value in the file as written; "" when absent or not a scalar
+  std::string shape;     ///< of a section's value: map, list or value; "" when absent
+};
+
+/// Receives every key request of the MapReaders of its thread while it is set.
+class KeyRecorder {
+ public:
+  virtual ~KeyRecorder() = default;
+  virtual void record(KeyRequest request) = 0;
+};
+
+/// Sets this thread's recorder (nullptr, the default: nothing is recorded); returns the previous
+/// one. Only `demdesign keys` sets one: it is a parse-time hook, never in a simulation's loops.
+KeyRecorder* set_key_recorder(KeyRecorder* recorder);
 
 class MapReader {
  public:
@@ -43,6 +72,9 @@ class MapReader {
   YAML::Node node(const std::string& key);
   /// All keys, in file order.
   std::vector<std::string> keys() const;
+  /// Says that this map's keys are names the user chooses (mesh names, parameter names, key
+  /// paths), not keys of the format; `what` stands for them in the key reference ("MESH").
+  void keys_are_names(std::string what) { names_ = std::move(what); }
 
   /// Error for a value of `key`, with location.
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
@@ -62,6 +94,14 @@ class MapReader {
   std::string file_;
   std::string path_;
   mutable std::set<std::string> used_;
+  std::string names_;  ///< see keys_are_names
+
+  /// Passes a request to this thread's KeyRecorder, if one is set.
+  void record(const std::string& key, std::string_view kind, bool required, std::string fallback,
+              std::optional<double> min = {}, std::optional<double> max = {}, std::string_view unit = "",
+              const std::vector<std::string>& allowed = {}) const;
+  double read_number(const std::string& key, double fallback, double min, double max, std::string_view unit);
+  std::string read_string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed);
 };
 
 }  // namespace dem
