@@ -388,7 +388,7 @@ std::string case_key_reference(const std::string& source_dir, bool markdown) {
   // The shipped cases, then a case that uses the sections none of them does.
   std::vector<fs::path> cases = yaml_files(root / "cases"), material_files = yaml_files(root / "materials"), measurement_files;
   cases.push_back(root / "tests" / "data" / "case_keys_coverage.yaml");
-  for (const fs::path& folder : {root / "cases" / "calibration", root / "tests" / "data" / "cross_engine"})
+  for (const fs::path& folder : {root / "cases" / "calibration", root / "tests" / "data", root / "tests" / "data" / "cross_engine"})
     for (const fs::path& file : yaml_files(folder)) {
       const Document kind = kind_of(file);
       if (kind == Document::material_file) material_files.push_back(file);
