@@ -1,4 +1,4 @@
-// Oblique impacts and spin: Chung & Ooi (2011) tests 4, 6, 7 (validation CO-4, CO-6, CO-7).
+// Oblique impacts and spin: Chung & Ooi (2011) tests 4 to 8 (validation CO-4 to CO-7).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -95,11 +95,12 @@ TEST(ChungOoi, Test6SpinningSphereOnPlaneSlidingRegime) {
   }
 }
 
-// --- Chung & Ooi test 6 against the paper's curves ---------------------------------------------
+// --- Chung & Ooi tests 5, 6 and 8 against the paper's curves --------------------------------
 // Published points: Chung & Ooi (2011) figures as digitised by the Kratos DEMApplication team
 // (KratosMultiphysics/Kratos, applications/DEMApplication/test_examples/basic_benchmarks/
-// paper_data/benchmark6_graph1.dat @1bfdba24). On the sliding points, where beta = chi - 1
-// exactly, the digitised values sit up to 0.016 off.
+// paper_data/benchmark6_graph1.dat @1bfdba24, benchmark5_graph{1,2}.dat @650ccb26, and
+// tests/DEM3D_chung_ooi_tests/paper_data_5_to_8/benchmark8_graph1.dat @5924ef79). On the sliding
+// points, where beta = chi - 1 exactly, the digitised values sit up to 0.016 off.
 //
 // Tolerances for a curve of beta: each point within 0.04 (validation CO-6 asks 0.03 for chi > 1;
 // 0.01 more for the digitisation), and the curve's error as Kratos measures it,
@@ -157,8 +158,8 @@ TEST(ChungOoi, Test6SpringCapReproducesThePublishedCurveOfAluminium) {
   // at chi 2.5-3.0).
   expect_curve(kTest6Aluminium, [](double chi) { return test6_beta(chi, "spring"); });
   // Beyond chi = 6.2 the contact no longer slides at the end of the impact and beta levels off at
-  // -0.11, where the aluminium curve keeps falling; the nylon curve of the same figure levels off
-  // at -0.11 as the model does (below). Checked here as a known
+  // -0.11, where the aluminium curve keeps falling; the nylon curve of the same figure and the
+  // paper's test 8 case B level off at -0.11 as the model does (below). Checked here as a known
   // difference, so that a change of the model there is seen.
   for (const CurvePoint& p : kTest6AluminiumTail) {
     const double beta = test6_beta(p.x, "spring");
@@ -186,6 +187,96 @@ TEST(ChungOoi, Test6TotalCapKeepsItsNumbers) {
       {4.5154, -0.098325138724499342}, {5.7489, -0.067357970004827836}, {7.8194, -0.074193294880743041},
       {11.8943, -0.079026248245371189}, {24.0088, -0.083539850570359259}};
   for (const CurvePoint& p : kTotalCap) EXPECT_NEAR(test6_beta(p.x, "total"), p.y, 1e-9) << "chi " << p.x;
+}
+
+// Test 5, steel: psi1 = Vt/(mu Vn) against psi2 = V'ct/(mu V'n) (contact point) and against
+// R w'/(mu Vn). Points at which the paper's contact slides throughout.
+constexpr CurvePoint kTest5SteelPsi2Sliding[] = {{9.9879, 3.0133}, {12.9607, 6.0133}};
+constexpr CurvePoint kTest5SteelSpinSliding[] = {{6.0058, -5.0062}, {10.0116, -5.0041}, {20.0000, -4.9905}};
+
+struct Test5Result {
+  double psi2, spin;  // V'ct/(mu V'n), R w'/(mu Vn)
+};
+
+Test5Result test5(double psi1) {
+  const double mu = 0.3, vn = 5.0, R = 1e-5;
+  CaseSpec spec = load_case("co5_oblique_constant_vn.yaml");
+  spec.particles[0].velocity = Vec3(psi1 * mu * vn, 0, -vn);
+  Sim sim(spec);
+  const Rebound r = bounce(sim, 2e-7);
+  // The paper's w' turns the contact point against the slip: w_paper = -wy (see test 4).
+  return {(r.vx - R * r.wy) / (mu * r.vz), -R * r.wy / (mu * vn)};
+}
+
+TEST(ChungOoi, Test5SteelSphereSlidingRegimeMatchesThePaper) {
+  // Where the contact slides throughout: R w'/(mu Vn) = -2.5 (1+e) = -5 and psi2 = psi1 - 7
+  // (e = 1), and the paper's points; 2 % as Kratos checks test 5 (sliding points only).
+  for (const CurvePoint& p : kTest5SteelSpinSliding) {
+    const Test5Result r = test5(p.x);
+    EXPECT_NEAR(r.spin, -5.0, 0.02 * 5.0) << "psi1 " << p.x;
+    EXPECT_NEAR(r.spin, p.y, 0.02 * 5.0) << "psi1 " << p.x;
+  }
+  for (const CurvePoint& p : kTest5SteelPsi2Sliding) {
+    const Test5Result r = test5(p.x);
+    EXPECT_NEAR(r.psi2, p.x - 7.0, 0.02 * std::abs(p.x - 7.0)) << "psi1 " << p.x;
+    EXPECT_NEAR(r.psi2, p.y, 0.02 * std::abs(p.y)) << "psi1 " << p.x;
+  }
+}
+
+TEST(ChungOoi, Test5SteelSphereStickingRegimeIsTheNoSlipSpring) {
+  // Below psi1 = 5 the paper's DEM curve reverses the contact point in proportion to psi1
+  // (psi2 = -0.75 ... -0.85 psi1 up to psi1 = 3.3; its FEM curve stays near 0 up to psi1 = 1),
+  // which the Mindlin no-slip stiffness kt = 8 G* a does not do with either cap (e = 1: no
+  // damping, and the elastic load is the load). A contact that sticks throughout returns the
+  // contact-point velocity almost unchanged: V'ct/Vct = 0.955 for nu = 0.3, from an independent
+  // integration of m_t x'' = -kt x (m_t = m/3.5, kt/kn = 6 G*/E* = 1.235, kn = 4/3 E* a) over a
+  // Hertz impact; the reversal comes only for psi1 = 1.7 ... 6 (lowest psi2 -1.45 near
+  // psi1 = 4.5, paper -2.79 at 4). Checked: that stick limit to 2 %, and where the reversal is.
+  const Test5Result small = test5(0.05);
+  EXPECT_NEAR(small.psi2 / 0.05, 0.955, 0.02 * 0.955);
+  double lowest = 0, at = 0;
+  for (double psi1 = 1.0; psi1 <= 7.0; psi1 += 0.5) {
+    const Test5Result r = test5(psi1);
+    if (r.psi2 < lowest) lowest = r.psi2, at = psi1;
+  }
+  EXPECT_NEAR(at, 4.5, 0.5);
+  EXPECT_LT(lowest, -1.3);
+}
+
+// Test 8, beta against chi for the sphere on a larger sphere; cases A and B of the figure agree
+// up to chi = 5.77 and part beyond it (A: -0.204, -0.248, -0.318; B: -0.106, -0.108, -0.106).
+constexpr CurvePoint kTest8CaseB[] = {
+    {0.1872, -0.8152}, {0.3583, -0.6262}, {0.5508, -0.4394}, {0.7647, -0.2378}, {0.9786, -0.0173},
+    {1.2139, 0.0961},  {1.4920, 0.1108},  {1.7701, 0.0898},  {2.0909, 0.0583},  {2.5187, 0.0058},
+    {2.9893, -0.0488}, {3.6310, -0.1034}, {4.5080, -0.1391}, {5.7701, -0.1622}, {7.8449, -0.1055},
+    {11.9091, -0.1076}, {23.9947, -0.1055}};
+
+double test8_beta(double chi) {
+  const double mu = 0.4, e = 0.5, vn = 0.2, R = 0.1, R_large = 0.5;
+  const double vtc = 3.5 * mu * (1 + e) * vn / chi;
+  CaseSpec spec = load_case("co8_sphere_on_large_sphere.yaml");
+  spec.particles[0].angular_velocity = Vec3(0, -vtc / R, 0);  // contact point moves at +vtc in z
+  Sim sim(spec);
+  const size_t small = sim.slot(0), large = sim.slot(1);
+  bool touched = false;
+  while (sim.state.time < 5e-3) {
+    sim.advance();
+    const bool touching = overlap_of(sim.state, small, large) > 0;
+    touched |= touching;
+    if (touched && !touching) break;
+  }
+  EXPECT_TRUE(touched);
+  const State& s = sim.state;
+  // Contact-point velocity of the small sphere relative to the large one, along z.
+  const double vtc_after = (s.vz[small] - R * s.wy[small]) - (s.vz[large] + R_large * s.wy[large]);
+  return -vtc_after / vtc;
+}
+
+TEST(ChungOoi, Test8SphereOnLargerSphereMatchesThePublishedCurve) {
+  // coulomb_cap: spring (the case's), against case B, which the model follows over the whole
+  // range (largest deviation 0.033 at chi 2.99; case A falls beyond chi 6 as test 6's aluminium
+  // curve does).
+  expect_curve(kTest8CaseB, test8_beta);
 }
 
 TEST(ChungOoi, Test7SpinningPairWithoutSlipKeepsItsSpin) {
