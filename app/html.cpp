@@ -37,7 +37,6 @@ std::string num(double v, int sig) {
   return fmt::format("{:.{}f}", v, decimals);
 }
 
-namespace {
 std::string base64(const std::string& bytes) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -56,6 +55,7 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
+namespace {
 const char* kStyle = R"(
 body{font-family:"DejaVu Sans",Helvetica,Arial,sans-serif;font-size:14px;color:#222;max-width:1100px;margin:24px auto;padding:0 16px;line-height:1.45}
 h1{font-size:24px;margin-bottom:4px}h2{font-size:19px;border-bottom:2px solid #ccd;padding-bottom:3px;margin-top:32px}
