@@ -675,6 +675,8 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
     h += figure(p, report_dir, "centring_offset", "Offset of the load's centroid from the box centre along <code>across</code>.");
   }
 
+  h += viewer3d::section(model, state, in.records_from, in.viewer);
+
   // Images.
   if (!in.images.empty()) {
     h += "<h2>Images</h2>\n";

@@ -1,7 +1,8 @@
 // The engineering report of a run (throughput, spillage, blockage, power, wear, belt loading,
 // all at a steady state found from the data) and of a design sweep (variants ranked by
 // weighted criteria). Each report is one self-contained HTML file (images as base64 data URIs,
-// inline CSS, no scripts, no links) beside the CSV files and plot scripts it was made from.
+// inline CSS, no links; the run report's only scripts are the inlined 3D view, app/viewer3d.h)
+// beside the CSV files and plot scripts it was made from.
 #pragma once
 
 #include <cstddef>
@@ -14,6 +15,7 @@
 #include "model.h"
 #include "spec.h"
 #include "state.h"
+#include "viewer3d.h"
 
 namespace dem::report {
 
@@ -40,6 +42,7 @@ struct RunReportInput {
   /// model.design, or edited copies.
   std::vector<SensorSpec> sensors;
   std::vector<std::pair<std::string, double>> design;
+  viewer3d::Options viewer;  ///< the interactive 3D view (three.js to inline, particle limit)
 };
 
 /// Key numbers of a run, to rank sweep variants. Names carry their unit ("throughput_t_h").
