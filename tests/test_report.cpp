@@ -1,5 +1,6 @@
 // Run and sweep reports: self-contained HTML, steady interval and mean, metrics round trip,
-// the report without gnuplot, a plant still filling, the report in headless Chromium, sweep ranking.
+// the report without gnuplot, a plant still filling, the report in headless Chromium, the 3D view
+// (drawn in headless Chromium, or a note without three.js), sweep ranking.
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -16,8 +17,12 @@
 #include <sstream>
 
 #include "model.h"
+#include "particles.h"
+#include "render/render.h"
 #include "report.h"
+#include "run.h"
 #include "spec.h"
+#include "viewer3d.h"
 
 extern "C" char** environ;
 
@@ -60,12 +65,31 @@ bool gnuplot_installed() {
   return false;
 }
 
-/// Every <img> embeds its picture as a data URI; nothing refers outside the file.
-void expect_self_contained(const std::string& html) {
+/// The page without the contents of its <script> elements (the inlined three.js names XML
+/// namespaces such as http://www.w3.org/1999/xhtml; it fetches nothing).
+std::string without_scripts(const std::string& html) {
+  std::string out;
+  std::size_t from = 0;
+  for (std::size_t at = html.find("<script"); at != std::string::npos; at = html.find("<script", from)) {
+    const std::size_t open_end = html.find('>', at), close = html.find("</script>", at);
+    if (open_end == std::string::npos || close == std::string::npos) break;
+    out += html.substr(from, open_end + 1 - from);
+    from = close;
+  }
+  return out + html.substr(from);
+}
+
+/// Every <img> embeds its picture as a data URI; nothing refers outside the file: the only
+/// scripts are inline (no src), and no address appears outside them.
+void expect_self_contained(const std::string& page) {
+  const std::string html = without_scripts(page);
   EXPECT_EQ(html.find("http://"), std::string::npos);
   EXPECT_EQ(html.find("https://"), std::string::npos);
   EXPECT_EQ(html.find("src=\"file"), std::string::npos);
-  EXPECT_EQ(html.find("<script"), std::string::npos);
+  for (std::size_t at = html.find("<script"); at != std::string::npos; at = html.find("<script", at + 1)) {
+    const std::string tag = html.substr(at, html.find('>', at) - at);
+    EXPECT_TRUE(tag == "<script" || tag == "<script type=\"application/json\" id=\"v3d-data\"") << tag;
+  }
   EXPECT_EQ(html.find("<link"), std::string::npos);
   for (std::size_t at = html.find("<img"); at != std::string::npos; at = html.find("<img", at + 1)) {
     const std::size_t src = html.find("src=\"", at);
@@ -303,6 +327,116 @@ document.getElementById('report').addEventListener('load', () => {
   EXPECT_NE(text.find("title report test chute"), std::string::npos) << text.substr(at, 200);
   EXPECT_EQ(text.find("Uncaught"), std::string::npos) << text;
   EXPECT_EQ(text.find(":ERROR:CONSOLE"), std::string::npos) << text;
+}
+
+bool three_js_installed() { return fs::exists(viewer3d::kDefaultThreeJs); }
+
+TEST(RunReport, ViewerSaysWhyWithoutThreeJs) {
+  Fixture f("demdesign_report_nothree_test");
+  f.input.viewer.three_js = (f.dir / "absent" / "three.min.js").string();
+  report::write_run_report(f.input, (f.dir / "report").string());
+  const std::string html = read(f.dir / "report" / "report.html");
+  EXPECT_NE(html.find("3D view not available: three.js not found at " + f.input.viewer.three_js), std::string::npos);
+  EXPECT_NE(html.find("libjs-three"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  expect_self_contained(html);
+}
+
+TEST(RunReport, ViewerInlinesThreeJsAndSubsamplesParticles) {
+  if (!three_js_installed()) GTEST_SKIP() << "three.js not installed (Debian package libjs-three; .ci/install-deps installs it)";
+  Fixture f("demdesign_report_viewer_data_test");
+  for (int k = 0; k < 50; ++k) f.state.add_sphere(0.01 * k, 0.5, 0.1, 0.005, 2600, 0);
+  f.input.viewer.max_particles = 20;
+  report::write_run_report(f.input, (f.dir / "report").string());
+  const std::string html = read(f.dir / "report" / "report.html");
+  expect_self_contained(html);
+  EXPECT_NE(html.find("three.js (MIT licence), inlined from"), std::string::npos);
+  EXPECT_NE(html.find("<b>Subsampled:</b> 20 of the 50 particles are shown"), std::string::npos);
+  EXPECT_NE(html.find("\"particles\":{\"n\":20,"), std::string::npos);
+  EXPECT_NE(html.find("\"shear\":{\"label\":\"shear work rate\",\"unit\":\"W/m\\u00b2\",\"max\":80}"), std::string::npos)
+      << "the liner's 80 W/m^2 (the wear section's number) is the top of the scale";
+}
+
+/// The bounding box of the pixels of `colour` (within 3 per channel) and how many pixels inside
+/// it differ from that colour by more than 40 in some channel.
+struct ViewerArea {
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+  long background = 0, drawn = 0;
+};
+ViewerArea viewer_area(const render::Image& image, std::array<int, 3> colour) {
+  ViewerArea a;
+  auto distance = [&](const std::uint8_t* p) {
+    return std::max({std::abs(p[0] - colour[0]), std::abs(p[1] - colour[1]), std::abs(p[2] - colour[2])});
+  };
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (distance(image.pixel(x, y)) <= 3) a.x0 = std::min(a.x0, x), a.y0 = std::min(a.y0, y), a.x1 = std::max(a.x1, x), a.y1 = std::max(a.y1, y), ++a.background;
+  for (int y = a.y0; y <= a.y1; ++y)
+    for (int x = a.x0; x <= a.x1; ++x)
+      if (distance(image.pixel(x, y)) > 40) ++a.drawn;
+  return a;
+}
+
+// A short real run (particles fed onto the liner) reported, then opened in headless Chromium
+// with WebGL on SwiftShader: the view must say it drew, the console must show no errors, and a
+// screenshot scrolled to the view must show the canvas with walls and particles on its
+// background.
+TEST(RunReport, ViewerDrawsInHeadlessChromium) {
+  if (!three_js_installed()) GTEST_SKIP() << "three.js not installed (Debian package libjs-three; .ci/install-deps installs it)";
+  Fixture f("demdesign_report_viewer_test");
+  CaseSpec spec = parse_case_text(kCase, "report.yaml");
+  spec.simulation.duration = 0.45;
+  const Model model = compile(spec);
+  State state = initial_state(model);
+  Workspace work;
+  RunOptions options;
+  options.write_files = false;
+  options.progress = false;
+  std::ostringstream log;
+  const RunSummary summary = run(model, state, work, options, log);
+  ASSERT_GT(state.owned(), 100u) << log.str();
+  f.input.model = &model, f.input.state = &state, f.input.records_from = 0;
+  f.input.images.clear();
+  const fs::path out = f.dir / "report";
+  report::write_run_report(f.input, out.string());
+  const std::string page = "file://" + (out / "report.html").string();
+
+  const fs::path log_path = f.dir / "chromium.txt";
+  const std::vector<std::string> common = {"chromium", "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                                           "--enable-logging=stderr", "--v=0", "--hide-scrollbars", "--virtual-time-budget=20000"};
+  std::vector<std::string> dom = common;
+  dom.insert(dom.end(), {"--dump-dom", page});
+  const int status = run_program(dom, log_path);
+  ASSERT_NE(status, 127) << "chromium is not installed (Debian package chromium; .ci/install-deps installs it)";
+  const std::string text = read(log_path);
+  ASSERT_EQ(status, 0) << text;
+  EXPECT_NE(text.find("id=\"v3d\" data-state=\"drawn\""), std::string::npos) << text.substr(0, 3000);
+  EXPECT_NE(text.find("<div id=\"v3d-msg\" style=\"display:none\"></div>"), std::string::npos) << "the view shows no error";
+  EXPECT_EQ(text.find("Uncaught"), std::string::npos) << text.substr(0, 3000);
+  EXPECT_EQ(text.find(":ERROR:CONSOLE"), std::string::npos) << text.substr(0, 3000);
+
+  // The screenshot: a probe page holds the report in a frame scrolled to the view.
+  std::ofstream(f.dir / "probe.html") << R"(<!DOCTYPE html><html><body style="margin:0">
+<iframe id="report" src="report/report.html" style="border:0;width:1200px;height:900px"></iframe>
+<script>
+document.getElementById('report').addEventListener('load', () => {
+  const w = document.getElementById('report').contentWindow;
+  w.scrollTo(0, w.document.getElementById('view3d').getBoundingClientRect().top + w.scrollY);
+});
+</script></body></html>)";
+  const fs::path shot = f.dir / "viewer.png";
+  std::vector<std::string> screenshot = common;
+  screenshot.insert(screenshot.end(), {"--allow-file-access-from-files", "--window-size=1200,900", "--screenshot=" + shot.string(),
+                                       "file://" + (f.dir / "probe.html").string()});
+  ASSERT_EQ(run_program(screenshot, f.dir / "chromium_screenshot.txt"), 0) << read(f.dir / "chromium_screenshot.txt");
+  const render::Image image = render::read_png(shot.string());
+  const ViewerArea area = viewer_area(image, {0xec, 0xef, 0xf4});  // the canvas's clear colour
+  std::cout << "screenshot: " << shot.string() << " (viewer " << area.x1 - area.x0 + 1 << " x " << area.y1 - area.y0 + 1 << " px, "
+            << area.drawn << " drawn pixels)\n";
+  ASSERT_GT(area.background, 0) << "no viewer background in " << shot;
+  EXPECT_GT(area.x1 - area.x0, 600) << shot;
+  EXPECT_GT(area.y1 - area.y0, 300) << shot;
+  EXPECT_GT(area.drawn, 2000) << "the canvas shows only its background: " << shot;
 }
 
 TEST(SweepReport, RanksByNormalisedWeightedScore) {
