@@ -77,12 +77,12 @@ const char* kScript = R"JS(
     var stops = [[0.267,0.005,0.329],[0.283,0.141,0.458],[0.254,0.265,0.530],[0.207,0.372,0.553],[0.164,0.471,0.558],[0.128,0.567,0.551],[0.135,0.659,0.518],[0.267,0.749,0.441],[0.478,0.821,0.318],[0.741,0.873,0.150],[0.993,0.906,0.144]];
     function cmap(t) { if (!(t >= 0)) t = 0; if (t > 1) t = 1; var x = t * (stops.length - 1), i = Math.min(Math.floor(x), stops.length - 2), w = x - i, a = stops[i], b = stops[i + 1]; return [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])]; }
     var gradient = 'linear-gradient(to right,' + stops.map(function (c, i) { return 'rgb(' + c.map(function (v) { return Math.round(255 * v); }).join(',') + ') ' + Math.round(100 * i / (stops.length - 1)) + '%'; }).join(',') + ')';
-    function legend(id, title, max, unit) {
+    function legend(id, title, max, unit, peak) {
       var el = document.getElementById(id);
       el.innerHTML = '<span class="v3d-lt"></span><span class="v3d-bar"></span><span class="v3d-lt"></span>';
       el.children[0].textContent = title + ' [' + unit + ']: 0';
       el.children[1].style.background = gradient;
-      el.children[2].textContent = Number(max).toPrecision(3);
+      el.children[2].textContent = Number(max).toPrecision(3) + (peak > max ? ' and above (peak ' + Number(peak).toPrecision(3) + ')' : '');
       el.style.display = '';
     }
     var setAttr = function (g, name, a) { if (g.setAttribute) g.setAttribute(name, a); else g.addAttribute(name, a); };
@@ -129,7 +129,7 @@ const char* kScript = R"JS(
         }
         col.needsUpdate = true;
       });
-      if (f) legend('v3d-wall-legend', f.label, f.max, f.unit); else document.getElementById('v3d-wall-legend').style.display = 'none';
+      if (f) legend('v3d-wall-legend', f.label, f.max, f.unit, f.peak); else document.getElementById('v3d-wall-legend').style.display = 'none';
     }
 
     // Particles: sphere sprites sized by radius in perspective, shaded as spheres.
@@ -234,7 +234,7 @@ std::string build(const Model& model, const State& state, double records_from, c
 
   // Walls in their pose at the end, with the wall fields per triangle.
   const double seconds = state.time - records_from;  // [s] the records' interval
-  double shear_max = 0, impact_max = 0;
+  std::vector<double> shear_all, impact_all;  // every triangle's finite rate, for the colour scale
   bool recorded = false;
   std::string meshes;
   for (std::size_t m = 0; m < model.meshes.size(); ++m) {
@@ -250,13 +250,13 @@ std::string build(const Model& model, const State& state, double records_from, c
     std::string fields;
     if (m < state.records.size() && seconds > 0) {
       const TriangleRecords& rec = state.records[m];
-      auto rate = [&](const std::vector<double>& work, double& max) {
+      auto rate = [&](const std::vector<double>& work, std::vector<double>& all) {
         std::vector<float> out(surface.size(), std::nanf(""));
         for (std::size_t t = 0; t < surface.size() && t < work.size(); ++t)
-          if (surface.areas[t] > 0) out[t] = float(work[t] / (seconds * surface.areas[t])), max = std::max(max, double(out[t]));
+          if (surface.areas[t] > 0 && std::isfinite(work[t])) out[t] = float(work[t] / (seconds * surface.areas[t])), all.push_back(out[t]);
         return pack(out);
       };
-      fields = ",\"shear\":\"" + rate(rec.shear_work, shear_max) + "\",\"impact\":\"" + rate(rec.impact_energy, impact_max) + "\"";
+      fields = ",\"shear\":\"" + rate(rec.shear_work, shear_all) + "\",\"impact\":\"" + rate(rec.impact_energy, impact_all) + "\"";
       recorded = true;
     }
     meshes += fmt::format("{}{{\"name\":{},\"p\":\"{}\",\"t\":\"{}\"{}}}", meshes.empty() ? "" : ",", json_string(model.meshes[m].name),
@@ -280,11 +280,16 @@ std::string build(const Model& model, const State& state, double records_from, c
   Eigen::Vector3d up = -Eigen::Vector3d(model.gravity[0], model.gravity[1], model.gravity[2]);
   if (!(up.norm() > 0)) up = Eigen::Vector3d::UnitZ();
   up.normalize();
+  // Colour scale 0 to the 99th percentile over the triangles, as in the wear maps (app/flow_images.cpp):
+  // one hot triangle does not turn every other one dark; the peak is in the legend.
+  auto field = [](const char* name, const char* label, std::vector<double>& all) {
+    std::sort(all.begin(), all.end());
+    const double top = all.empty() ? 0 : all[static_cast<std::size_t>(0.99 * double(all.size() - 1))], peak = all.empty() ? 0 : all.back();
+    return fmt::format("\"{}\":{{\"label\":\"{}\",\"unit\":\"W/m\\u00b2\",\"max\":{},\"peak\":{}}}", name, label, json_number(top),
+                       json_number(peak));
+  };
   std::string fields = "{";
-  if (recorded)
-    fields += fmt::format("\"shear\":{{\"label\":\"shear work rate\",\"unit\":\"W/m\\u00b2\",\"max\":{}}},"
-                          "\"impact\":{{\"label\":\"impact energy rate\",\"unit\":\"W/m\\u00b2\",\"max\":{}}}",
-                          json_number(shear_max), json_number(impact_max));
+  if (recorded) fields += field("shear", "shear work rate", shear_all) + "," + field("impact", "impact energy rate", impact_all);
   fields += "}";
   const std::string data = fmt::format(
       "{{\"up\":[{},{},{}],\"meshes\":[{}],\"fields\":{},\"speedMax\":{},\"particles\":{{\"n\":{},\"p\":\"{}\",\"r\":\"{}\",\"s\":\"{}\"}}}}",
@@ -299,7 +304,7 @@ std::string build(const Model& model, const State& state, double records_from, c
     h += fmt::format(" <b>Subsampled:</b> {} of the {} particles are shown (evenly over the particle slots, about 1 in {:.3g}), "
                      "to keep this file small.", shown, total, double(total) / double(limit));
   if (recorded)
-    h += fmt::format(" Wall fields are averaged over t = {} to {} s, per triangle area; 0 to the largest value on the colour scale.",
+    h += fmt::format(" Wall fields are averaged over t = {} to {} s, per triangle area; the colour scale runs from 0 to the 99th percentile over the triangles (the peak is beside it).",
                      html::num(records_from, 3), html::num(state.time, 4));
   else if (!model.meshes.empty())
     h += " No wall records yet (recording starts at " + html::num(records_from, 3) + " s): the walls are plain.";

@@ -353,8 +353,8 @@ TEST(RunReport, ViewerInlinesThreeJsAndSubsamplesParticles) {
   EXPECT_NE(html.find("three.js (MIT licence), inlined from"), std::string::npos);
   EXPECT_NE(html.find("<b>Subsampled:</b> 20 of the 50 particles are shown"), std::string::npos);
   EXPECT_NE(html.find("\"particles\":{\"n\":20,"), std::string::npos);
-  EXPECT_NE(html.find("\"shear\":{\"label\":\"shear work rate\",\"unit\":\"W/m\\u00b2\",\"max\":80}"), std::string::npos)
-      << "the liner's 80 W/m^2 (the wear section's number) is the top of the scale";
+  EXPECT_NE(html.find("\"shear\":{\"label\":\"shear work rate\",\"unit\":\"W/m\\u00b2\",\"max\":20,\"peak\":80}"), std::string::npos)
+      << "scale to the 99th percentile of the liner's 20 and 80 W/m^2 (the lower), the peak beside it";
 }
 
 /// The bounding box of the pixels of `colour` (within 3 per channel) and how many pixels inside
