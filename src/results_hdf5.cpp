@@ -461,6 +461,74 @@ StoredFrame read_frame(const std::string& path) {
   return frame;
 }
 
+void write_paraview_script(const std::string& directory) {
+  static const char* const kScript = R"PY(# Opens this run's results in ParaView, coloured as the run's report colours them: particles as
+# spheres of their radius coloured by speed [m/s], walls by shear work rate [W/m^2] (abrasive wear),
+# at the last saved time. Written by demdesign beside particles.xdmf.
+#   ParaView: View > Python Shell > Run Script, then pick this file.
+#   pvbatch open_in_paraview.py --png view.png    renders an image (without a display:
+#   xvfb-run -a pvbatch ..., Debian's ParaView draws through X).
+# The files are XDMF 3: ParaView's Xdmf3 readers (the "XDMF Reader" of the File > Open dialog is
+# the older Xdmf2 reader and rejects a frame with no particles).
+import os
+import sys
+from paraview.simple import *
+
+here = os.path.dirname(os.path.abspath(__file__))
+view = GetActiveViewOrCreate("RenderView")
+particles = Xdmf3ReaderT(registrationName="particles", FileName=[os.path.join(here, "particles.xdmf")])
+particles.UpdatePipelineInformation()
+times = list(particles.TimestepValues or [0.0])
+scene = GetAnimationScene()
+scene.UpdateAnimationUsingDataTimeSteps()
+scene.AnimationTime = times[-1]
+spheres = Glyph(registrationName="spheres", Input=particles, GlyphType="Sphere")
+spheres.ScaleArray = ["POINTS", "radius"]
+spheres.ScaleFactor = 2.0  # the glyph sphere has unit diameter
+spheres.GlyphMode = "All Points"
+shown = Show(spheres, view)
+ColorBy(shown, ("POINTS", "speed"))
+shown.RescaleTransferFunctionToDataRange(True, False)
+shown.SetScalarBarVisibility(view, True)
+speed_bar = GetScalarBar(GetColorTransferFunction("speed"), view)
+speed_bar.Title = "particle speed [m/s]"
+speed_bar.ComponentTitle = ""
+speed_bar.WindowLocation = "Upper Right Corner"
+speed_bar.TitleFontSize = 10
+speed_bar.LabelFontSize = 9
+if os.path.exists(os.path.join(here, "walls.xdmf")):
+    walls = Xdmf3ReaderS(registrationName="walls", FileName=[os.path.join(here, "walls.xdmf")])
+    wall_display = Show(walls, view)
+    ColorBy(wall_display, ("CELLS", "shear_work_rate_W_per_m2"))
+    wall_display.RescaleTransferFunctionToDataRange(True, False)
+    wall_display.SetScalarBarVisibility(view, True)
+    wall_display.Opacity = 0.6
+    wall_bar = GetScalarBar(GetColorTransferFunction("shear_work_rate_W_per_m2"), view)
+    wall_bar.Title = "wall shear work rate [W/m^2]"
+    wall_bar.ComponentTitle = ""
+    wall_bar.WindowLocation = "Upper Left Corner"
+    wall_bar.TitleFontSize = 10
+    wall_bar.LabelFontSize = 9
+# An oblique view from the side (z is up), fitted to the data.
+view.CameraPosition = [1.0, -1.6, 1.0]
+view.CameraFocalPoint = [0.0, 0.0, 0.0]
+view.CameraViewUp = [0.0, 0.0, 1.0]
+view.ResetCamera()
+Render(view)
+if "--png" in sys.argv:
+    SaveScreenshot(sys.argv[sys.argv.index("--png") + 1], view, ImageResolution=[1280, 720])
+)PY";
+  const fs::path final_path = fs::path(directory) / "open_in_paraview.py", temp_path = final_path.string() + ".tmp";
+  {
+    std::ofstream file(temp_path, std::ios::binary | std::ios::trunc);
+    if (!file) fail(temp_path.string(), "cannot open for writing");
+    file << kScript;
+    file.close();
+    if (!file) fail(temp_path.string(), "write failed (disk full?)");
+  }
+  publish(temp_path, final_path);
+}
+
 void write_mesh_fields(const std::string& directory, const std::vector<MeshFieldSet>& meshes, double time) {
   std::filesystem::create_directories(directory);
   const std::string path = directory + "/walls.h5", temporary = path + ".part";

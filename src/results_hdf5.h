@@ -60,6 +60,12 @@ struct MeshFieldSet {
 /// DIR/walls.xdmf (a spatial collection of triangle grids with cell attributes), both atomically.
 void write_mesh_fields(const std::string& directory, const std::vector<MeshFieldSet>& meshes, double time);
 
+/// Writes DIR/open_in_paraview.py (atomically): a ParaView Python script that opens DIR's
+/// particles.xdmf (spheres scaled by radius, coloured by speed) and walls.xdmf when there is one
+/// (coloured by shear work rate), at the last saved time. In ParaView: View > Python Shell > Run
+/// Script; or `pvpython` / `pvbatch open_in_paraview.py --png FILE` to render an image.
+void write_paraview_script(const std::string& directory);
+
 /// Reads a frame file written by FrameWriter; throws std::runtime_error naming the path.
 StoredFrame read_frame(const std::string& path);
 

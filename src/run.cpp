@@ -326,6 +326,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       if (options.write_files && writer) {
         try {
           write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
         } catch (const std::exception&) {
         }
       }
@@ -395,6 +396,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     if (checkpoint_due && writer) {
       save_checkpoint(checkpoint_path, model, *results);
       write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
     }
     if (stopping) {
       if (writer)
@@ -438,6 +440,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
   if (options.write_files) {
     write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
     write_file_atomically(out + "/run_info.yaml",
                           run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
