@@ -1,4 +1,4 @@
-// The periodic direct shear test (../shared/protocols/CALIBRATION_TESTS.md, `direct_shear`; the
+// The periodic direct shear test (docs/materials-and-calibration.md, `direct_shear`; the
 // source paper's Fig. 9). A cell periodic in x (shear direction) and y between two rough plates:
 // plane walls each carrying one glued layer of d50 spheres of the material (`attach_to`, a
 // hexagonal layer 1.1 d50 apart). The bottom plate is fixed, the top plate is servo-controlled.

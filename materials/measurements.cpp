@@ -1,4 +1,4 @@
-// Reading measurement files (../shared/protocols/CALIBRATION_TESTS.md). Every key goes through
+// Reading measurement files (docs/materials-and-calibration.md). Every key goes through
 // MapReader, so a misspelt key names the nearest valid one; tests and observables are checked
 // against the virtual tests' own tables (test_names, observable_names).
 #include "measurements.h"

@@ -1,7 +1,7 @@
 // The table of virtual tests: name, observables, the function that runs it (one file each, the
 // virtual laboratory: lab_drop_rebound.cpp, lab_bulk_density.cpp, lab_angle_of_repose.cpp,
 // lab_rotating_drum.cpp, lab_hopper_discharge.cpp, lab_direct_shear.cpp). Set-ups and extraction rules:
-// ../shared/protocols/CALIBRATION_TESTS.md.
+// each file's header, summarised in docs/materials-and-calibration.md ("The virtual lab tests").
 #include "virtual_tests.h"
 
 #include <fmt/format.h>

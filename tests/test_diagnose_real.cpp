@@ -181,8 +181,8 @@ TEST(DiagnoseReal, HiddenLiquidBridgesWithVirtualTests) {
   ASSERT_FALSE(d.candidates.empty());
   // Liquid bridges come first, or second as a rival these data cannot rule out: JKR cohesion is
   // cohesion too, and two points of a yield locus with a bulk density do not always tell the two
-  // apart (the diagnosis then says so and names what to measure). Runs: 2026-12-01 at stop 23,
-  // bridges first by 0.9 in BIC over clump shape; at stop 24 (lists following the drift, which
+  // apart (the diagnosis then says so and names what to measure). Runs on 2026-12-01:
+  // bridges first by 0.9 in BIC over clump shape; with the neighbour lists following the drift (which
   // changed the bulk-density pours' last bits), JKR first by 2.5 over the bridges, under the
   // rival margin. Earlier builds: bridges first, JKR second by more than 5.
   const auto bridges = std::find_if(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.name == "liquid_bridge"; });

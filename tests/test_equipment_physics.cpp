@@ -1,4 +1,4 @@
-// Equipment against known answers (../shared/validation section 8 and MV-1, numbers copied here):
+// Equipment against known answers (published values, copied here with their sources):
 // Beverloo silo discharge, screw conveyor throughput, belt discharge trajectory, bucket elevator
 // discharge type.
 #include <gtest/gtest.h>
