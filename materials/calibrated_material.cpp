@@ -3,8 +3,9 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
+
+#include "run.h"
 
 namespace dem::materials {
 
@@ -121,15 +122,8 @@ std::string calibrated_material_text(const CalibrationResult& fit, const Calibra
 
 void write_calibrated_material(const std::string& path, const CalibrationResult& fit, const CalibratedMaterialSource& source) {
   const std::string text = calibrated_material_text(fit, source);
-  const std::filesystem::path target(path), temporary = target.string() + ".tmp";
-  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot write the calibrated material", temporary.string()));
-  }
-  std::filesystem::rename(temporary, target);
+  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  write_file_atomically(path, text);
 }
 
 }  // namespace dem::materials

@@ -146,6 +146,26 @@ void publish(const fs::path& from, const fs::path& to) {
   if (ec) fail(to.string(), fmt::format("renaming {} failed ({})", from.string(), ec.message()));
 }
 
+// Temporary file + fsync + rename: readers see the old file or the new one, never a partial one.
+void write_text_atomically(const std::string& directory, const std::string& name, const std::string& text) {
+  const fs::path final_path = fs::path(directory) / name;
+  const fs::path temp_path = fs::path(directory) / (name + ".tmp");
+  {
+    std::ofstream file(temp_path, std::ios::binary | std::ios::trunc);
+    if (!file) fail(temp_path.string(), "cannot open for writing");
+    file.write(text.data(), static_cast<std::streamsize>(text.size()));
+    file.close();
+    if (!file) {
+      std::error_code ec;
+      fs::remove(temp_path, ec);
+      fail(temp_path.string(), "write failed (disk full?)");
+    }
+  }
+  sync_to_disk(temp_path.string(), false);
+  publish(temp_path, final_path);
+  sync_to_disk(directory.empty() ? "." : directory, true);
+}
+
 std::string frame_file_name(std::int64_t step) { return fmt::format("frame_{:06d}.h5", step); }
 
 // Value of `name="..."` inside the tag that starts at `tag` (up to its closing '>').
@@ -353,24 +373,7 @@ void FrameWriter::write_xdmf(const std::vector<FrameInfo>& frames) const {
          "  </Domain>\n"
          "</Xdmf>\n";
 
-  // Temporary file + fsync + rename: readers see the old index or the new one, never a partial one.
-  const fs::path final_path = fs::path(directory_) / kXdmfName;
-  const fs::path temp_path = fs::path(directory_) / (std::string(kXdmfName) + ".tmp");
-  {
-    std::ofstream file(temp_path, std::ios::binary | std::ios::trunc);
-    if (!file) fail(temp_path.string(), "cannot open for writing");
-    const std::string text = out.str();
-    file.write(text.data(), static_cast<std::streamsize>(text.size()));
-    file.close();
-    if (!file) {
-      std::error_code ec;
-      fs::remove(temp_path, ec);
-      fail(temp_path.string(), "write failed (disk full?)");
-    }
-  }
-  sync_to_disk(temp_path.string(), false);
-  publish(temp_path, final_path);
-  sync_to_disk(directory_.empty() ? "." : directory_, true);
+  write_text_atomically(directory_, kXdmfName, out.str());
 }
 
 void FrameWriter::adopt_existing() {
@@ -518,15 +521,7 @@ Render(view)
 if "--png" in sys.argv:
     SaveScreenshot(sys.argv[sys.argv.index("--png") + 1], view, ImageResolution=[1280, 720])
 )PY";
-  const fs::path final_path = fs::path(directory) / "open_in_paraview.py", temp_path = final_path.string() + ".tmp";
-  {
-    std::ofstream file(temp_path, std::ios::binary | std::ios::trunc);
-    if (!file) fail(temp_path.string(), "cannot open for writing");
-    file << kScript;
-    file.close();
-    if (!file) fail(temp_path.string(), "write failed (disk full?)");
-  }
-  publish(temp_path, final_path);
+  write_text_atomically(directory, "open_in_paraview.py", kScript);
 }
 
 void write_mesh_fields(const std::string& directory, const std::vector<MeshFieldSet>& meshes, double time) {
