@@ -436,6 +436,7 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
   for (const BoxResult& b : boxes) {
     metric("centring_offset_" + b.name + "_pct", b.width > 0 ? 100 * b.offset.at_run.mean / (1000 * b.width) : kNaN);
     metric("vertical_speed_" + b.name + "_m_s", b.vertical);
+    metric("mass_in_" + b.name + "_kg", b.mass.at_run.mean);  // a packing's bulk density times the box's volume
     if (!std::isnan(b.belt_speed) && b.belt_speed != 0) {
       metric("speed_ratio_" + b.name, b.along / b.belt_speed);
       // For ranking: how far the load's speed along the belt is from the belt's (0 is best).

@@ -17,6 +17,7 @@
 #include <regex>
 #include <thread>
 
+#include "bias_check.h"
 #include "mpi_campaign.h"
 #include "report.h"
 #include "spec.h"
@@ -95,7 +96,8 @@ std::string SweepPlan::design_label(size_t k) const {
 SweepPlan read_sweep(const YAML::Node& root, const std::string& file) {
   SweepPlan plan = read_design_sweep(root, file);
   plan.design_paths = plan.paths.size();
-  if (root.IsMap() && root["uncertainty"]) add_uncertainty(plan, root, file);
+  if (root.IsMap() && root["bias_check"]) add_bias_check(plan, root, file);
+  else if (root.IsMap() && root["uncertainty"]) add_uncertainty(plan, root, file);
   return plan;
 }
 
@@ -163,6 +165,7 @@ YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k)
   YAML::Node copy = YAML::Clone(root);
   copy.remove("sweep");
   copy.remove("uncertainty");
+  copy.remove("bias_check");
   for (size_t p = 0; p < plan.paths.size(); ++p) {
     const std::vector<PathStep> steps = split_path(plan.paths[p]);
     // yaml-cpp nodes are handles: walking with operator[] on a non-const node creates missing
@@ -388,6 +391,14 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
                            std::isfinite(b.run_noise) ? fmt::format("  (run noise {:.2g})", b.run_noise) : "");
     for (const Beats& x : summary.beats)
       if (x.probability > 0.5) log << fmt::format("  P({} beats {} on {}) = {:.2f} over {} parameter sets\n", x.a, x.b, x.metric, x.probability, x.pairs);
+  }
+  if (!plan.bias_runs.empty()) {
+    const BiasSummary summary = summarise_bias_check(plan, input.variants, options.out + "/report");
+    input.extra_html = summary.html;
+    input.title = fmt::format("What the scalings cost: {}", fs::path(options.case_path).filename().string());
+    log << "bias check: each KPI as the case runs against the checks\n";
+    for (const KpiShift& s : summary.shifts)
+      log << fmt::format("  {}{}{}\n", s.design.empty() ? "" : s.design + ": ", s.sensitive ? "SENSITIVE: " : "", s.words);
   }
   report::write_sweep_report(input, options.out + "/report");
   const auto ranked = report::rank_variants(input);

@@ -44,6 +44,10 @@ struct SweepPlan {
   int samples = 0;
   size_t design_paths = 0;
   std::vector<std::string> held;  ///< calibrated parameters a case cannot vary, held at their fitted values
+  /// With `bias_check:` (app/bias_check.h): the runs per design variant ("as the case", then the
+  /// checks); variant k is design k / runs at run k % runs. Empty: no bias check.
+  std::vector<std::string> bias_runs;
+  double bias_tolerance_pct = 5;  ///< [%] a KPI that moves by less is not sensitive to the scaling
   /// The design part of variant k's label ("" without a sweep).
   std::string design_label(size_t k) const;
   /// Short name of variant k: "v02".

@@ -144,6 +144,18 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
       if (!particle_material[k]) continue;
       model.materials[k].density *= model.mass_scaling;
       model.materials[k].youngs_modulus *= model.stiffness_scaling;
+      // Parameters fitted at one stiffness need not hold at another: say so when a calibrated
+      // material runs at a stiffness more than 25 % away from the one its calibration used.
+      if (const auto& record = spec.materials[k].calibration) {
+        const double ratio = model.stiffness_scaling / record->stiffness_scaling;
+        if (ratio > 1.25 || ratio < 0.8)
+          model.notes.push_back(fmt::format(
+              "{} was calibrated with its Young's modulus x {:g} ({:.3g} Pa in the virtual tests) and runs here at x {:g} ({:.3g} Pa): "
+              "parameters fitted at one stiffness need not hold at another; calibrate at the case's stiffness, or add `bias_check:` "
+              "to see what the difference moves",
+              spec.materials[k].name, record->stiffness_scaling, spec.materials[k].youngs_modulus * record->stiffness_scaling,
+              model.stiffness_scaling, spec.materials[k].youngs_modulus * model.stiffness_scaling));
+      }
     }
   }
   auto material_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {

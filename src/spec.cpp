@@ -723,6 +723,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   }
   top.node("sweep");  // read by the sweep runner (app/sweep.cpp) before the variants are parsed
   top.node("uncertainty");  // likewise (app/uncertainty.h)
+  top.node("bias_check");   // likewise (app/bias_check.h)
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;
