@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -20,6 +22,7 @@
 #include "material_model.h"
 #include "measurements.h"
 #include "mpi_campaign.h"
+#include "run.h"
 
 namespace dem::app {
 
@@ -89,6 +92,10 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
                          "instead of comparing: simulate this TRUTH material on every experiment of MEASUREMENTS, add Gaussian noise of "
                          "each observation's sigma and write OUT/synthetic_measurements.yaml (synthetic data)");
       (*cmd)->add_option("--noise-seed", noise_seed_, "seed of the added measurement noise (--synthetic-from)");
+      (*cmd)->add_option("--stiffness-check", stiffness_check_,
+                         "compare again with the particles this much stiffer and say for each observable whether the stiffness "
+                         "(--stiffness-scaling) is high enough for it (OUT/stiffness_check.csv)")
+          ->check(CLI::Range(1.01, 1e4));
     }
   }
 }
@@ -154,6 +161,15 @@ int CalibrationCommands::run_measured(const std::string& command) {
     for (const std::string& w : measured.warnings) std::cout << "warning: " << w << std::endl;
   apply_measured(model, measured);
   model.stiffness_scaling = stiffness_scaling_;
+  // Parameters fitted at one stiffness need not hold at another.
+  if (const auto& record = model.particle.calibration; record && mpi::world().rank == 0) {
+    const double ratio = stiffness_scaling_ / record->stiffness_scaling;
+    if (ratio > 1.25 || ratio < 0.8)
+      std::cout << fmt::format("note: {} was calibrated with its Young's modulus x {:g} in the virtual tests; this {} runs them at x {:g}: "
+                               "parameters fitted at one stiffness need not hold at another (--stiffness-scaling {:g} repeats the calibration's)",
+                               material_, record->stiffness_scaling, command, stiffness_scaling_, record->stiffness_scaling)
+                << std::endl;
+  }
   CalibrationOptions options;
   options.replicas = replicas_;
   options.rounds = rounds_;
@@ -212,6 +228,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
       std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured, t.sigma_measured,
                                t.simulated, t.sigma_simulated, t.residual);
     for (const auto& p : comparison.patterns) std::cout << "  " << p.words << "\n";
+    if (stiffness_check_ > 0) stiffness_check(model, measured, options, comparison);
   } else if (command == "calibrate") {
     calibration = calibrate(model, measured, params, options);
     if (world.rank != 0) return 0;
@@ -287,6 +304,36 @@ int CalibrationCommands::run_measured(const std::string& command) {
   const std::string html = report::write_calibration_report(input, out_);
   std::cout << fmt::format("report: {} ({:.0f} s)\n", html, input.wall_seconds);
   return 0;
+}
+
+void CalibrationCommands::stiffness_check(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options,
+                                          const Comparison& as_run) {
+  MaterialModel stiffer = model;
+  stiffer.stiffness_scaling = model.stiffness_scaling * stiffness_check_;
+  std::cout << fmt::format("stiffness check: the comparison again with the particles {:g} x stiffer (Young's modulus x {:g})\n", stiffness_check_,
+                           stiffer.stiffness_scaling)
+            << std::flush;
+  const Comparison checked = compare(stiffer, measured, options);
+  // An observable is sensitive when it moves by more than one measurement sigma and by more than
+  // twice the shift's simulation noise: the fit at this stiffness would then not hold at the other.
+  std::string csv = "observable,simulated,simulated_stiffer,shift,shift_in_measurement_sigma,noise,sensitive\n";
+  int sensitive = 0;
+  std::cout << fmt::format("  {:<28} {:>10} {:>10} {:>9}  verdict\n", "observable", "as run", "stiffer", "shift/sig");
+  for (const Term& t : as_run.terms) {
+    if (t.is_outcome()) continue;
+    const auto other = std::find_if(checked.terms.begin(), checked.terms.end(), [&](const Term& u) { return u.name() == t.name(); });
+    if (other == checked.terms.end()) continue;
+    const double shift = other->simulated - t.simulated, noise = std::hypot(t.sigma_simulated, other->sigma_simulated);
+    const double in_sigma = t.sigma_measured > 0 ? shift / t.sigma_measured : std::numeric_limits<double>::quiet_NaN();
+    const bool moved = std::abs(in_sigma) > 1.0 && std::abs(shift) > 2 * noise;
+    sensitive += moved;
+    std::cout << fmt::format("  {:<28} {:>10.4g} {:>10.4g} {:>+9.2f}  {}\n", t.name(), t.simulated, other->simulated, in_sigma,
+                             moved ? "SENSITIVE: the stiffness moves it by more than its measurement sigma" : "good enough");
+    csv += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{}\n", t.name(), t.simulated, other->simulated, shift, in_sigma, noise, moved ? 1 : 0);
+  }
+  std::cout << fmt::format("  {} of the observables depend on the stiffness{}\n", sensitive,
+                           sensitive ? ": a calibration at this stiffness holds only for cases run at the same stiffness" : "");
+  write_file_atomically((fs::path(out_) / "stiffness_check.csv").string(), csv);
 }
 
 std::vector<std::string> CalibrationCommands::render_tests(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {

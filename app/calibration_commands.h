@@ -42,10 +42,15 @@ class CalibrationCommands {
   std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_, effects_, synthetic_from_;
   std::vector<std::string> set_;
   double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
+  double stiffness_check_ = 0;  ///< compare --stiffness-check: factor of the second comparison (0: none)
   int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
   bool no_store_ = false, no_renders_ = false;
   long long noise_seed_ = 1;
   int write_synthetic();
+  /// compare --stiffness-check: the comparison again with stiffer particles, each observable's
+  /// shift against its measurement sigma (printed, and OUT/stiffness_check.csv).
+  void stiffness_check(const materials::MaterialModel& model, const materials::MeasurementSet& measured,
+                       const materials::CalibrationOptions& options, const materials::Comparison& as_run);
   /// One render of the final state per test type of the measurement file, with `model`.
   std::vector<std::string> render_tests(const materials::MaterialModel& model, const materials::MeasurementSet& measured,
                                         const materials::CalibrationOptions& options);

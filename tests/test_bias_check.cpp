@@ -4,6 +4,7 @@
 // beads, 2 % when ten times stiffer): flagged. A dense silo's discharge rate does not (Beverloo:
 // the flow is set by the orifice, gravity and the bulk density, not by the contact stiffness):
 // not flagged. A calibrated material run at another stiffness than it was calibrated at is named.
+// `compare --stiffness-check` says the same of a calibration's observables.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -142,6 +143,56 @@ particles:
   const std::string other = notes(0.1);
   EXPECT_NE(other.find("beads was calibrated with its Young's modulus x 1"), std::string::npos) << other;
   EXPECT_NE(other.find("bias_check"), std::string::npos) << other;
+}
+
+// compare --stiffness-check: a drop's restitution does not depend on the stiffness (restitution
+// damping gives the asked coefficient at any stiffness: good enough); a poured cup of soft beads
+// packs denser the softer they are, by more than a tight measurement sigma: sensitive.
+TEST(BiasCheck, CompareSaysWhichObservablesTheStiffnessMoves) {
+  fs::create_directories(kScratch);
+  std::ofstream(kScratch / "soft_beads.yaml") << R"(name: soft_beads
+description: soft 5 mm beads
+contact: {normal: hertz, damping: restitution, tangential: mindlin}
+properties: {density: 2500, youngs_modulus: 2.0e5, poisson_ratio: 0.25, restitution: 0.5, friction: 0.5}
+size: 0.005
+walls:
+  steel: {friction: 0.5, restitution: 0.5}
+tunable:
+  friction: [0.2, 0.8]
+)";
+  std::ofstream(kScratch / "measurements.yaml") << R"(material: soft beads
+particles: {diameter: 0.005, density: 2500}
+walls:
+  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800}
+experiments:
+  - {id: drop, test: drop_rebound, setup: {drop_height: 0.05, plate: steel}, observed: {restitution: {value: 0.5, sigma: 0.02}}}
+  - id: cup
+    test: bulk_density
+    setup: {cup_diameter: 0.05, cup_height: 0.05, pour_height: 0.02, base: steel}
+    observed: {bulk_density: {value: 1500, sigma: 3}}
+)";
+  const fs::path out = kScratch / "compare";
+  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' compare '" + (kScratch / "soft_beads.yaml").string() + "' '" +
+                              (kScratch / "measurements.yaml").string() + "' --replicas 2 --stiffness-check 10 --no-renders --quiet --out '" +
+                              out.string() + "' > '" + out.string() + ".log' 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(out.string() + ".log");
+  std::map<std::string, std::pair<double, bool>> rows;  // observable -> (shift in measurement sigma, sensitive)
+  std::istringstream in(read_text(out / "stiffness_check.csv"));
+  std::string line;
+  std::getline(in, line);  // observable,simulated,simulated_stiffer,shift,shift_in_measurement_sigma,noise,sensitive
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    for (std::string c; std::getline(cs, c, ',');) cells.push_back(c);
+    if (cells.size() == 7) rows[cells[0]] = {std::atof(cells[4].c_str()), cells[6] == "1"};
+  }
+  ASSERT_TRUE(rows.count("drop/restitution") && rows.count("cup/bulk_density")) << read_text(out.string() + ".log");
+  EXPECT_FALSE(rows.at("drop/restitution").second) << rows.at("drop/restitution").first << " sigma";
+  EXPECT_LT(std::abs(rows.at("drop/restitution").first), 1.0);
+  EXPECT_TRUE(rows.at("cup/bulk_density").second) << rows.at("cup/bulk_density").first << " sigma\n" << read_text(out.string() + ".log");
+  EXPECT_LT(rows.at("cup/bulk_density").first, -1.0) << "stiffer beads pack less densely";
+  std::cout << "stiffness x 10: drop restitution " << rows.at("drop/restitution").first << " sigma, poured density "
+            << rows.at("cup/bulk_density").first << " sigma\n";
 }
 
 }  // namespace
