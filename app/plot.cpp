@@ -40,6 +40,8 @@ std::string read_all(const fs::path& path) {
   return text.str();
 }
 
+bool has_band(const Series& s) { return !s.lo.empty() && s.lo.size() == s.x.size() && s.hi.size() == s.x.size(); }
+
 /// The script that draws `plot` from `data_name` into `png_name` (both relative to its folder).
 std::string script(const Plot& plot, const std::vector<const Series*>& drawn, const std::string& data_name,
                    const std::string& png_name) {
@@ -63,8 +65,13 @@ std::string script(const Plot& plot, const std::vector<const Series*>& drawn, co
         "set object 1 rect from {}, graph 0 to {}, graph 1 behind fillcolor rgb '{}' fillstyle solid 1.0 noborder\n",
         number(plot.band->first), number(plot.band->second), band_colour);
   std::vector<std::string> items;
+  // Line k in line type k + 1 (gnuplot's own order), its band, when it has one, in the same colour.
   for (std::size_t k = 0; k < drawn.size(); ++k)
-    items.push_back(fmt::format("{} index {} using 1:2 with lines lw 1.5 title {}", gnuplot_string(data_name), k,
+    if (has_band(*drawn[k]))
+      items.push_back(fmt::format("{} index {} using 1:3:4 with filledcurves fillstyle transparent solid 0.25 noborder lt {} title {}",
+                                  gnuplot_string(data_name), k, k + 1, gnuplot_string(drawn[k]->band_label)));
+  for (std::size_t k = 0; k < drawn.size(); ++k)
+    items.push_back(fmt::format("{} index {} using 1:2 with lines lw 1.5 lt {} title {}", gnuplot_string(data_name), k, k + 1,
                                 gnuplot_string(drawn[k]->label)));
   const char* line_colours[] = {"#222222", "#b2182b", "#2166ac", "#762a83"};
   for (std::size_t k = 0; k < plot.lines.size(); ++k)
@@ -140,7 +147,8 @@ bool draw_plot(const Plot& plot, const std::string& png_path, std::string* messa
       if (s.x.empty() || s.x.size() != s.y.size()) continue;
       if (!drawn.empty()) table += "\n\n";
       table += fmt::format("# {}\n", one_line(s.label));
-      for (std::size_t i = 0; i < s.x.size(); ++i) table += number(s.x[i]) + "\t" + number(s.y[i]) + "\n";
+      for (std::size_t i = 0; i < s.x.size(); ++i)
+        table += number(s.x[i]) + "\t" + number(s.y[i]) + (has_band(s) ? "\t" + number(s.lo[i]) + "\t" + number(s.hi[i]) : std::string()) + "\n";
       drawn.push_back(&s);
     }
     if (drawn.empty()) return fail("no data to plot");

@@ -13,10 +13,14 @@
 
 namespace dem::plot {
 
-/// One line of a plot; x and y have the same length (NaN leaves a gap).
+/// One line of a plot; x and y have the same length (NaN leaves a gap). With `lo` and `hi` of the
+/// same length too, the interval between them is shaded in the line's colour (a band, e.g. 5 % to
+/// 95 % over samples) and named `band_label` in the key.
 struct Series {
   std::string label;
   std::vector<double> x, y;
+  std::vector<double> lo = {}, hi = {};
+  std::string band_label = {};
 };
 
 /// A horizontal reference line (a mean, a design value), drawn dashed with its label in the key.

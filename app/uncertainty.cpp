@@ -7,10 +7,13 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "calibration_record.h"
 #include "html.h"
+#include "plot.h"
 #include "run.h"
 #include "spec.h"
 #include "yaml_check.h"
@@ -27,6 +30,105 @@ double quantile(const std::vector<double>& sorted, double q) {
   const double at = q * static_cast<double>(sorted.size() - 1);
   const size_t lo = static_cast<size_t>(std::floor(at)), hi = std::min(lo + 1, sorted.size() - 1);
   return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+}
+
+/// One series of a run report's plot data (plots/NAME.tsv): its label and points.
+struct Block {
+  std::string label;
+  std::vector<double> t, y;
+};
+
+/// The blocks of a plot's TSV ("# label", then "t<TAB>y" rows; blocks apart by blank lines).
+std::vector<Block> read_blocks(const std::filesystem::path& path) {
+  std::vector<Block> blocks;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("# ", 0) == 0) {
+      blocks.push_back({line.substr(2), {}, {}});
+      continue;
+    }
+    if (line.empty() || blocks.empty()) continue;
+    std::istringstream row(line);
+    double t = kNaN, y = kNaN;
+    row >> t >> y;
+    if (row) blocks.back().t.push_back(t), blocks.back().y.push_back(y);
+  }
+  return blocks;
+}
+
+/// y(t) of a block by linear interpolation (held constant beyond its ends).
+double at_time(const Block& b, double t) {
+  if (b.t.empty()) return kNaN;
+  if (t <= b.t.front()) return b.y.front();
+  if (t >= b.t.back()) return b.y.back();
+  const size_t hi = static_cast<size_t>(std::upper_bound(b.t.begin(), b.t.end(), t) - b.t.begin());
+  const double w = (t - b.t[hi - 1]) / (b.t[hi] - b.t[hi - 1]);
+  return b.y[hi - 1] + w * (b.y[hi] - b.y[hi - 1]);
+}
+
+/// The time series of the run reports as bands over the parameter sets: for each plot of the
+/// KPIs over time that the runs drew, per design and series, the median line and the 5-95 %
+/// band. Returns the HTML figures (drawn into dir/plots).
+std::string time_bands(const SweepPlan& plan, const std::vector<report::SweepVariant>& variants, size_t designs, size_t samples,
+                       const std::string& dir) {
+  namespace fs = std::filesystem;
+  const fs::path runs = fs::path(dir).parent_path() / "variants";
+  struct Kind {
+    const char* name;
+    const char* title;
+    const char* y_label;
+  };
+  const Kind kinds[] = {{"outlet_flow", "Mass flow at the outlets", "mass flow [t/h]"},
+                        {"sensor_flow", "Mass flow through the plane sensors", "mass flow [t/h]"},
+                        {"mesh_power", "Power per mesh", "power [W]"},
+                        {"mesh_torque", "Torque per mesh", "torque [N m]"}};
+  std::string h;
+  for (const Kind& kind : kinds) {
+    plot::Plot p;
+    p.title = fmt::format("{}: median and 90 % band over the parameter sets", kind.title);
+    p.x_label = "time [s]";
+    p.y_label = kind.y_label;
+    for (size_t d = 0; d < designs && p.series.size() < 8; ++d) {
+      std::vector<std::vector<Block>> per_sample;
+      for (size_t s = 0; s < samples; ++s) {
+        const size_t k = d * samples + s;
+        if (!variants[k].ok) continue;
+        std::vector<Block> blocks = read_blocks(runs / plan.name(k) / "report" / "plots" / (std::string(kind.name) + ".tsv"));
+        if (!blocks.empty()) per_sample.push_back(std::move(blocks));
+      }
+      if (per_sample.size() < 2) continue;
+      for (const Block& first : per_sample.front()) {
+        plot::Series line;
+        const std::string design = plan.design_label(d * samples);
+        line.label = design.empty() ? first.label : design + ": " + first.label;
+        line.band_label = "5-95 %";
+        for (double t : first.t) {
+          std::vector<double> values;
+          for (const auto& blocks : per_sample)
+            for (const Block& b : blocks)
+              if (b.label == first.label) {
+                const double y = at_time(b, t);
+                if (std::isfinite(y)) values.push_back(y);
+              }
+          std::sort(values.begin(), values.end());
+          line.x.push_back(t);
+          line.y.push_back(quantile(values, 0.5));
+          line.lo.push_back(quantile(values, 0.05));
+          line.hi.push_back(quantile(values, 0.95));
+        }
+        if (p.series.size() < 8) p.series.push_back(std::move(line));
+      }
+    }
+    if (p.series.empty()) continue;
+    const std::string png = (fs::path(dir) / "plots" / (std::string("band_") + kind.name + ".png")).string();
+    std::string message;
+    const bool ok = plot::draw_plot(p, png, &message);
+    h += fmt::format("<figure>{}<figcaption>{} over time: the median over the parameter sets (line) and the band from 5 % to 95 % "
+                     "(shaded), per design; data in plots/band_{}.tsv.</figcaption></figure>\n",
+                     ok ? html::embed_image(png, p.title) : fmt::format("<p class=\"missing\">not drawn: {}</p>", html::esc(message)),
+                     kind.title, kind.name);
+  }
+  return h;
 }
 
 }  // namespace
@@ -184,6 +286,8 @@ UncertaintySummary summarise_uncertainty(const SweepPlan& plan, const std::vecto
       h += "</table>\n";
     }
   }
+  if (const std::string over_time = time_bands(plan, variants, designs, samples, dir); !over_time.empty())
+    h += "<h3>KPIs over time</h3>\n" + over_time;
   h += "<p class=\"note\">Also in uncertainty.csv" + std::string(out.beats.empty() ? "" : " and beats.csv") + ".</p>\n";
   return out;
 }

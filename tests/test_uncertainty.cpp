@@ -134,8 +134,12 @@ TEST(Uncertainty, BandsAndPairedProbabilities) {
   EXPECT_DOUBLE_EQ(flow0.run_noise, 0.1);
   EXPECT_EQ(flow0.samples, 8);
   for (const app::Beats& b : u.beats) {
-    if (b.metric == "throughput_t_h") EXPECT_DOUBLE_EQ(b.probability, b.a == "particles[0].positions[0][2]=0.02" ? 1.0 : 0.0);
-    if (b.metric == "spillage_pct") EXPECT_DOUBLE_EQ(b.probability, 0.5);
+    if (b.metric == "throughput_t_h") {
+      EXPECT_DOUBLE_EQ(b.probability, b.a == "particles[0].positions[0][2]=0.02" ? 1.0 : 0.0);
+    }
+    if (b.metric == "spillage_pct") {
+      EXPECT_DOUBLE_EQ(b.probability, 0.5);
+    }
     EXPECT_EQ(b.pairs, 8);
   }
   EXPECT_EQ(u.beats.size(), 4u);

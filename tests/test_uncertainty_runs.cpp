@@ -4,7 +4,7 @@
 // values (the same runs, whichever way they are asked for); the wider orifice (40 against 30 mm:
 // Beverloo's (D0 - 1.5 d)^2.5 gives 2.3 times the flow) beats the narrower at every parameter set,
 // while two orifices 0.2 mm apart (Beverloo: 2 % more flow, inside the run-to-run scatter) are not
-// told apart with certainty.
+// told apart with certainty. The flow over time is drawn as a band per design.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -168,6 +168,11 @@ uncertainty: {samples: 6, seed: 2}
   EXPECT_GT(near, 0.0) << "0.2 mm apart: not certain";
   EXPECT_LT(near, 1.0) << "0.2 mm apart: not certain";
   EXPECT_NE(read_text(kScratch / "uncertain" / "report" / "sweep.html").find("Which design wins"), std::string::npos);
+  // The flow over time as a band per design: the median line and the 5-95 % band of each design.
+  const std::string bands = read_text(kScratch / "uncertain" / "report" / "plots" / "band_outlet_flow.tsv");
+  EXPECT_NE(bands.find("# silo.orifice_diameter=0.04: outlet discharge"), std::string::npos) << bands.substr(0, 300);
+  EXPECT_TRUE(fs::exists(kScratch / "uncertain" / "report" / "plots" / "band_outlet_flow.png"));
+  EXPECT_NE(read_text(kScratch / "uncertain" / "report" / "sweep.html").find("KPIs over time"), std::string::npos);
   std::cout << "flow of the 30 mm orifice: median " << b[0] << " t/h, 90 % band [" << b[1] << ", " << b[2] << "] (direct sweep: "
             << quantile(direct, 0.5) << " [" << quantile(direct, 0.05) << ", " << quantile(direct, 0.95) << "]); P(40 mm beats 30 mm) = "
             << wide << ", P(30.2 mm beats 30 mm) = " << near << "\n";
