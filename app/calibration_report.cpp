@@ -21,6 +21,7 @@ using html::esc;
 using html::num;
 using html::row;
 using materials::Comparison;
+using materials::ExperimentRun;
 using materials::Term;
 
 std::string figure_html(bool ok, const std::string& png, const std::string& title, const std::string& message, const std::string& caption) {
@@ -50,6 +51,27 @@ std::string comparison_section(const Comparison& c, const std::string& heading, 
   h += "</table>\n<p class=\"note\">residual = (simulated &minus; measured) / sqrt(&sigma;<sub>meas</sub>&sup2; + &sigma;<sub>sim</sub>&sup2;); "
        "&sigma;<sub>sim</sub> is the standard error of the mean over the replicas (different packings). A mismatched outcome counts 3 &sigma;.</p>\n";
   for (const std::string& n : c.notes) h += "<p class=\"note\">" + esc(n) + "</p>\n";
+  // Per experiment: what drives its misfit, and how its simulations ran (the protocol quantities
+  // each virtual test reports: how far a drum's wall layer is carried, how much of a silo
+  // discharged when, a shear sample's height and mass scaling, ...). A misfit that comes with an
+  // unusual protocol quantity may be a difference of apparatus rather than missing physics.
+  if (!c.runs.empty()) {
+    h += "<h3>Each experiment: what drives its misfit, and how it ran</h3>\n<table>" +
+         row({"experiment", "largest residual", "outcomes in the replicas", "replicas", "particles", "how the simulations ran"}, true);
+    for (const ExperimentRun& r : c.runs) {
+      const Term* worst = nullptr;
+      for (const Term& t : c.terms)
+        if (t.experiment == r.id && (!worst || std::abs(t.residual) > std::abs(worst->residual))) worst = &t;
+      std::string outcomes;
+      for (const auto& [flag, share] : r.flag_fraction)
+        if (share > 0) outcomes += (outcomes.empty() ? "" : ", ") + fmt::format("{} in {:.0f} %", flag, 100 * share);
+      std::string notes;
+      for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "<br>") + esc(n);
+      h += row({esc(r.id), worst ? fmt::format("{} {:+.2f} &sigma;", esc(worst->observable), worst->residual) : "",
+                outcomes.empty() ? "none" : esc(outcomes), std::to_string(r.replicas), std::to_string(r.particles), notes});
+    }
+    h += "</table>\n";
+  }
   // Residual per term.
   plot::ErrorBarPlot rp;
   rp.title = heading + ": normalised residuals";

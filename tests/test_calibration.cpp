@@ -486,6 +486,13 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   EXPECT_NE(text.find("Most likely missing: epsd"), std::string::npos);
   EXPECT_NE(text.find("Error ledger"), std::string::npos);
   EXPECT_EQ(text.find("http"), std::string::npos);
+  // Per experiment, the observable that drives its misfit.
+  EXPECT_NE(text.find("what drives its misfit"), std::string::npos);
+  const materials::Term* worst = nullptr;
+  for (const materials::Term& t : d.base.before.terms)
+    if (t.experiment == d.base.before.runs.front().id && (!worst || std::abs(t.residual) > std::abs(worst->residual))) worst = &t;
+  ASSERT_NE(worst, nullptr);
+  EXPECT_NE(text.find(fmt::format("<td>{}</td><td>{} {:+.2f} &sigma;</td>", worst->experiment, worst->observable, worst->residual)), std::string::npos);
   if (std::filesystem::exists(dir + "/plots/base_contour0.png")) {
     EXPECT_NE(text.find("data:image/png;base64"), std::string::npos);
   }
