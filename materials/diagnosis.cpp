@@ -348,13 +348,16 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
     void (*apply)(CalibrationOptions&);
     bool diagnosis_only;
   };
+  // What goes first costs the least insight. The wall parameters' screen goes late: a wall pair
+  // the starting material only guessed (a steel restitution) misfits like missing physics, and
+  // without the screen a diagnosis would offer an effect to absorb it.
   const Step ladder[] = {
       {"one surrogate round instead of two (no zoom on the optimum)", [](CalibrationOptions& o) { o.rounds = 1; }, false},
       {"design factor 1 instead of 2 (fewer design points)", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 1.0); }, false},
-      {"wall parameters not screened", [](CalibrationOptions& o) { o.wall_candidates = false; }, true},
       {"signatures with one packing", [](CalibrationOptions& o) { o.signature_replicas = 1; }, true},
       {"design factor 0.5", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 0.5); }, false},
       {"two packings per comparison instead of three", [](CalibrationOptions& o) { o.replicas = std::min(o.replicas, 2); }, false},
+      {"wall parameters not screened", [](CalibrationOptions& o) { o.wall_candidates = false; }, true},
       {"one candidate confirmed instead of two", [](CalibrationOptions& o) { o.confirm_candidates = std::min(o.confirm_candidates, 1); }, true},
   };
   plan.seconds = seconds(plan.options);

@@ -640,6 +640,12 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   ASSERT_FALSE(tight.given_up.empty());
   EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
   EXPECT_EQ(tight.options.rounds, 1);
+  // The wall parameters' screen goes only after the design points and the packings (a guessed
+  // wall pair misfits like missing physics): 51 passes fit 1800 s with the walls still screened.
+  EXPECT_TRUE(tight.options.wall_candidates);
+  EXPECT_EQ(tight.options.replicas, 2);
+  EXPECT_EQ(tight.options.design_factor, 0.5);
+  EXPECT_NEAR(tight.seconds, 51 * 35.0, 1e-9);
   options.budget_seconds = 60;
   const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
   EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
