@@ -36,6 +36,7 @@
 #include "sweep.h"
 #include "triangle_mesh.h"
 #include "video.h"
+#include "validation_report.h"
 
 namespace {
 
@@ -347,6 +348,12 @@ int main(int argc, char** argv) {
   keys_cmd->add_flag("--markdown", keys_markdown, "Markdown tables, as in docs/case-keys.md");
   keys_cmd->add_option("--source", keys_source, "source tree whose shipped files are read (default: the one built from)");
 
+  std::string validate_out = "out/validation", validate_source = dem::app::default_source_dir();
+  CLI::App* validate_cmd = app.add_subcommand("validate", "run the published benchmarks (Chung & Ooi 2011 tests 1-8) and write a "
+                                                          "validation page with tables and plots");
+  validate_cmd->add_option("--out", validate_out, "output folder (validation.html, validation.md, validation.csv, plots/)");
+  validate_cmd->add_option("--source", validate_source, "source tree whose cases/ are run (default: the one built from)");
+
   // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
   dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
     dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
@@ -372,6 +379,7 @@ int main(int argc, char** argv) {
       std::cout << dem::app::case_key_reference(keys_source, keys_markdown);
       return 0;
     }
+    if (validate_cmd->parsed()) return dem::app::validate_command(validate_source, validate_out, std::cout);
     if (check_cmd->parsed()) {
       const dem::Model model = compile_case(read_case(check_path));
       const dem::State state = dem::initial_state(model);

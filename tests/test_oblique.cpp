@@ -8,34 +8,23 @@
 #include <string>
 
 #include "sim.h"
+#include "validation.h"
 
 namespace dem::test {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-struct Rebound {
-  double vx, vz, wy;  // after the contact
-};
+using validation::CurvePoint;
+using validation::Rebound;
+using validation::Test5Result;
 
-/// Runs a one-sphere impact on the plane z = 0 until the sphere has left it.
-Rebound bounce(Sim& sim, double max_time) {
-  bool touched = false;
-  while (sim.state.time < max_time) {
-    sim.advance();
-    const bool touching = sim.state.radius[0] - sim.state.z[0] > 0;
-    touched |= touching;
-    if (touched && !touching) break;
-  }
-  return {sim.state.vx[0], sim.state.vz[0], sim.state.wy[0]};
-}
+const std::string kCases = std::string(DEMDESIGN_SOURCE_DIR) + "/cases";
 
-Rebound oblique_impact(double angle_deg) {
-  CaseSpec spec = load_case("co4_oblique_impact.yaml");
-  spec.particles[0].velocity = Vec3(3.9 * std::sin(angle_deg * kDeg), 0, -3.9 * std::cos(angle_deg * kDeg));
-  Sim sim(spec);
-  return bounce(sim, 1e-4);
-}
+Rebound oblique_impact(double angle_deg) { return validation::test4_impact(kCases, angle_deg); }
+double test6_beta(double chi, const std::string& coulomb_cap, bool nylon = false) { return validation::test6_beta(kCases, chi, coulomb_cap, nylon); }
+Test5Result test5(double psi1) { return validation::test5(kCases, psi1); }
+double test8_beta(double chi) { return validation::test8_beta(kCases, chi); }
 
 TEST(ChungOoi, Test4SlidingRegimeMatchesRigidBodyResult) {
   // CO-4, gross sliding (theta >= 32.5 deg), exact: Vt' = Vt - mu (1+e) Vn,
@@ -84,8 +73,7 @@ TEST(ChungOoi, Test6SpinningSphereOnPlaneSlidingRegime) {
     CaseSpec spec = load_case("co6_spin_impact.yaml");
     spec.contact.damping.options["end_of_contact"] = "clip";
     spec.particles[0].angular_velocity = Vec3(0, -vtc / R, 0);  // contact point moves at +vtc in x
-    Sim sim(spec);
-    const Rebound r = bounce(sim, 5e-3);
+    const Rebound r = validation::bounce(spec, 5e-3);
     const double e = r.vz / vn;
     const double vtc_after = r.vx - R * r.wy;
     const double chi = 3.5 * mu * (1 + e) * vn / vtc;
@@ -106,10 +94,6 @@ TEST(ChungOoi, Test6SpinningSphereOnPlaneSlidingRegime) {
 // 0.01 more for the digitisation), and the curve's error as Kratos measures it,
 // sum |beta - beta_paper| / sum |beta_paper|, at most 10 % (Kratos' bound for test 4's curves).
 
-struct CurvePoint {
-  double x, y;
-};
-
 /// Checks the model's values against a published curve with the tolerances above.
 template <typename Model>
 void expect_curve(std::span<const CurvePoint> paper, Model model, double point_tolerance = 0.04) {
@@ -123,45 +107,16 @@ void expect_curve(std::span<const CurvePoint> paper, Model model, double point_t
   EXPECT_LE(error / size, 0.10);
 }
 
-// Test 6, beta against chi: aluminium alloy and nylon spheres.
-constexpr CurvePoint kTest6Aluminium[] = {
-    {0.1762, -0.8200}, {0.3524, -0.6335}, {0.5507, -0.4447}, {0.7709, -0.2428}, {0.9692, -0.0277},
-    {1.1894, 0.0974},  {1.4537, 0.1193},  {1.7401, 0.0996},  {2.0925, 0.0579},  {2.4890, 0.0052},
-    {2.9956, -0.0497}, {3.6344, -0.1001}, {4.5154, -0.1396}, {5.7489, -0.1748}};
-/// The aluminium curve's last three points, which the spring cap does not follow.
-constexpr CurvePoint kTest6AluminiumTail[] = {{7.8194, -0.2077}, {11.8943, -0.2582}, {24.0088, -0.3416}};
-constexpr CurvePoint kTest6Nylon[] = {
-    {0.1762, -0.8244}, {0.3744, -0.6379}, {0.5727, -0.4425}, {0.7489, -0.2428}, {0.9692, -0.0255}, {1.1894, 0.0930},
-    {1.4537, 0.1193},  {1.7401, 0.1171},  {2.0925, 0.0952},  {2.5110, 0.0557},  {2.9956, 0.0074},  {3.6123, -0.0562},
-    {4.5154, -0.1199}, {5.7709, -0.1594}, {7.8194, -0.1177}, {11.9163, -0.1133}, {24.0088, -0.1155}};
-
-/// beta = -Vtc'/Vtc of test 6 (sphere on a plane, Vn = 0.2 m/s) at chi = 3.5 mu (1+e) Vn/Vtc with
-/// the nominal e = 0.5, as the paper and Kratos define it.
-double test6_beta(double chi, const std::string& coulomb_cap, bool nylon = false) {
-  const double mu = 0.4, e = 0.5, vn = 0.2, R = 0.1;
-  const double vtc = 3.5 * mu * (1 + e) * vn / chi;
-  CaseSpec spec = load_case("co6_spin_impact.yaml");
-  spec.contact.tangential.options["coulomb_cap"] = coulomb_cap;
-  if (nylon) {  // the paper's nylon: E 2.5 GPa, nu 0.40, 1000 kg/m^3 (validation CO-6)
-    spec.materials[0].youngs_modulus = 2.5e9;
-    spec.materials[0].poisson_ratio = 0.40;
-    spec.materials[0].density = 1000;
-  }
-  spec.particles[0].angular_velocity = Vec3(0, -vtc / R, 0);  // contact point moves at +vtc in x
-  Sim sim(spec);
-  const Rebound r = bounce(sim, 5e-3);
-  return -(r.vx - R * r.wy) / vtc;
-}
-
+// Test 6, beta against chi: aluminium alloy and nylon spheres (app/validation.cpp holds the curves).
 TEST(ChungOoi, Test6SpringCapReproducesThePublishedCurveOfAluminium) {
   // coulomb_cap: spring, sliding and sticking regimes up to chi = 5.75 (largest deviation 0.034,
   // at chi 2.5-3.0).
-  expect_curve(kTest6Aluminium, [](double chi) { return test6_beta(chi, "spring"); });
+  expect_curve(validation::kTest6Aluminium, [](double chi) { return test6_beta(chi, "spring"); });
   // Beyond chi = 6.2 the contact no longer slides at the end of the impact and beta levels off at
   // -0.11, where the aluminium curve keeps falling; the nylon curve of the same figure and the
   // paper's test 8 case B level off at -0.11 as the model does (below). Checked here as a known
   // difference, so that a change of the model there is seen.
-  for (const CurvePoint& p : kTest6AluminiumTail) {
+  for (const CurvePoint& p : validation::kTest6AluminiumTail) {
     const double beta = test6_beta(p.x, "spring");
     EXPECT_NEAR(beta, -0.112, 0.005) << "chi " << p.x;
     EXPECT_GT(beta - p.y, 0.09) << "chi " << p.x;
@@ -171,7 +126,7 @@ TEST(ChungOoi, Test6SpringCapReproducesThePublishedCurveOfAluminium) {
 TEST(ChungOoi, Test6SpringCapReproducesThePublishedCurveOfNylon) {
   // The whole curve, chi 0.18 ... 24, with its jump between chi 5.8 and 7.8 (largest deviation
   // 0.013, on a sliding point).
-  expect_curve(kTest6Nylon, [](double chi) { return test6_beta(chi, "spring", true); }, 0.03);
+  expect_curve(validation::kTest6Nylon, [](double chi) { return test6_beta(chi, "spring", true); }, 0.03);
 }
 
 TEST(ChungOoi, Test6TotalCapKeepsItsNumbers) {
@@ -191,32 +146,15 @@ TEST(ChungOoi, Test6TotalCapKeepsItsNumbers) {
 
 // Test 5, steel: psi1 = Vt/(mu Vn) against psi2 = V'ct/(mu V'n) (contact point) and against
 // R w'/(mu Vn). Points at which the paper's contact slides throughout.
-constexpr CurvePoint kTest5SteelPsi2Sliding[] = {{9.9879, 3.0133}, {12.9607, 6.0133}};
-constexpr CurvePoint kTest5SteelSpinSliding[] = {{6.0058, -5.0062}, {10.0116, -5.0041}, {20.0000, -4.9905}};
-
-struct Test5Result {
-  double psi2, spin;  // V'ct/(mu V'n), R w'/(mu Vn)
-};
-
-Test5Result test5(double psi1) {
-  const double mu = 0.3, vn = 5.0, R = 1e-5;
-  CaseSpec spec = load_case("co5_oblique_constant_vn.yaml");
-  spec.particles[0].velocity = Vec3(psi1 * mu * vn, 0, -vn);
-  Sim sim(spec);
-  const Rebound r = bounce(sim, 2e-7);
-  // The paper's w' turns the contact point against the slip: w_paper = -wy (see test 4).
-  return {(r.vx - R * r.wy) / (mu * r.vz), -R * r.wy / (mu * vn)};
-}
-
 TEST(ChungOoi, Test5SteelSphereSlidingRegimeMatchesThePaper) {
   // Where the contact slides throughout: R w'/(mu Vn) = -2.5 (1+e) = -5 and psi2 = psi1 - 7
   // (e = 1), and the paper's points; 2 % as Kratos checks test 5 (sliding points only).
-  for (const CurvePoint& p : kTest5SteelSpinSliding) {
+  for (const CurvePoint& p : validation::kTest5SteelSpinSliding) {
     const Test5Result r = test5(p.x);
     EXPECT_NEAR(r.spin, -5.0, 0.02 * 5.0) << "psi1 " << p.x;
     EXPECT_NEAR(r.spin, p.y, 0.02 * 5.0) << "psi1 " << p.x;
   }
-  for (const CurvePoint& p : kTest5SteelPsi2Sliding) {
+  for (const CurvePoint& p : validation::kTest5SteelPsi2Sliding) {
     const Test5Result r = test5(p.x);
     EXPECT_NEAR(r.psi2, p.x - 7.0, 0.02 * std::abs(p.x - 7.0)) << "psi1 " << p.x;
     EXPECT_NEAR(r.psi2, p.y, 0.02 * std::abs(p.y)) << "psi1 " << p.x;
@@ -245,38 +183,11 @@ TEST(ChungOoi, Test5SteelSphereStickingRegimeIsTheNoSlipSpring) {
 
 // Test 8, beta against chi for the sphere on a larger sphere; cases A and B of the figure agree
 // up to chi = 5.77 and part beyond it (A: -0.204, -0.248, -0.318; B: -0.106, -0.108, -0.106).
-constexpr CurvePoint kTest8CaseB[] = {
-    {0.1872, -0.8152}, {0.3583, -0.6262}, {0.5508, -0.4394}, {0.7647, -0.2378}, {0.9786, -0.0173},
-    {1.2139, 0.0961},  {1.4920, 0.1108},  {1.7701, 0.0898},  {2.0909, 0.0583},  {2.5187, 0.0058},
-    {2.9893, -0.0488}, {3.6310, -0.1034}, {4.5080, -0.1391}, {5.7701, -0.1622}, {7.8449, -0.1055},
-    {11.9091, -0.1076}, {23.9947, -0.1055}};
-
-double test8_beta(double chi) {
-  const double mu = 0.4, e = 0.5, vn = 0.2, R = 0.1, R_large = 0.5;
-  const double vtc = 3.5 * mu * (1 + e) * vn / chi;
-  CaseSpec spec = load_case("co8_sphere_on_large_sphere.yaml");
-  spec.particles[0].angular_velocity = Vec3(0, -vtc / R, 0);  // contact point moves at +vtc in z
-  Sim sim(spec);
-  const size_t small = sim.slot(0), large = sim.slot(1);
-  bool touched = false;
-  while (sim.state.time < 5e-3) {
-    sim.advance();
-    const bool touching = overlap_of(sim.state, small, large) > 0;
-    touched |= touching;
-    if (touched && !touching) break;
-  }
-  EXPECT_TRUE(touched);
-  const State& s = sim.state;
-  // Contact-point velocity of the small sphere relative to the large one, along z.
-  const double vtc_after = (s.vz[small] - R * s.wy[small]) - (s.vz[large] + R_large * s.wy[large]);
-  return -vtc_after / vtc;
-}
-
 TEST(ChungOoi, Test8SphereOnLargerSphereMatchesThePublishedCurve) {
   // coulomb_cap: spring (the case's), against case B, which the model follows over the whole
   // range (largest deviation 0.033 at chi 2.99; case A falls beyond chi 6 as test 6's aluminium
   // curve does).
-  expect_curve(kTest8CaseB, test8_beta);
+  expect_curve(validation::kTest8CaseB, test8_beta);
 }
 
 TEST(ChungOoi, Test7SpinningPairWithoutSlipKeepsItsSpin) {

@@ -1,0 +1,40 @@
+// `demdesign validate`, the real binary: the validation page with its table, data and plots.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(ValidateCommand, WritesTheValidationPageWithEveryCurve) {
+  const fs::path out = fs::temp_directory_path() / "demdesign_validate_test";
+  fs::remove_all(out);
+  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' validate --source '" + DEMDESIGN_SOURCE_DIR + "' --out '" + out.string() +
+                              "' > '" + out.string() + ".log' 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(out.string() + ".log");
+  const std::string md = read_text(out / "validation.md");
+  EXPECT_NE(md.find("85 points inside their tolerance, 0 outside, 3 known differences"), std::string::npos) << md.substr(0, 400);
+  EXPECT_NE(md.find("## CO6 aluminium: beta"), std::string::npos);
+  EXPECT_NE(md.find("![CO8 sphere on sphere: beta](plots/co8_sphere_on_sphere_beta.png)"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "plots" / "co6_nylon_beta.png"));
+  // 88 points and a header.
+  std::istringstream csv(read_text(out / "validation.csv"));
+  int lines = 0;
+  for (std::string line; std::getline(csv, line);) ++lines;
+  EXPECT_EQ(lines, 89);
+  EXPECT_NE(read_text(out / "validation.html").find("data:image/png;base64"), std::string::npos);
+}
+
+}  // namespace
