@@ -1,6 +1,6 @@
 // Kinematics of moving walls: a rigid motion of a mesh (or a group of meshes) as a function of
 // time, composed from simple parts (translation, rotation about an axis, sinusoidal oscillation,
-// a CSV table of positions or speeds) and read from the case YAML.
+// a CSV table of positions or speeds) and read from the case YAML (read_motion, spec.h).
 //
 // The motion is prescribed, not integrated: pose(t) is evaluated in closed form at any t, so a
 // restart from a checkpoint places the walls exactly where an uninterrupted run would, and
@@ -53,11 +53,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-// Forward declaration: spec.h includes this header, so it stays free of yaml-cpp's headers.
-namespace YAML {
-class Node;
-}
 
 namespace dem {
 
@@ -141,11 +136,5 @@ struct Motion {
   /// a path-length bound was rejected because it grows without end for a wall that oscillates.
   double max_displacement(double t0, double t1, double radius) const;
 };
-
-/// Reads a `motion:` value: a single part map or a list of part maps (null: no motion).
-/// `file` and `key_path` ("meshes.drum.motion") name the value in errors; `base_dir` resolves
-/// relative CSV paths (the case file's folder). Throws CaseError naming file, line and key.
-Motion read_motion(const YAML::Node& node, const std::string& file, const std::string& key_path,
-                   const std::string& base_dir);
 
 }  // namespace dem

@@ -309,6 +309,11 @@ CaseSpec parse_case_node(const YAML::Node& root, const std::string& file);
 /// sets and measurement files, `size:` of a material file.
 class MapReader;
 SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string& file, const std::string& key = "diameter");
+/// Reads a `motion:` value (kinematics.h): a single part map or a list of part maps (null: no
+/// motion). `file` and `key_path` ("meshes.drum.motion") name the value in errors; `base_dir`
+/// resolves relative CSV paths (the case file's folder). Throws CaseError naming file, line and key.
+Motion read_motion(const YAML::Node& node, const std::string& file, const std::string& key_path,
+                   const std::string& base_dir);
 /// Same for YAML text (tests keep their model inline); `name` stands in for the file name.
 CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>");
 
