@@ -20,9 +20,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "output/run.h"
 #include "plot.h"
-#include "run.h"
-#include "steady_state.h"
+#include "statistics/steady_state.h"
 
 namespace dem::report {
 namespace {

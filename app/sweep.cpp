@@ -17,11 +17,11 @@
 #include <regex>
 #include <thread>
 
+#include "case/spec.h"
+#include "case/yaml_check.h"
 #include "mpi_campaign.h"
 #include "report.h"
-#include "spec.h"
 #include "uncertainty.h"
-#include "yaml_check.h"
 
 namespace dem::app {
 

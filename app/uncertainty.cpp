@@ -9,11 +9,11 @@
 #include <map>
 #include <set>
 
-#include "calibration_record.h"
+#include "case/calibration_record.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
 #include "html.h"
-#include "run.h"
-#include "spec.h"
-#include "yaml_check.h"
+#include "output/run.h"
 
 namespace dem::app {
 

@@ -13,9 +13,9 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "effect.h"
+#include "case/yaml_check.h"
+#include "contact/effect.h"
 #include "library.h"
-#include "yaml_check.h"
 
 namespace dem::materials {
 
