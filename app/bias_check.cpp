@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <limits>
 
+#include "case/spec.h"
+#include "case/yaml_check.h"
 #include "html.h"
-#include "run.h"
-#include "spec.h"
-#include "yaml_check.h"
+#include "output/run.h"
 
 namespace dem::app {
 

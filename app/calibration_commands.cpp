@@ -22,7 +22,7 @@
 #include "material_model.h"
 #include "measurements.h"
 #include "mpi_campaign.h"
-#include "run.h"
+#include "output/run.h"
 
 namespace dem::app {
 

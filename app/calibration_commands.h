@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "calibration.h"
-#include "model.h"
-#include "state.h"
+#include "core/model.h"
+#include "core/state.h"
 
 namespace dem::app {
 

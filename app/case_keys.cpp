@@ -12,14 +12,14 @@
 #include <memory>
 #include <set>
 
-#include "effect.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
+#include "contact/effect.h"
 #include "equipment.h"
 #include "library.h"
 #include "material_model.h"
 #include "measurements.h"
-#include "spec.h"
 #include "sweep.h"
-#include "yaml_check.h"
 
 namespace dem::app {
 
@@ -340,7 +340,7 @@ std::string mixing_name(Mixing m) {
   return "";
 }
 
-/// The contact parameters and options, from the effect table (src/effect_table.cpp).
+/// The contact parameters and options, from the effect table (src/contact/effect_table.cpp).
 void contact_tables(std::string& out, bool markdown) {
   heading(out, 2, "Contact parameters", markdown);
   out += "Keys of `materials.NAME`, `interactions[]`, a material file's `properties` and `walls.NAME`, and a "

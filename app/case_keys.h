@@ -1,8 +1,9 @@
 // The case-key reference (`demdesign keys`, docs/case-keys.md), written from the readers
 // themselves: every shipped case, material file and measurement file is read with a KeyRecorder
-// set (src/yaml_check.h), every equipment generator also once with no parameters (its defaults),
-// and each key the readers asked for becomes a row: type, unit, default, valid range and an
-// example from a shipped file. A key added to a reader appears here without anyone writing it.
+// set (src/case/yaml_check.h), every equipment generator also once with no parameters (its
+// defaults), and each key the readers asked for becomes a row: type, unit, default, valid range
+// and an example from a shipped file. A key added to a reader appears here without anyone
+// writing it.
 #pragma once
 
 #include <string>

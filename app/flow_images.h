@@ -4,9 +4,9 @@
 
 #include <string>
 
-#include "model.h"
-#include "state.h"
-#include "workspace.h"
+#include "core/model.h"
+#include "core/state.h"
+#include "core/workspace.h"
 
 namespace dem::app {
 

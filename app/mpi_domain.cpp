@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "spec.h"
+#include "case/spec.h"
 
 #ifdef DEMDESIGN_WITH_MPI
 #include <mpi.h>

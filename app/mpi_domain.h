@@ -1,5 +1,5 @@
-// Spatial domain decomposition over MPI ranks (the engine's side is src/domain.h): one case split
-// into slabs along one axis, `mpirun -np N demdesign CASE.yaml`.
+// Spatial domain decomposition over MPI ranks (the engine's side is src/core/domain.h): one case
+// split into slabs along one axis, `mpirun -np N demdesign CASE.yaml`.
 //
 // Slabs: along the axis on which the particles spread furthest (a periodic axis counts with its
 // period, the axis of gravity at half its extent: particles travel along it). The cuts between slabs sit at quantiles of the particle count (load balance by
@@ -22,7 +22,7 @@
 
 #include <memory>
 
-#include "domain.h"
+#include "core/domain.h"
 
 namespace dem::app::mpi {
 

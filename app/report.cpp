@@ -1,5 +1,5 @@
 // The run report: numbers at a detected steady state, plots by gnuplot, one self-contained
-// HTML file (the sweep report is app/sweep_report.cpp).
+// HTML file (the sweep report is app/sweep_report.cpp; metrics.csv is app/report_metrics.cpp).
 #include "report.h"
 
 #include "html.h"
@@ -20,15 +20,15 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "output/run.h"
 #include "plot.h"
-#include "run.h"
-#include "steady_state.h"
+#include "report_internal.h"
+#include "statistics/steady_state.h"
 
 namespace dem::report {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kSecondsPerYear = 8760.0 * 3600.0;  // 8760 h
 constexpr double kTonnesPerHourPerKgPerSecond = 3.6;
 
@@ -41,12 +41,6 @@ using html::num;
 std::string html_head(const std::string& title) { return html::head(title); }
 
 std::string pm(double mean, double spread, int sig = 4) { return num(mean, sig) + " &plusmn; " + num(spread, 2); }
-
-std::string key(const std::string& text) {
-  std::string out;
-  for (char c : text) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return out;
-}
 
 // ---- series -------------------------------------------------------------------------------
 
@@ -121,60 +115,6 @@ std::string figure(const plot::Plot& p, const std::string& dir, const std::strin
 }
 
 }  // namespace
-
-double RunMetrics::get(const std::string& name) const {
-  for (const auto& [n, v] : values)
-    if (n == name) return v;
-  return kNaN;
-}
-
-void write_metrics(const RunMetrics& metrics, const std::string& path) {
-  std::string text = "name,value\n";
-  text += fmt::format("steady,{}\n", metrics.steady ? 1 : 0);
-  std::string steady_text = metrics.steady_text;
-  std::replace(steady_text.begin(), steady_text.end(), '\n', ' ');
-  text += "# steady_text: " + steady_text + "\n";
-  for (const auto& [name, value] : metrics.values) text += fmt::format("{},{:.17g}\n", key(name), value);
-  write_file_atomically(path, text);
-}
-
-RunMetrics read_metrics(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw std::runtime_error(fmt::format("{}: cannot read the metrics file", path));
-  std::stringstream text;
-  text << file.rdbuf();
-  return parse_metrics(text.str(), path);
-}
-
-RunMetrics parse_metrics(const std::string& text, const std::string& path) {
-  std::istringstream in(text);
-  RunMetrics m;
-  std::string line;
-  const std::string text_tag = "# steady_text: ";
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.rfind(text_tag, 0) == 0) {
-      m.steady_text = line.substr(text_tag.size());
-      continue;
-    }
-    if (line.empty() || line[0] == '#' || line == "name,value") continue;
-    const std::size_t comma = line.find(',');
-    if (comma == std::string::npos) throw std::runtime_error(fmt::format("{}:{}: expected name,value", path, number));
-    const std::string name = line.substr(0, comma);
-    double value = kNaN;
-    try {
-      value = std::stod(line.substr(comma + 1));
-    } catch (const std::exception&) {
-      throw std::runtime_error(fmt::format("{}:{}: '{}' is not a number", path, number, line.substr(comma + 1)));
-    }
-    if (name == "steady")
-      m.steady = value != 0;
-    else
-      m.values.emplace_back(name, value);
-  }
-  return m;
-}
 
 RunMetrics write_run_report(const RunReportInput& in, const std::string& report_dir) {
   if (!in.model || !in.state) throw std::invalid_argument("write_run_report: model and state are required");

@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "diagnostics.h"
-#include "model.h"
-#include "spec.h"
-#include "state.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/state.h"
+#include "statistics/diagnostics.h"
 #include "viewer3d.h"
 
 namespace dem::report {

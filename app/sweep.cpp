@@ -18,11 +18,11 @@
 #include <thread>
 
 #include "bias_check.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
 #include "mpi_campaign.h"
 #include "report.h"
-#include "spec.h"
 #include "uncertainty.h"
-#include "yaml_check.h"
 
 namespace dem::app {
 

@@ -12,7 +12,7 @@
 #include <filesystem>
 #include <limits>
 
-#include "run.h"
+#include "output/run.h"
 
 namespace dem::report {
 namespace {

@@ -11,12 +11,12 @@
 #include <set>
 #include <sstream>
 
-#include "calibration_record.h"
+#include "case/calibration_record.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
 #include "html.h"
+#include "output/run.h"
 #include "plot.h"
-#include "run.h"
-#include "spec.h"
-#include "yaml_check.h"
 
 namespace dem::app {
 

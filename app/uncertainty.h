@@ -1,9 +1,10 @@
 // Design numbers with the calibration's uncertainty: a case with an `uncertainty:` section runs
 // at parameter sets drawn from the calibration of each calibrated library material it uses (the
-// `calibration:` block that `demdesign calibrate` / `diagnose` write, src/calibration_record.h),
-// as a sweep runs its variants, and reports every KPI of metrics.csv as a median with a 90 % band
-// over the samples. With a `sweep:` too, every design variant runs at the same parameter sets,
-// and the variants are compared sample by sample: the probability that one beats another.
+// `calibration:` block that `demdesign calibrate` / `diagnose` write,
+// src/case/calibration_record.h), as a sweep runs its variants, and reports every KPI of
+// metrics.csv as a median with a 90 % band over the samples. With a `sweep:` too, every design
+// variant runs at the same parameter sets, and the variants are compared sample by sample: the
+// probability that one beats another.
 //
 //   uncertainty:
 //     samples: 16     # parameter sets per design variant (space-filling: a Latin hypercube)

@@ -6,11 +6,11 @@
 #include <cmath>
 #include <numbers>
 
-#include "model.h"
-#include "particles.h"
-#include "state.h"
-#include "step.h"
-#include "workspace.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/state.h"
+#include "core/step.h"
+#include "core/workspace.h"
 
 namespace dem::validation {
 

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "spec.h"
+#include "case/spec.h"
 
 namespace dem::validation {
 

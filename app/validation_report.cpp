@@ -12,7 +12,7 @@
 
 #include "html.h"
 #include "plot_contour.h"
-#include "run.h"
+#include "output/run.h"
 #include "validation.h"
 
 namespace dem::app {

@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <string>
 
-#include "model.h"
-#include "state.h"
+#include "core/model.h"
+#include "core/state.h"
 
 namespace dem::viewer3d {
 

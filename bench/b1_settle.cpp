@@ -21,7 +21,7 @@
 //     particle in id order (jx then jy); zero velocity. splitmix64:
 //       state += 0x9e3779b97f4a7c15; z = state; z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9;
 //       z = (z ^ (z >> 27)) * 0x94d049bb133111eb; return z ^ (z >> 31)
-//     (dem::Random in src/particles.h is exactly this).
+//     (dem::Random in src/core/particles.h is exactly this).
 //   Sizes: N = 20,000: 25 x 25 x 32, Lx = Ly = 0.125 m.
 //          N = 100,000: 50 x 50 x 40, Lx = Ly = 0.25 m.
 //   Neighbour skin: 1 mm.
@@ -57,16 +57,16 @@
 #include <string>
 #include <vector>
 
-#include "allocator.h"
 #include "b1_spec.h"
-#include "diagnostics.h"
+#include "base/allocator.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/state.h"
+#include "core/step.h"
+#include "core/workspace.h"
 #include "peak_memory.h"
-#include "model.h"
-#include "particles.h"
-#include "spec.h"
-#include "state.h"
-#include "step.h"
-#include "workspace.h"
+#include "statistics/diagnostics.h"
 
 namespace {
 

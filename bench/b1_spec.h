@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "particles.h"
-#include "spec.h"
+#include "case/spec.h"
+#include "core/particles.h"
 
 namespace bench::b1 {
 

@@ -67,18 +67,18 @@
 #include <string>
 #include <vector>
 
-#include "allocator.h"
-#include "checkpoint.h"
-#include "diagnostics.h"
-#include "peak_memory.h"
+#include "base/allocator.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/state.h"
+#include "core/step.h"
+#include "core/workspace.h"
 #include "mesh_health.h"
-#include "model.h"
-#include "particles.h"
-#include "spec.h"
-#include "state.h"
-#include "step.h"
+#include "output/checkpoint.h"
+#include "peak_memory.h"
+#include "statistics/diagnostics.h"
 #include "triangle_mesh.h"
-#include "workspace.h"
 
 namespace {
 

@@ -16,13 +16,13 @@
 #include <memory>
 #include <string>
 
-#include "allocator.h"
 #include "b1_spec.h"
-#include "diagnostics.h"
-#include "domain.h"
+#include "base/allocator.h"
+#include "core/domain.h"
+#include "core/step.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
-#include "step.h"
+#include "statistics/diagnostics.h"
 
 namespace {
 

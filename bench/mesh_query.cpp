@@ -15,8 +15,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mesh.h"
-#include "particles.h"
+#include "contact/mesh.h"
+#include "core/particles.h"
 
 namespace {
 

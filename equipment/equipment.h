@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "spec.h"
+#include "case/spec.h"
 
 namespace dem::equipment {
 

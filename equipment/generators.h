@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "case/yaml_check.h"
 #include "equipment.h"
-#include "yaml_check.h"
 
 namespace dem::equipment::detail {
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "run.h"
+#include "output/run.h"
 
 namespace dem::materials {
 

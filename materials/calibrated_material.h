@@ -1,7 +1,7 @@
 // A calibrated material as a library file: what `calibrate` and `diagnose` write into their
 // output folder, so that measurement -> material -> design is one chain of files. The file is a
 // materials/NAME.yaml like the shipped ones (a case names it with `{library: NAME}`) plus a
-// `calibration:` block with the fit it came from (src/calibration_record.h): the fitted
+// `calibration:` block with the fit it came from (src/case/calibration_record.h): the fitted
 // parameters, their standard deviations and correlation, chi^2/n, the effects and the command.
 #pragma once
 

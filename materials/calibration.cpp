@@ -16,7 +16,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "effect.h"
+#include "contact/effect.h"
 
 namespace dem::materials {
 

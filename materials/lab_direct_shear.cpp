@@ -19,10 +19,10 @@
 //
 // Stresses come from the plate forces over the cell area A: tau = (F_bottom,x - F_top,x) / 2A,
 // sigma = mean of both plates' normal stress. Over the last pre-shear window the contact stress
-// tensor (Eq. 5, src/stress.h) over the sample between the glued layers' centre planes is
-// averaged and compared with them (notes). Mass scaling: raised so that the inertial number
-// I = (v/H) d50 / sqrt(sigma_n / rho) is 8e-4 at the lower normal stress (quasi-static, GDR MiDi
-// 2004: I < 1e-3), never lowered below the model's; I is reported.
+// tensor (Eq. 5, src/statistics/stress.h) over the sample between the glued layers' centre
+// planes is averaged and compared with them (notes). Mass scaling: raised so that the inertial
+// number I = (v/H) d50 / sqrt(sigma_n / rho) is 8e-4 at the lower normal stress (quasi-static, GDR
+// MiDi 2004: I < 1e-3), never lowered below the model's; I is reported.
 #include "lab_direct_shear.h"
 
 #include <fmt/format.h>
@@ -32,10 +32,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "particles.h"
-#include "step.h"
-#include "stress.h"
-#include "workspace.h"
+#include "core/particles.h"
+#include "core/step.h"
+#include "core/workspace.h"
+#include "statistics/stress.h"
 
 namespace dem::materials {
 

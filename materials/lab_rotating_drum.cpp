@@ -23,7 +23,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "particles.h"
+#include "core/particles.h"
 #include "virtual_test_support.h"
 
 namespace dem::materials::detail {

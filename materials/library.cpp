@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "spec.h"
+#include "case/spec.h"
 
 namespace dem::materials {
 

@@ -2,7 +2,7 @@
 // and the C++ that calibrates them against laboratory measurements (virtual tests, comparison,
 // calibration, diagnosis). A case uses a library material with
 //   materials: {ore: {library: gravel}}
-// (the case reader, src/spec.cpp, reads the file; where it is found is said here:
+// (the case reader, src/case/spec_materials.cpp, reads the file; where it is found is said here:
 // use_material_library). `demdesign materials` lists what is there.
 #pragma once
 

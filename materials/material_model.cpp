@@ -1,7 +1,8 @@
 // Library material files become calibratable models. The file is read by the case reader itself
 // (a one-particle case text that names the file as a library material, with the wall materials
 // its `walls:` pairs need), so a library file means the same here as in a case, with the same
-// errors. Rejected alternative: a second reader of library files that could drift from spec.cpp.
+// errors. Rejected alternative: a second reader of library files that could drift from the case
+// reader's (src/case/spec_materials.cpp).
 #include "material_model.h"
 
 #include <fmt/format.h>
@@ -13,9 +14,9 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "effect.h"
+#include "case/yaml_check.h"
+#include "contact/effect.h"
 #include "library.h"
-#include "yaml_check.h"
 
 namespace dem::materials {
 

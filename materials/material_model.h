@@ -27,7 +27,7 @@ double get_parameter(const MaterialModel& model, const std::string& key);
 void set_parameter(MaterialModel& model, const std::string& key, double value);
 
 /// A physical effect the model does not use, and how to add it: a contact effect whose file
-/// declares a CandidateSpec (src/effect.h), or particle shape as clumps.
+/// declares a CandidateSpec (src/contact/effect.h), or particle shape as clumps.
 struct EffectCandidate {
   std::string name;         ///< the effect's name in the table ("epsd", "liquid_bridge", "jkr", ...) or "clump_shape"
   std::string title;        ///< in words: "rolling resistance"

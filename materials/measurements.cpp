@@ -12,8 +12,8 @@
 #include <set>
 #include <sstream>
 
-#include "effect.h"
-#include "yaml_check.h"
+#include "case/yaml_check.h"
+#include "contact/effect.h"
 
 namespace dem::materials {
 

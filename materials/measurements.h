@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "spec.h"
+#include "case/spec.h"
 #include "virtual_tests.h"
 
 namespace dem::materials {

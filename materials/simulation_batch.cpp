@@ -16,8 +16,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "diagnostics.h"
 #include "simulation_store.h"
+#include "statistics/diagnostics.h"
 
 namespace dem::materials {
 

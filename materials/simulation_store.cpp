@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "run.h"
+#include "output/run.h"
 
 namespace dem::materials {
 

@@ -9,9 +9,9 @@
 #include <numeric>
 #include <numbers>
 
-#include "clump_geometry.h"
-#include "particles.h"
-#include "step.h"
+#include "bodies/clump_geometry.h"
+#include "core/particles.h"
+#include "core/step.h"
 
 namespace dem::materials::detail {
 

@@ -12,11 +12,11 @@
 #include <utility>
 #include <vector>
 
-#include "model.h"
-#include "spec.h"
-#include "state.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/state.h"
+#include "core/workspace.h"
 #include "virtual_tests.h"
-#include "workspace.h"
 
 namespace dem::materials::detail {
 

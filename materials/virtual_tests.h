@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "model.h"
-#include "spec.h"
-#include "state.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/state.h"
 
 namespace dem::materials {
 

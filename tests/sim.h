@@ -5,13 +5,13 @@
 #include <cmath>
 #include <string>
 
-#include "diagnostics.h"
-#include "model.h"
-#include "particles.h"
-#include "spec.h"
-#include "state.h"
-#include "step.h"
-#include "workspace.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/state.h"
+#include "core/step.h"
+#include "core/workspace.h"
+#include "statistics/diagnostics.h"
 
 namespace dem::test {
 

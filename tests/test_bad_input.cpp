@@ -13,7 +13,7 @@
 #include <string>
 
 #include "bad_input.h"
-#include "spec.h"
+#include "case/spec.h"
 #include "triangle_mesh.h"
 
 namespace {

@@ -14,8 +14,8 @@
 #include <sstream>
 #include <string>
 
-#include "model.h"
-#include "spec.h"
+#include "case/spec.h"
+#include "core/model.h"
 
 namespace {
 

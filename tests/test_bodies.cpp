@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "rigid_body.h"
+#include "bodies/rigid_body.h"
 #include "sim.h"
 
 namespace dem::test {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "checkpoint.h"
-#include "neighbors.h"
+#include "core/neighbors.h"
+#include "output/checkpoint.h"
 #include "sim.h"
-#include "stress.h"
+#include "statistics/stress.h"
 
 namespace dem::test {
 namespace {

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "calibrated_material.h"
-#include "calibration_record.h"
+#include "case/calibration_record.h"
 #include "material_model.h"
 
 namespace dem::materials {

@@ -11,9 +11,9 @@
 #include <stdexcept>
 
 #include "calibration.h"
+#include "case/spec.h"
 #include "material_model.h"
 #include "mpi_campaign.h"
-#include "spec.h"
 
 namespace {
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "spec.h"
-#include "yaml_check.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
 
 namespace dem::test {
 namespace {

@@ -6,9 +6,9 @@
 #include <sstream>
 
 #include "equipment.h"
-#include "run.h"
-#include "triangle_mesh.h"
+#include "output/run.h"
 #include "sim.h"
+#include "triangle_mesh.h"
 
 namespace dem::test {
 namespace {

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "clump_geometry.h"
+#include "bodies/clump_geometry.h"
 
 namespace dem {
 namespace {

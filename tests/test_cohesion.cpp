@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "forces.h"
+#include "core/forces.h"
 #include "sim.h"
 
 namespace dem::test {

@@ -8,10 +8,10 @@
 #include <algorithm>
 
 #include "calibration.h"
-#include "effect.h"
+#include "case/spec.h"
+#include "contact/effect.h"
+#include "core/model.h"
 #include "material_model.h"
-#include "model.h"
-#include "spec.h"
 
 namespace dem::materials {
 namespace {

@@ -25,12 +25,12 @@
 #include <thread>
 #include <vector>
 
-#include "diagnostics.h"
-#include "model.h"
-#include "particles.h"
-#include "run.h"
-#include "spec.h"
-#include "step.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "core/step.h"
+#include "output/run.h"
+#include "statistics/diagnostics.h"
 
 namespace {
 

@@ -1,10 +1,10 @@
-// Domain decomposition (src/domain.h, app/mpi_domain.h), run as `mpirun -np 2 domain_mpi_tests`
-// (tests/CMakeLists.txt). Every rank runs each case twice: whole, in this process alone, and split
-// into slabs shared with the other rank. Particles and momentum must be conserved exactly (to
-// rounding), and the decomposed runs must match the single-rank runs within their run-to-run
-// spread: a split run is not bitwise the same (contacts across a face are summed in another
-// order), so its trajectories part from the single run's after a while, as two runs of one case
-// on different machines would.
+// Domain decomposition (src/core/domain.h, app/mpi_domain.h), run as
+// `mpirun -np 2 domain_mpi_tests` (tests/CMakeLists.txt). Every rank runs each case twice: whole,
+// in this process alone, and split into slabs shared with the other rank. Particles and momentum
+// must be conserved exactly (to rounding), and the decomposed runs must match the single-rank runs
+// within their run-to-run spread: a split run is not bitwise the same (contacts across a face are
+// summed in another order), so its trajectories part from the single run's after a while, as two
+// runs of one case on different machines would.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -12,15 +12,15 @@
 #include <memory>
 #include <sstream>
 
-#include "diagnostics.h"
-#include "domain.h"
+#include "case/spec.h"
+#include "core/domain.h"
+#include "core/model.h"
+#include "core/particles.h"
 #include "equipment.h"
-#include "model.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
-#include "particles.h"
-#include "run.h"
-#include "spec.h"
+#include "output/run.h"
+#include "statistics/diagnostics.h"
 
 namespace {
 

@@ -13,10 +13,10 @@
 #include <numbers>
 #include <set>
 
-#include "forces.h"
-#include "neighbors.h"
+#include "core/forces.h"
+#include "core/neighbors.h"
+#include "core/timestep.h"
 #include "sim.h"
-#include "timestep.h"
 
 namespace dem::test {
 namespace {
@@ -437,10 +437,11 @@ TEST(Effects, EveryEffectTogetherFitsTheBatchHistoryColumns) {
 // The particle pairs' geometry leaves the spin inputs (relative spin, reduced moment of
 // inertia) unset unless an active effect declares that it reads them (EffectSpec::reads_spin):
 // an effect that read them undeclared would see garbage. Each effect is one file of
-// src/effects/ (its name its table entry's); the files that index those columns must declare it.
+// src/contact/effects/ (its name its table entry's); the files that index those columns must
+// declare it.
 TEST(Effects, EffectsThatReadTheSpinInputsDeclareIt) {
   int readers = 0;
-  for (const auto& file : std::filesystem::directory_iterator(DEMDESIGN_SOURCE_DIR "/src/effects")) {
+  for (const auto& file : std::filesystem::directory_iterator(DEMDESIGN_SOURCE_DIR "/src/contact/effects")) {
     if (file.path().extension() != ".cpp") continue;
     std::ifstream in(file.path());
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

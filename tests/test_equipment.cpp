@@ -391,7 +391,7 @@ TEST(Equipment, ExpandFillsPortsDomainAndDesign) {
 TEST(Equipment, ErrorsFromACaseFileNameItsLines) {
   // The parameters as the case reader keeps them: the node under the type key of the whole file,
   // so marks are lines of the case file. (parse_case_text is not used: its `equipment:` wiring
-  // lives in src/spec.cpp.)
+  // lives in src/case/spec_walls.cpp.)
   const char* text = R"(simulation: {duration: 0.1}
 materials:
   ore: {density: 2600, youngs_modulus: 5e7}

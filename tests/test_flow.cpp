@@ -6,8 +6,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "checkpoint.h"
-#include "run.h"
+#include "output/checkpoint.h"
+#include "output/run.h"
 #include "sim.h"
 
 namespace dem::test {

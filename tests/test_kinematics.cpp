@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "kinematics.h"
-#include "spec.h"
+#include "case/spec.h"
+#include "motion/kinematics.h"
 
 namespace dem {
 namespace {

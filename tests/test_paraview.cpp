@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "results_hdf5.h"
+#include "output/results_hdf5.h"
 
 namespace dem {
 namespace {

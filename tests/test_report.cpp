@@ -16,12 +16,12 @@
 #include <random>
 #include <sstream>
 
-#include "model.h"
-#include "particles.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "output/run.h"
 #include "render/render.h"
 #include "report.h"
-#include "run.h"
-#include "spec.h"
 #include "viewer3d.h"
 
 extern "C" char** environ;

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "results_hdf5.h"
+#include "output/results_hdf5.h"
 
 namespace fs = std::filesystem;
 using dem::FrameInfo;

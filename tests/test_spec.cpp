@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "model.h"
-#include "spec.h"
+#include "case/spec.h"
+#include "core/model.h"
 
 namespace dem::test {
 namespace {

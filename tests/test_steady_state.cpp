@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "steady_state.h"
+#include "statistics/steady_state.h"
 
 namespace dem::test {
 namespace {

@@ -1,7 +1,7 @@
 // Design sweeps: reading the `sweep:` section, the variants' cases, errors with file and line.
 #include <gtest/gtest.h>
 
-#include "spec.h"
+#include "case/spec.h"
 #include "sweep.h"
 
 namespace dem::test {

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "spec.h"
+#include "case/spec.h"
 #include "sweep.h"
 #include "uncertainty.h"
 

@@ -3,7 +3,7 @@
 // contact its dissipation depends on the impact speed (the contact lasts longer at low speed, so
 // slow impacts lose more), which the restitution law (a constant e) cannot reproduce.
 // tests/test_contributor_effect.cpp checks that it reaches every tool with no other edit.
-#include "effect.h"
+#include "contact/effect.h"
 
 namespace dem::test_effects {
 namespace {

@@ -1,10 +1,10 @@
 #include <fmt/format.h>
 
 #include "bad_input.h"
+#include "case/spec.h"
+#include "core/model.h"
+#include "core/particles.h"
 #include "equipment.h"
-#include "model.h"
-#include "particles.h"
-#include "spec.h"
 
 namespace dem::fuzz {
 

@@ -1,0 +1,230 @@
+// Reading a case's materials into the CaseSpec: each material's properties and effect
+// parameters, library materials (materials/NAME.yaml, found beside the case or through the
+// material library's lookup) with their overrides, wall pair parameters and calibration, and the
+// contact model (`contact:`, one effect per stage or a list for the additive stages).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "case/calibration_record.h"
+#include "case/spec.h"
+#include "case/spec_reading.h"
+#include "case/yaml_check.h"
+#include "contact/effect.h"
+
+namespace dem {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::vector<std::string> all_param_keys() {
+  std::vector<std::string> keys;
+  for (const EffectSpec* effect : effect_table())
+    for (const ParamSpec& p : effect->params) keys.emplace_back(p.key);
+  return keys;
+}
+
+LibraryLookup& library_lookup() {
+  static LibraryLookup lookup;
+  return lookup;
+}
+
+/// Where `materials: {NAME: {library: gravel}}` finds gravel.yaml, first match wins: the case's
+/// folder, its `materials/` and `../materials/` folders, then the lookup the material library set.
+std::filesystem::path find_library_file(const std::string& wanted, const std::string& case_file, std::string& searched) {
+  const std::filesystem::path dir = std::filesystem::path(case_file).parent_path();
+  for (const std::filesystem::path& folder : {dir, dir / "materials", dir / ".." / "materials"}) {
+    const std::filesystem::path candidate = folder / (wanted + ".yaml");
+    searched += "\n  " + candidate.lexically_normal().string();
+    if (std::filesystem::is_regular_file(candidate)) return candidate;
+  }
+  return library_lookup() ? library_lookup()(wanted, case_file, searched) : std::filesystem::path();
+}
+
+ContactSpec::Choice read_choice(const YAML::Node& node, const std::string& file, const std::string& path,
+                                MapReader& parent, const std::string& key) {
+  ContactSpec::Choice choice;
+  choice.location = parent.at(node);
+  if (node.IsScalar()) {
+    choice.model = node.Scalar();
+    return choice;
+  }
+  if (!node.IsMap()) parent.fail(key, "must be a model name or a map {model: NAME, OPTION: VALUE}");
+  MapReader map(node, file, path);
+  choice.model = map.string("model", "");
+  if (choice.model.empty()) map.fail("model", "missing: name the model");
+  for (const std::string& k : map.keys())
+    if (k != "model") choice.options[k] = map.string(k, "");
+  return choice;
+}
+
+std::vector<std::string> effect_names(Stage stage, bool with_none) {
+  std::vector<std::string> names;
+  if (with_none) names.emplace_back("none");
+  for (const EffectSpec* e : effect_table())
+    if (e->stage == stage) names.emplace_back(e->name);
+  return names;
+}
+
+void check_choice(const ContactSpec::Choice& c, Stage stage, const std::string& path) {
+  const auto valid = effect_names(stage, !stage_is_additive(stage));
+  if (std::find(valid.begin(), valid.end(), c.model) != valid.end()) return;
+  const std::string hint = nearest_word(c.model, valid);
+  std::string list;
+  for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+  throw CaseError(fmt::format("{}: {}: '{}' is not a {} model{}; valid: {}", c.location.str(), path, c.model,
+                              kStageKeys[static_cast<int>(stage)],
+                              hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
+}
+
+}  // namespace
+
+namespace spec_reading {
+
+/// Reads the effect parameters of a material or interaction map (all keys not in `fixed`).
+void read_effect_params(MapReader& map, const std::vector<std::string>& fixed, std::map<std::string, double>& params,
+                        std::map<std::string, SourceLocation>& where) {
+  std::vector<std::string> valid = fixed;
+  const auto keys = all_param_keys();
+  valid.insert(valid.end(), keys.begin(), keys.end());
+  for (const std::string& key : map.keys()) {
+    if (std::find(fixed.begin(), fixed.end(), key) != fixed.end()) continue;
+    const ParamSpec* p = find_param(key);
+    if (!p) continue;  // reported by finish() with a suggestion
+    params[key] = map.number(key, p->default_value, p->min_value, p->max_value, p->unit);
+    where[key] = map.where(key);
+  }
+  map.finish(valid);
+}
+
+/// A material's properties: the map under `materials.NAME` of a case, or `properties` of a
+/// material file (`path` names it in errors).
+MaterialSpec read_material(const std::string& name, const YAML::Node& node, const std::string& file, const std::string& path) {
+  MapReader map(node, file, path);
+  MaterialSpec m;
+  m.name = name;
+  m.location = map.location();
+  m.density = map.required_number("density", 1.0, 1e5, "kg/m^3");
+  m.youngs_modulus = map.required_number("youngs_modulus", 1e3, kInf, "Pa");
+  m.poisson_ratio = map.number("poisson_ratio", 0.25, -0.99, 0.499, "-");
+  read_effect_params(map, {"density", "youngs_modulus", "poisson_ratio"}, m.params, m.where);
+  return m;
+}
+
+LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file) {
+  const std::string wanted = entry.string("library", "");
+  std::string searched;
+  const std::filesystem::path found = find_library_file(wanted, case_file, searched);
+  if (found.empty()) entry.fail("library", fmt::format("no material file '{}.yaml' found; looked in:{}", wanted, searched));
+  std::ifstream in(found);
+  std::stringstream text;
+  text << in.rdbuf();
+  LibraryMaterial lib;
+  lib.file = found.lexically_normal().string();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", lib.file, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+  MapReader file_map(root, lib.file, "");
+  if (!file_map.has("properties")) file_map.fail("properties", "missing: the material's {density, youngs_modulus, ...}");
+  lib.material = read_material(name, file_map.node("properties"), lib.file, "properties");
+  lib.material.library_file = lib.file;
+  lib.material.description = file_map.string("name", wanted);
+  lib.material.description = file_map.string("description", lib.material.description);
+  if (const YAML::Node sources = file_map.node("sources")) {
+    MapReader s(sources, lib.file, "sources");
+    s.keys_are_names("PARAMETER");
+    for (const std::string& key : s.keys()) lib.material.sources[key] = s.string(key, "");
+  }
+  if (const YAML::Node tunable = file_map.node("tunable")) {
+    MapReader t(tunable, lib.file, "tunable");
+    t.keys_are_names("PARAMETER");
+    for (const std::string& key : t.keys()) {
+      const YAML::Node range = t.node(key);
+      if (!range.IsSequence() || range.size() != 2) t.fail(key, "must be a range [min, max]");
+      const double lo = MapReader::finite_number(range[0], t, key), hi = MapReader::finite_number(range[1], t, key);
+      if (!(lo < hi)) t.fail(key, "needs min < max");
+      lib.material.tunable[key] = {lo, hi};
+    }
+  }
+  if (const YAML::Node walls = file_map.node("walls")) {
+    if (!walls.IsMap()) file_map.fail("walls", "must map wall material names to pair parameters {friction: ..., ...}");
+    for (const auto& kv : walls) lib.walls.emplace_back(kv.first.as<std::string>(), kv.second);
+  }
+  lib.contact = file_map.node("contact");
+  file_map.node("size");  // a typical size, for the calibration tests
+  if (const YAML::Node fit = file_map.node("calibration")) {
+    lib.material.calibration = read_calibration_record(fit, lib.file);
+    // The values the file states are the fit's: a file edited after its calibration is refused.
+    const CalibrationRecord& r = *lib.material.calibration;
+    for (size_t k = 0; k < r.parameters.size(); ++k) {
+      const auto given = lib.material.params.find(r.parameters[k]);
+      if (given != lib.material.params.end() && std::abs(given->second - r.value[k]) > 1e-6 * std::max(1.0, std::abs(r.value[k])))
+        throw CaseError(fmt::format("{}: properties.{} is {:g} but calibration.value gives {:g}: the file was edited after its calibration; "
+                                    "calibrate again, or remove the calibration block",
+                                    r.location.str(), r.parameters[k], given->second, r.value[k]));
+    }
+  }
+  file_map.finish();
+  // Overrides in the case entry, beside `library:`.
+  MaterialSpec& m = lib.material;
+  m.location = entry.location();
+  m.density = entry.number("density", m.density, 1.0, 1e5, "kg/m^3");
+  m.youngs_modulus = entry.number("youngs_modulus", m.youngs_modulus, 1e3, kInf, "Pa");
+  m.poisson_ratio = entry.number("poisson_ratio", m.poisson_ratio, -0.99, 0.499, "-");
+  for (const char* key : {"density", "youngs_modulus", "poisson_ratio"})
+    if (entry.has(key)) m.where[key] = entry.where(key), m.sources[key] = "set in the case";
+  std::map<std::string, double> overrides;
+  std::map<std::string, SourceLocation> where;
+  read_effect_params(entry, {"library", "density", "youngs_modulus", "poisson_ratio"}, overrides, where);
+  for (const auto& [key, value] : overrides) m.params[key] = value, m.where[key] = where[key], m.sources[key] = "set in the case";
+  return lib;
+}
+
+ContactSpec read_contact(const YAML::Node& node, const std::string& file) {
+  ContactSpec contact;
+  if (!node) return contact;
+  MapReader map(node, file, "contact");
+  const std::pair<Stage, ContactSpec::Choice*> single[] = {{Stage::normal, &contact.normal},
+                                                           {Stage::damping, &contact.damping},
+                                                           {Stage::tangential, &contact.tangential},
+                                                           {Stage::rolling, &contact.rolling},
+                                                           {Stage::twisting, &contact.twisting}};
+  for (auto [stage, choice] : single) {
+    const std::string key(kStageKeys[static_cast<int>(stage)]);
+    if (!map.has(key)) {
+      map.node(key);
+      continue;
+    }
+    *choice = read_choice(map.node(key), file, "contact." + key, map, key);
+    check_choice(*choice, stage, "contact." + key);
+  }
+  for (Stage stage : {Stage::adhesion, Stage::extra}) {
+    const std::string key(kStageKeys[static_cast<int>(stage)]);
+    const YAML::Node list = map.node(key);
+    if (!list) continue;
+    if (!list.IsSequence()) map.fail(key, "must be a list of models, e.g. [liquid_bridge]");
+    auto& out = stage == Stage::adhesion ? contact.adhesion : contact.extra;
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string path = fmt::format("contact.{}[{}]", key, k);
+      out.push_back(read_choice(list[k], file, path, map, key));
+      check_choice(out.back(), stage, path);
+    }
+  }
+  map.finish();
+  return contact;
+}
+
+}  // namespace spec_reading
+
+void set_library_lookup(LibraryLookup lookup) { library_lookup() = std::move(lookup); }
+
+}  // namespace dem

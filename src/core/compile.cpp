@@ -1,0 +1,506 @@
+// compile(spec): resolve names, switch on effects, mix per-pair parameters, check the time step.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "bodies/clump_geometry.h"
+#include "case/yaml_check.h"
+#include "core/model.h"
+#include "core/timestep.h"
+
+namespace dem {
+
+/// Most particles a case may create at the start (a bound on memory, see compile).
+constexpr std::int64_t kMaxParticles = 20'000'000;
+
+namespace {
+
+double mix(Mixing rule, double a, double b) {
+  switch (rule) {
+    case Mixing::arithmetic: return 0.5 * (a + b);
+    case Mixing::geometric: return std::sqrt(a * b);
+    case Mixing::harmonic: return (a > 0 && b > 0) ? 2.0 * a * b / (a + b) : 0.0;
+    case Mixing::minimum: return std::min(a, b);
+    case Mixing::maximum: return std::max(a, b);
+  }
+  return a;
+}
+
+/// 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (rigid: E = inf adds nothing).
+double effective_youngs(const Material& a, const Material& b) {
+  const double inv = (1 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus +
+                     (1 - b.poisson_ratio * b.poisson_ratio) / b.youngs_modulus;
+  return 1.0 / inv;
+}
+
+/// 1/G* = 2(2 - nu1)(1 + nu1)/E1 + 2(2 - nu2)(1 + nu2)/E2 (Mindlin; LIGGGHTS/EDEM form).
+double effective_shear(const Material& a, const Material& b) {
+  const double inv = 2 * (2 - a.poisson_ratio) * (1 + a.poisson_ratio) / a.youngs_modulus +
+                     2 * (2 - b.poisson_ratio) * (1 + b.poisson_ratio) / b.youngs_modulus;
+  return 1.0 / inv;
+}
+
+void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, int& param_cursor) {
+  if (choice.model == "none") return;
+  const EffectSpec* spec = find_effect(stage, choice.model);
+  ActiveEffect active{spec, param_cursor, model.history_width, {}};
+  for (const auto& option_value : choice.options) {
+    // Named copies, not structured bindings: clang 14 (the fuzz build) cannot capture those.
+    const std::string& key = option_value.first;
+    const std::string& value = option_value.second;
+    const auto option = std::find_if(spec->options.begin(), spec->options.end(),
+                                     [&](const OptionSpec& o) { return o.key == key; });
+    if (option == spec->options.end()) {
+      std::string valid = "model";
+      for (const auto& o : spec->options) valid += fmt::format(", {}", o.key);
+      throw CaseError(fmt::format("{}: contact.{}.{}: unknown option of '{}'; valid: {}", choice.location.str(),
+                                  kStageKeys[static_cast<int>(stage)], key, spec->name, valid));
+    }
+    const auto at = std::find(option->values.begin(), option->values.end(), value);
+    if (at == option->values.end()) {
+      std::string valid;
+      for (const auto& v : option->values) valid += (valid.empty() ? "" : ", ") + std::string(v);
+      throw CaseError(fmt::format("{}: contact.{}.{}: '{}' is not valid; valid: {}", choice.location.str(),
+                                  kStageKeys[static_cast<int>(stage)], key, value, valid));
+    }
+    active.options[option - spec->options.begin()] = static_cast<std::uint8_t>(at - option->values.begin());
+  }
+  for (const HistorySpec& h : spec->history) {
+    model.history_width += h.width;
+    model.history_odd.insert(model.history_odd.end(), h.width, h.odd ? 1 : 0);
+  }
+  // Every effect of the table at once fits (tests: Effects.AllHistoriesFitABatch); a new effect
+  // with history may need kHistoryMax raised.
+  if (model.history_width > kHistoryMax)
+    throw std::logic_error(fmt::format("contact history of {} doubles exceeds kHistoryMax = {} (src/contact/effect.h)", model.history_width, kHistoryMax));
+  param_cursor += static_cast<int>(spec->params.size()) + spec->derived_count;
+  model.spin_inputs |= spec->reads_spin;
+  model.effects.push_back(active);
+}
+
+const ParamSpec* active_param(const Model& model, std::string_view key) {
+  for (const ActiveEffect& e : model.effects)
+    for (const ParamSpec& p : e.spec->params)
+      if (p.key == key) return &p;
+  return nullptr;
+}
+
+void note_unused(Model& model, const std::map<std::string, double>& params,
+                 const std::map<std::string, SourceLocation>& where, const std::string& owner) {
+  for (const auto& [key, value] : params) {
+    if (active_param(model, key)) continue;
+    std::string effect;
+    for (const EffectSpec* e : effect_table())
+      for (const ParamSpec& p : e->params)
+        if (p.key == key && effect.empty()) effect = fmt::format("contact.{}: {}", kStageKeys[static_cast<int>(e->stage)], e->name);
+    model.notes.push_back(fmt::format("{}: {}.{} = {:g} has no effect: it belongs to {}, which this case does not switch on",
+                                      where.at(key).str(), owner, key, value, effect));
+  }
+}
+
+std::uint64_t fnv1a(const void* data, size_t bytes, std::uint64_t h) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 0x100000001b3ULL;
+  return h;
+}
+
+}  // namespace
+
+int Model::material_index(std::string_view name) const {
+  for (size_t k = 0; k < materials.size(); ++k)
+    if (materials[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+double Model::pair_param(int a, int b, std::string_view key) const {
+  for (const ActiveEffect& e : effects)
+    for (size_t k = 0; k < e.spec->params.size(); ++k)
+      if (e.spec->params[k].key == key) return pair_row(pair_type(a, b))[e.param_offset + k];
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+Model compile(const CaseSpec& spec, const MeshLoader& loader) {
+  Model model;
+  model.source = spec.path;
+  model.title = spec.title;
+
+  for (const MaterialSpec& m : spec.materials)
+    model.materials.push_back({m.name, m.density, m.youngs_modulus, m.poisson_ratio});
+  // Mass scaling and reduced stiffness act on the materials particles are made of.
+  model.mass_scaling = spec.simulation.mass_scaling;
+  model.stiffness_scaling = spec.simulation.stiffness_scaling;
+  {
+    std::vector<std::uint8_t> particle_material(model.materials.size(), 0);
+    for (const auto& p : spec.particles)
+      if (const int k = model.material_index(p.material); k >= 0) particle_material[k] = 1;
+    for (const auto& in : spec.inlets)
+      if (const int k = model.material_index(in.material); k >= 0) particle_material[k] = 1;
+    for (size_t k = 0; k < model.materials.size(); ++k) {
+      if (!particle_material[k]) continue;
+      model.materials[k].density *= model.mass_scaling;
+      model.materials[k].youngs_modulus *= model.stiffness_scaling;
+      // Parameters fitted at one stiffness need not hold at another: say so when a calibrated
+      // material runs at a stiffness more than 25 % away from the one its calibration used.
+      if (const auto& record = spec.materials[k].calibration) {
+        const double ratio = model.stiffness_scaling / record->stiffness_scaling;
+        if (ratio > 1.25 || ratio < 0.8)
+          model.notes.push_back(fmt::format(
+              "{} was calibrated with its Young's modulus x {:g} ({:.3g} Pa in the virtual tests) and runs here at x {:g} ({:.3g} Pa): "
+              "parameters fitted at one stiffness need not hold at another; calibrate at the case's stiffness, or add `bias_check:` "
+              "to see what the difference moves",
+              spec.materials[k].name, record->stiffness_scaling, spec.materials[k].youngs_modulus * record->stiffness_scaling,
+              model.stiffness_scaling, spec.materials[k].youngs_modulus * model.stiffness_scaling));
+      }
+    }
+  }
+  auto material_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
+    const int index = model.material_index(name);
+    if (index >= 0) return index;
+    std::vector<std::string> names;
+    std::string list;
+    for (const auto& m : model.materials) names.push_back(m.name), list += (list.empty() ? "" : ", ") + m.name;
+    const std::string hint = nearest_word(name, names);
+    throw CaseError(fmt::format("{}: {}: unknown material '{}'{}; materials of this case: {}", where.str(), key, name,
+                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
+  };
+
+  // Effects in stage order.
+  int param_cursor = 2;  // columns 0, 1: E*, G*
+  const ContactSpec& c = spec.contact;
+  if (c.normal.model == "none")
+    throw CaseError(fmt::format("{}: contact.normal: a normal force law is required (hertz or linear)", c.normal.location.str()));
+  add_effect(model, c.normal, Stage::normal, param_cursor);
+  add_effect(model, c.damping, Stage::damping, param_cursor);
+  for (const auto& a : c.adhesion) add_effect(model, a, Stage::adhesion, param_cursor);
+  add_effect(model, c.tangential, Stage::tangential, param_cursor);
+  add_effect(model, c.rolling, Stage::rolling, param_cursor);
+  add_effect(model, c.twisting, Stage::twisting, param_cursor);
+  for (const auto& e : c.extra) add_effect(model, e, Stage::extra, param_cursor);
+  model.pair_stride = param_cursor;
+  for (const ActiveEffect& e : model.effects) {
+    if (!e.spec->requires_normal.empty() && e.spec->requires_normal != c.normal.model)
+      throw CaseError(fmt::format("{}: contact: '{}' is written for the '{}' normal law, but contact.normal is '{}'",
+                                  c.normal.location.str(), e.spec->name, e.spec->requires_normal, c.normal.model));
+  }
+
+  // Pair table: mixed material values, then explicit interactions, then derived values.
+  const int n = model.n_materials();
+  model.pair_table.assign(static_cast<size_t>(n) * n * model.pair_stride, 0.0);
+  auto value_of = [&](const MaterialSpec& m, const ParamSpec& p) {
+    const auto it = m.params.find(std::string(p.key));
+    return it == m.params.end() ? p.default_value : it->second;
+  };
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      double* row = model.pair_table.data() + static_cast<size_t>(model.pair_type(a, b)) * model.pair_stride;
+      row[0] = effective_youngs(model.materials[a], model.materials[b]);
+      row[1] = effective_shear(model.materials[a], model.materials[b]);
+      for (const ActiveEffect& e : model.effects)
+        for (size_t k = 0; k < e.spec->params.size(); ++k) {
+          const ParamSpec& p = e.spec->params[k];
+          row[e.param_offset + k] = mix(p.mixing, value_of(spec.materials[a], p), value_of(spec.materials[b], p));
+        }
+    }
+  }
+  for (size_t k = 0; k < spec.interactions.size(); ++k) {
+    const InteractionSpec& in = spec.interactions[k];
+    const std::string key = fmt::format("interactions[{}].materials", k);
+    const int a = material_or_fail(in.material_a, in.location, key);
+    const int b = material_or_fail(in.material_b, in.location, key);
+    for (const auto& [name, value] : in.params) {
+      for (const ActiveEffect& e : model.effects)
+        for (size_t p = 0; p < e.spec->params.size(); ++p)
+          if (e.spec->params[p].key == name) {
+            model.pair_table[static_cast<size_t>(model.pair_type(a, b)) * model.pair_stride + e.param_offset + p] = value;
+            model.pair_table[static_cast<size_t>(model.pair_type(b, a)) * model.pair_stride + e.param_offset + p] = value;
+          }
+    }
+    note_unused(model, in.params, in.where, fmt::format("interactions[{}]", k));
+  }
+  for (const MaterialSpec& m : spec.materials) note_unused(model, m.params, m.where, "materials." + m.name);
+  for (int t = 0; t < n * n; ++t)
+    for (const ActiveEffect& e : model.effects)
+      if (e.spec->derive) e.spec->derive(model.pair_table.data() + static_cast<size_t>(t) * model.pair_stride + e.param_offset);
+
+  // Walls.
+  for (size_t k = 0; k < spec.planes.size(); ++k) {
+    const PlaneWallSpec& w = spec.planes[k];
+    PlaneWall wall{w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
+                   {w.velocity.x(), w.velocity.y(), w.velocity.z()},
+                   material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))};
+    wall.cylinder = w.cylinder;
+    wall.radius = w.radius;
+    wall.servo = w.has_servo;
+    wall.target_stress = w.servo.target_stress;
+    wall.servo_area = w.servo.area;
+    wall.servo_max_speed = w.servo.max_speed;
+    model.planes.push_back(wall);
+  }
+
+  // Mesh walls: triangles inline or from the loader, placed by their transform.
+  for (size_t k = 0; k < spec.meshes.size(); ++k) {
+    const MeshWallSpec& m = spec.meshes[k];
+    auto surface = std::make_shared<TriangleSurface>();
+    if (!m.triangles.empty()) {
+      const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(m.rotate_deg.z() * std::numbers::pi / 180, Vec3::UnitZ()) *
+                                        Eigen::AngleAxisd(m.rotate_deg.y() * std::numbers::pi / 180, Vec3::UnitY()) *
+                                        Eigen::AngleAxisd(m.rotate_deg.x() * std::numbers::pi / 180, Vec3::UnitX()))
+                                           .toRotationMatrix();
+      for (const auto& v : m.vertices) {
+        const Vec3 placed = rotation * (Vec3(v[0], v[1], v[2]) * m.unit_scale).cwiseProduct(m.scale) + m.translate;
+        surface->vertices.push_back({placed.x(), placed.y(), placed.z()});
+      }
+      surface->triangles = m.triangles;
+    } else {
+      if (!loader)
+        throw CaseError(fmt::format("{}: meshes[{}].file: reading mesh files needs the geometry library; run the case "
+                                    "with the demdesign program", m.location.str(), k));
+      TriangleSoup soup = loader(m);
+      surface->vertices = std::move(soup.vertices);
+      surface->triangles = std::move(soup.triangles);
+    }
+    if (surface->triangles.empty())
+      throw CaseError(fmt::format("{}: meshes[{}]: the mesh has no triangles", m.location.str(), k));
+    surface->build_topology();
+    MeshWall wall;
+    wall.name = m.name;
+    wall.material = material_or_fail(m.material, m.location, fmt::format("meshes[{}].material", k));
+    wall.surface = surface;
+    wall.bvh = std::make_shared<TriangleBvh>(*surface);
+    wall.motion = m.motion;
+    wall.surface_velocity = m.surface;
+    model.meshes.push_back(std::move(wall));
+  }
+
+  // Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
+  for (const ClumpTemplateSpec& clump : spec.clumps) {
+    std::vector<ClumpSphere> spheres;
+    for (size_t k = 0; k < clump.radii.size(); ++k) spheres.push_back({clump.centres[k], clump.radii[k]});
+    const ClumpMassProperties props = clump_mass_properties(spheres, 1.0);
+    const double scale = 1.0 / std::cbrt(6.0 * props.volume / std::numbers::pi);  // to d_eq = 1 m
+    ClumpTemplate t;
+    t.name = clump.name;
+    for (size_t k = 0; k < spheres.size(); ++k) {
+      const Vec3 local = props.principal_axes.transpose() * (spheres[k].centre - props.centre_of_mass) * scale;
+      t.centres.push_back({local.x(), local.y(), local.z()});
+      t.radii.push_back(spheres[k].radius * scale);
+    }
+    const double s5 = std::pow(scale, 5);
+    t.inertia_per_density = {props.principal_moments.x() * s5, props.principal_moments.y() * s5, props.principal_moments.z() * s5};
+    t.volume = props.volume * scale * scale * scale;
+    t.bounding_radius = props.bounding_radius * scale;
+    model.clumps.push_back(std::move(t));
+  }
+  auto clump_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
+    if (name.empty()) return -1;
+    for (size_t k = 0; k < model.clumps.size(); ++k)
+      if (model.clumps[k].name == name) return static_cast<int>(k);
+    std::vector<std::string> names;
+    for (const auto& known : model.clumps) names.push_back(known.name);
+    const std::string hint = nearest_word(name, names);
+    throw CaseError(fmt::format("{}: {}: unknown clump template '{}'{}; define it under `clumps:`", where.str(), key, name,
+                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
+  };
+  // Largest and smallest sphere a size distribution can create, for a sphere or a clump.
+  model.radius_min = std::numeric_limits<double>::infinity();
+  auto extend_radii = [&](const SizeDistributionSpec& d, int clump) {
+    double big = 0.5, small = 0.5;
+    if (clump >= 0) {
+      const auto& radii = model.clumps[clump].radii;
+      big = *std::max_element(radii.begin(), radii.end());
+      small = *std::min_element(radii.begin(), radii.end());
+    }
+    model.radius_max = std::max(model.radius_max, big * d.largest());
+    model.radius_min = std::min(model.radius_min, small * d.smallest());
+  };
+  for (size_t k = 0; k < spec.particles.size(); ++k) {
+    const ParticleSetSpec& p = spec.particles[k];
+    const std::string key = fmt::format("particles[{}]", k);
+    ParticleSource source{p, material_or_fail(p.material, p.location, key + ".material"),
+                          clump_or_fail(p.clump, p.location, key + ".clump")};
+    extend_radii(p.diameter, source.clump);
+    // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
+    if (!p.attach_to.empty()) {
+      for (size_t w = 0; w < model.planes.size(); ++w)
+        if (model.planes[w].name == p.attach_to) source.attached = static_cast<int>(w);
+      std::vector<std::string> names;
+      for (const PlaneWall& w : model.planes) names.push_back(w.name);
+      const std::string hint = nearest_word(p.attach_to, names);
+      if (source.attached < 0)
+        throw CaseError(fmt::format("{}: {}.attach_to: no wall named '{}'{}; particles glue to a plane wall under `walls:`",
+                                    p.location.str(), key, p.attach_to,
+                                    hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
+      if (model.planes[source.attached].cylinder)
+        throw CaseError(fmt::format("{}: {}.attach_to: '{}' is a cylinder; particles glue only to plane walls",
+                                    p.location.str(), key, p.attach_to));
+      if (source.clump >= 0)
+        throw CaseError(fmt::format("{}: {}.attach_to: glued particles must be spheres (drop `clump`)", p.location.str(), key));
+      model.has_attached = true;
+    }
+    model.sources.push_back(std::move(source));
+  }
+  // Particle counts are bounded before anything is allocated for them: a mistyped `count`
+  // (an extra zero or three) must be an error, not an out-of-memory kill minutes later.
+  {
+    std::int64_t total = 0;
+    for (size_t k = 0; k < spec.particles.size(); ++k) {
+      const ParticleSetSpec& p = spec.particles[k];
+      total += p.count;
+      if (total > kMaxParticles)
+        throw CaseError(fmt::format("{}: particles[{}].count: {} particles in all exceeds the limit of {} (about {:.0f} GB at "
+                                    "~1 kB per particle with its contacts); lower `count`",
+                                    p.location.str(), k, total, kMaxParticles, kMaxParticles * 1e3 / 1e9));
+      if (!p.positions.empty()) continue;
+      // Random placement without overlap stops near 30-35 % solid: refuse what cannot fit
+      // before drawing any diameter.
+      const double region = (p.region_max - p.region_min).prod();
+      const double d = p.diameter.smallest();
+      const double scale = p.clump.empty() ? 1.0 : 0.5;  // a clump's spheres may overlap
+      const double solid = static_cast<double>(p.count) * std::numbers::pi / 6.0 * d * d * d * scale;
+      if (!(solid <= 0.6 * region))
+        throw CaseError(fmt::format("{}: particles[{}].count: {} particles of at least {:g} m hold {:.3g} m^3 of solid, "
+                                    "{:.0f} % of the region's {:.3g} m^3; random placement stops near 30-35 %. Enlarge "
+                                    "`region` or lower `count`",
+                                    p.location.str(), k, p.count, d, solid, 100.0 * solid / region, region));
+    }
+  }
+  const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());
+  for (size_t k = 0; k < spec.inlets.size(); ++k) {
+    const InletSpec& in = spec.inlets[k];
+    const std::string key = fmt::format("inlets[{}]", k);
+    Inlet inlet{in, material_or_fail(in.material, in.location, key + ".material"), clump_or_fail(in.clump, in.location, key + ".clump"), in.interval};
+    extend_radii(in.diameter, inlet.clump);
+    model.inlets.push_back(std::move(inlet));
+  }
+  model.outlets = spec.outlets;
+  for (size_t k = 0; k < spec.inlets.size(); ++k)
+    if (!spec.inlets[k].port.empty() && !(spec.inlets[k].region_max.array() > spec.inlets[k].region_min.array()).all())
+      throw CaseError(fmt::format("{}: inlets[{}].port: '{}' names an equipment port that was not resolved: the "
+                                  "case needs `equipment:` with that port (or give `region` instead)",
+                                  spec.inlets[k].location.str(), k, spec.inlets[k].port));
+  // Sensors: unit directions, a slab a couple of particles thick, unique names.
+  for (size_t k = 0; k < spec.sensors.size(); ++k) {
+    SensorSpec sensor = spec.sensors[k];
+    for (size_t j = 0; j < k; ++j)
+      if (spec.sensors[j].name == sensor.name)
+        throw CaseError(fmt::format("{}: sensors[{}].name: '{}' is used twice; sensor names must differ", sensor.location.str(), k, sensor.name));
+    sensor.normal.normalize();
+    sensor.across.normalize();
+    if (sensor.kind == SensorSpec::Kind::plane && sensor.thickness <= 0) sensor.thickness = 4.0 * model.radius_max;
+    model.sensors.push_back(sensor);
+  }
+  model.design = spec.design;
+  model.equipment_camera = spec.equipment_camera;
+
+  // Options.
+  const SimulationSpec& s = spec.simulation;
+  model.duration = s.duration;
+  model.gravity = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
+  model.seed = s.seed;
+  model.stop_on_trouble = s.stop_on_trouble;
+  model.max_overlap_ratio = s.max_overlap_ratio;
+  model.energy_rise_limit = s.energy_rise_limit;
+  model.threads = s.threads;
+  model.skin = s.skin > 0 ? s.skin : 0.5 * model.radius_min;
+  model.has_domain = s.has_domain;
+  model.domain_min = {s.domain_min.x(), s.domain_min.y(), s.domain_min.z()};
+  model.domain_max = {s.domain_max.x(), s.domain_max.y(), s.domain_max.z()};
+  model.output = spec.output;
+  for (int a = 0; a < 3; ++a)
+    if (s.periodic[a]) model.period[a] = s.domain_max[a] - s.domain_min[a];
+  for (const ActiveEffect& e : model.effects) {
+    if (!e.spec->range) continue;
+    for (int t = 0; t < n * n; ++t) {
+      const double* row = model.pair_row(t);
+      model.interaction_range = std::max(model.interaction_range, e.spec->range(row, row + e.param_offset, model.radius_max));
+    }
+  }
+
+  model.advice = advise_time_step(model, s);
+  model.dt = model.advice.dt;
+  if (!model.advice.safe && s.refuse_unsafe_step)
+    throw CaseError(fmt::format("{}: simulation.time_step: {:g} s is unsafe for this material and particle size:\n{}\n"
+                                "Use a smaller step, `time_step: auto`, or `unsafe_time_step: warn` to run anyway.",
+                                spec.path, model.dt, model.advice.report));
+  if (!model.advice.safe) model.notes.push_back("time step is unsafe (unsafe_time_step: warn):\n" + model.advice.report);
+
+  // Inlets insert in batches: often enough that a batch is a thin layer of the region.
+  for (Inlet& inlet : model.inlets) {
+    if (inlet.interval > 0) continue;
+    const Vec3 extent = inlet.spec.region_max - inlet.spec.region_min;
+    const double speed = inlet.spec.velocity.norm();
+    const double clear = speed > 0 ? 0.25 * extent.maxCoeff() / speed
+                                   : (g_norm > 0 ? 0.25 * std::sqrt(2.0 * extent.maxCoeff() / g_norm) : 0.01);
+    inlet.interval = std::clamp(clear, 20.0 * model.dt, 0.05);
+  }
+  // Servo walls: area from the periodic cross-section, speed limit from the step.
+  for (size_t k = 0; k < model.planes.size(); ++k) {
+    PlaneWall& w = model.planes[k];
+    if (!w.servo) continue;
+    if (w.servo_area <= 0) {
+      double area = 1.0;
+      int axes = 0;
+      for (int a = 0; a < 3; ++a)
+        if (std::abs(w.normal[a]) < 1e-12 && model.period[a] > 0) area *= model.period[a], ++axes;
+      if (axes != 2)
+        throw CaseError(fmt::format("{}: walls[{}].servo.area: needed unless the wall's normal is an axis and the two "
+                                    "other axes are periodic", spec.planes[k].location.str(), k));
+      w.servo_area = area;
+    }
+    if (w.servo_max_speed <= 0) w.servo_max_speed = 0.002 * model.radius_min / model.dt;
+  }
+  // Periodic axes: the minimum image is unique only if a period spans three cells.
+  const double cell = 2.0 * model.radius_max + model.interaction_range + model.skin;
+  for (int a = 0; a < 3; ++a)
+    if (model.period[a] > 0 && model.period[a] < 3.0 * cell)
+      throw CaseError(fmt::format("{}: simulation.domain: the periodic length along {} is {:g} m; it must be at least "
+                                  "three neighbour cells, {:g} m (2 x largest radius + interaction range + skin, x 3)",
+                                  spec.path, "xyz"[a], model.period[a], 3.0 * cell));
+
+  // Hash of what determines the physics (checkpoints refuse a different model).
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  h = fnv1a(model.pair_table.data(), model.pair_table.size() * sizeof(double), h);
+  for (const ActiveEffect& e : model.effects) h = fnv1a(e.spec->name.data(), e.spec->name.size(), h);
+  h = fnv1a(&model.dt, sizeof model.dt, h);
+  h = fnv1a(model.gravity.data(), sizeof model.gravity, h);
+  for (const PlaneWall& w : model.planes) {
+    h = fnv1a(w.point.data(), sizeof w.point, h);
+    h = fnv1a(w.normal.data(), sizeof w.normal, h);
+  }
+  model.hash = h;
+  return model;
+}
+
+std::string describe_effects() {
+  std::string out;
+  for (const EffectSpec* e : effect_table()) {
+    out += fmt::format("contact.{}: {}\n    {}\n    source: {}\n", kStageKeys[static_cast<int>(e->stage)], e->name,
+                       e->summary, e->citation);
+    for (const ParamSpec& p : e->params)
+      out += fmt::format("    {:<26} [{}] default {:g}, range [{:g}, {:g}]{}: {}\n", p.key, p.unit, p.default_value,
+                         p.min_value, p.max_value, p.tunable ? ", tunable" : "", p.doc);
+    for (const OptionSpec& o : e->options) {
+      std::string values;
+      for (const auto& v : o.values) values += (values.empty() ? "" : " | ") + std::string(v);
+      out += fmt::format("    option {}: {} (default {}): {}\n", o.key, values, o.values[0], o.doc);
+    }
+    for (const HistorySpec& hs : e->history) out += fmt::format("    history: {} ({} values)\n", hs.name, hs.width);
+    if (const CandidateSpec* c = e->candidate) {
+      std::string fitted, moves;
+      for (const FittedParam& f : c->fitted)
+        fitted += fmt::format("{}{} from {:g} in [{:g}, {:g}]{}", fitted.empty() ? "" : ", ", f.key, f.start, f.min, f.max,
+                              c->scale ? " (x the material's scale)" : "");
+      for (const std::string_view m : c->moves) moves += (moves.empty() ? "" : ", ") + std::string(m);
+      out += fmt::format("    diagnosis candidate ({}): fits {}\n      signature: {}\n      moves: {}\n", c->title, fitted,
+                         c->signature, moves);
+    }
+  }
+  return out;
+}
+
+}  // namespace dem

@@ -1,0 +1,102 @@
+#include "core/timestep.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace dem {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kMaxRayleighFraction = 0.4;
+constexpr double kMinStepsPerContact = 8.0;
+constexpr double kAutoStepsPerContact = 20.0;
+}  // namespace
+
+double rayleigh_time(double radius, double density, double youngs, double poisson) {
+  const double shear = youngs / (2.0 * (1.0 + poisson));
+  return kPi * radius * std::sqrt(density / shear) / (0.1631 * poisson + 0.8766);
+}
+
+double hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed) {
+  return 2.8683 * std::pow(m_eff * m_eff / (r_eff * youngs_eff * youngs_eff * speed), 0.2);
+}
+
+TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
+  TimeStepAdvice advice;
+  // Characteristic impact speed: given, or the largest of initial speeds and a free fall over
+  // the height the particles start above the lowest point of the scene.
+  double speed = sim.characteristic_velocity;
+  if (speed <= 0) {
+    const double g = std::sqrt(model.gravity[0] * model.gravity[0] + model.gravity[1] * model.gravity[1] +
+                               model.gravity[2] * model.gravity[2]);
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    const Vec3 down = g > 0 ? Vec3(model.gravity[0], model.gravity[1], model.gravity[2]) / g : Vec3(0, 0, -1);
+    for (const ParticleSource& s : model.sources) {
+      speed = std::max(speed, s.spec.velocity.norm() + s.spec.angular_velocity.norm() * 0.5 * s.spec.diameter.largest());
+      auto extend = [&](const Vec3& p) { low = std::min(low, -down.dot(p)), high = std::max(high, -down.dot(p)); };
+      for (const Vec3& p : s.spec.positions) extend(p);
+      if (s.spec.positions.empty()) extend(s.spec.region_min), extend(s.spec.region_max);
+    }
+    for (const PlaneWall& w : model.planes) low = std::min(low, -down.dot(Vec3(w.point[0], w.point[1], w.point[2])));
+    if (std::isfinite(high) && high > low) speed = std::max(speed, std::sqrt(2.0 * g * (high - low)));
+    speed = std::max(speed, 0.1);
+  }
+  advice.characteristic_velocity = speed;
+
+  // Shortest Rayleigh time and contact time over the particle materials and their partners.
+  advice.rayleigh_time = std::numeric_limits<double>::infinity();
+  advice.contact_time = std::numeric_limits<double>::infinity();
+  const bool hertz = !model.effects.empty() && model.effects.front().spec->name == "hertz";
+  struct Kind { int material; double diameter; };
+  std::vector<Kind> kinds;
+  for (const ParticleSource& s : model.sources) kinds.push_back({s.material, s.spec.diameter.smallest()});
+  for (const Inlet& in : model.inlets) {
+    kinds.push_back({in.material, in.spec.diameter.smallest()});
+    speed = std::max(speed, in.spec.velocity.norm());
+  }
+  for (const Kind& s : kinds) {
+    const Material& m = model.materials[s.material];
+    const double radius = 0.5 * s.diameter;
+    const double mass = m.density * 4.0 / 3.0 * kPi * radius * radius * radius;
+    advice.rayleigh_time = std::min(advice.rayleigh_time, rayleigh_time(radius, m.density, m.youngs_modulus, m.poisson_ratio));
+    std::vector<std::pair<int, bool>> partners{{s.material, false}};
+    for (const PlaneWall& w : model.planes) partners.push_back({w.material, true});
+    for (const MeshWall& w : model.meshes) partners.push_back({w.material, true});
+    for (const Kind& o : kinds) partners.push_back({o.material, false});
+    for (auto [other, wall] : partners) {
+      const double m_eff = wall ? mass : 0.5 * mass, r_eff = wall ? radius : 0.5 * radius;
+      const double* row = model.pair_row(model.pair_type(s.material, other));
+      double t;
+      if (hertz) {
+        t = hertz_contact_time(m_eff, r_eff, row[0], speed);
+      } else {  // linear: undamped period of the spring with the stiffness the kernel uses
+        double k = row[model.effects.front().param_offset];
+        if (k <= 0) {
+          const double v = row[model.effects.front().param_offset + 1];
+          k = 16.0 / 15.0 * std::sqrt(r_eff) * row[0] * std::pow(15.0 * m_eff * v * v / (16.0 * std::sqrt(r_eff) * row[0]), 0.2);
+        }
+        t = kPi * std::sqrt(m_eff / k);
+      }
+      advice.contact_time = std::min(advice.contact_time, t);
+    }
+  }
+
+  advice.user_given = sim.time_step > 0;
+  advice.dt = advice.user_given ? sim.time_step
+                                : std::min(sim.rayleigh_fraction * advice.rayleigh_time, advice.contact_time / kAutoStepsPerContact);
+  const double fraction = advice.dt / advice.rayleigh_time;
+  const double steps_per_contact = advice.contact_time / advice.dt;
+  advice.safe = (!hertz || fraction <= kMaxRayleighFraction) && steps_per_contact >= kMinStepsPerContact;
+  advice.report = fmt::format(
+      "  time step {:.4g} s ({}): {:.1f} % of the Rayleigh time {:.4g} s{}, {:.1f} steps per contact of {:.4g} s at "
+      "{:.3g} m/s (limits: {:.0f} %, {:.0f} steps)",
+      advice.dt, advice.user_given ? "given" : "auto", 100 * fraction, advice.rayleigh_time, hertz ? "" : " (not binding for a linear law)",
+      steps_per_contact, advice.contact_time, speed, 100 * kMaxRayleighFraction, kMinStepsPerContact);
+  return advice;
+}
+
+}  // namespace dem

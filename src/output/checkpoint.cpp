@@ -1,0 +1,128 @@
+#include "output/checkpoint.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <type_traits>
+
+namespace dem {
+
+namespace {
+
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
+/// Version 5 lacks State::lists_drift_velocity: read as zero, which is always a valid drift
+/// (verlet.h), so its runs resume.
+constexpr char kMagic5[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
+
+/// Every field of the State, in one order, for both directions (`version` 5 or 6).
+template <typename Io, typename S>
+void visit(Io& io, S& s, int version = 6) {
+  io(s.time), io(s.step), io(s.next_id), io(s.lost), io(s.lost_mass);
+  for (auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
+                  &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
+                  &s.z_built})
+    io(*c);
+  io(s.material), io(s.id), io(s.body), io(s.attached);
+  auto& b = s.bodies;
+  for (auto* c : {&b.x, &b.y, &b.z, &b.vx, &b.vy, &b.vz, &b.qw, &b.qx, &b.qy, &b.qz, &b.lx, &b.ly, &b.lz, &b.fx, &b.fy,
+                  &b.fz, &b.tx, &b.ty, &b.tz, &b.mass, &b.ix, &b.iy, &b.iz})
+    io(*c);
+  io(b.id);
+  auto& w = s.walls;
+  for (auto* c : {&w.px, &w.py, &w.pz, &w.vx, &w.vy, &w.vz, &w.fx, &w.fy, &w.fz}) io(*c);
+  io(s.inlets), io(s.outlets);
+  for (auto* list : {&s.pairs, &s.wall_pairs}) io(list->i), io(list->j), io(list->history);
+  io(s.has_meshes), io(s.mesh_history_width);
+  auto& mc = s.mesh_contacts;
+  io(mc.count), io(mc.mesh), io(mc.triangle), io(mc.px), io(mc.py), io(mc.pz), io(mc.history);
+  io(s.candidate_begin), io(s.mesh_candidates), io(s.lists_built_time);
+  if (version >= 6) io(s.lists_drift_velocity);
+  std::uint64_t meshes = s.records.size();
+  io(meshes);
+  if constexpr (!std::is_const_v<S>) s.records.resize(meshes);
+  for (auto& r : s.records) io(r.normal_impulse), io(r.shear_impulse), io(r.shear_work), io(r.impacts), io(r.impact_energy);
+  for (auto* c : {&s.mesh_loads.fx, &s.mesh_loads.fy, &s.mesh_loads.fz, &s.mesh_loads.tx, &s.mesh_loads.ty, &s.mesh_loads.tz,
+                  &s.mesh_loads.power})
+    io(*c);
+}
+
+struct Writer {
+  std::ofstream& out;
+  template <typename T>
+  void operator()(const T& value) {
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+    } else {
+      const std::uint64_t count = value.size();
+      out.write(reinterpret_cast<const char*>(&count), sizeof count);
+      out.write(reinterpret_cast<const char*>(value.data()), static_cast<std::streamsize>(count * sizeof(value[0])));
+    }
+  }
+};
+
+struct Reader {
+  std::ifstream& in;
+  const std::string& path;
+  std::uint64_t remaining;  // bytes left in the file, bounds every allocation
+  void read(void* data, std::uint64_t bytes) {
+    if (bytes > remaining) throw std::runtime_error(fmt::format("{}: checkpoint is truncated or corrupt", path));
+    in.read(static_cast<char*>(data), static_cast<std::streamsize>(bytes));
+    if (!in) throw std::runtime_error(fmt::format("{}: checkpoint is truncated", path));
+    remaining -= bytes;
+  }
+  template <typename T>
+  void operator()(T& value) {
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      read(&value, sizeof(T));
+    } else {
+      std::uint64_t count = 0;
+      read(&count, sizeof count);
+      if (count > remaining / sizeof(value[0]) + 1) throw std::runtime_error(fmt::format("{}: checkpoint is corrupt", path));
+      value.resize(count);
+      read(value.data(), count * sizeof(value[0]));
+    }
+  }
+};
+
+}  // namespace
+
+void save_checkpoint(const std::string& path, const Model& model, const State& state) {
+  const std::filesystem::path target(path);
+  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
+  const std::string temporary = path + ".part";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(kMagic, sizeof kMagic);
+    Writer writer{out};
+    writer(model.hash);
+    visit(writer, state);
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write the checkpoint (disk full?)", temporary));
+  }
+  std::filesystem::rename(temporary, target);
+}
+
+State load_checkpoint(const std::string& path, const Model& model) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("{}: no checkpoint to resume from", path));
+  Reader reader{in, path, static_cast<std::uint64_t>(std::filesystem::file_size(path))};
+  char magic[sizeof kMagic];
+  reader.read(magic, sizeof magic);
+  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0 ? 6 : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5 : 0;
+  if (version == 0) throw std::runtime_error(fmt::format("{}: not a demdesign checkpoint of this version", path));
+  std::uint64_t hash = 0;
+  reader(hash);
+  if (hash != model.hash)
+    throw std::runtime_error(fmt::format("{}: the checkpoint belongs to a different model (the case's physics changed "
+                                         "since it was written); run without --resume to start again",
+                                         path));
+  State state;
+  visit(reader, state, version);
+  return state;
+}
+
+}  // namespace dem

@@ -1,0 +1,461 @@
+#include "output/run.h"
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+#include <omp.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include "core/domain.h"
+#include "core/step.h"
+#include "output/checkpoint.h"
+#include "output/results_hdf5.h"
+
+namespace dem {
+
+namespace {
+
+std::atomic<int> stop_signal{0};
+extern "C" void on_stop_signal(int signal) { stop_signal = signal; }
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  if (s >= 3600) return fmt::format("{}h{:02}m", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{}m{:02}s", s / 60, s % 60);
+  return fmt::format("{}s", s);
+}
+
+std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
+  std::string out =
+      "time_s,step,particles,kinetic_translation_J,kinetic_rotation_J,contacts,max_overlap_ratio,mean_overlap_ratio,"
+      "dt_s,lost,inserted_mass_kg,removed_mass_kg";
+  for (const OutletSpec& o : model.outlets) out += fmt::format(",outlet_{}_kg", o.name);
+  for (const PlaneWall& w : model.planes) out += fmt::format(",wall_{}_normal_force_N", w.name);
+  for (const MeshWall& m : model.meshes)
+    out += fmt::format(",mesh_{0}_force_N,mesh_{0}_torque_Nm,mesh_{0}_power_W", m.name);
+  out += ",lost_mass_kg";
+  for (const SensorSpec& s : model.sensors)
+    out += s.kind == SensorSpec::Kind::plane ? fmt::format(",sensor_{}_flow_kg_s", s.name)
+                                             : fmt::format(",sensor_{0}_mass_kg,sensor_{0}_vx_m_s,sensor_{0}_vy_m_s,sensor_{0}_vz_m_s,sensor_{0}_offset_m", s.name);
+  out += "\n";
+  for (const Scalars& r : rows) {
+    out += fmt::format("{:.9g},{},{},{:.9g},{:.9g},{},{:.6g},{:.6g},{:.6g},{},{:.9g},{:.9g}", r.time, r.step, r.particles,
+                       r.kinetic_translation, r.kinetic_rotation, r.contacts, r.max_overlap_ratio, r.mean_overlap_ratio,
+                       r.dt, r.lost, r.inserted_mass, r.removed_mass);
+    for (double m : r.outlet_mass) out += fmt::format(",{:.9g}", m);
+    for (double f : r.wall_normal_force) out += fmt::format(",{:.9g}", f);
+    for (size_t m = 0; m < r.mesh_force.size(); ++m)
+      out += fmt::format(",{:.9g},{:.9g},{:.9g}", r.mesh_force[m], r.mesh_torque[m], r.mesh_power[m]);
+    out += fmt::format(",{:.9g}", r.lost_mass);
+    for (size_t k = 0; k < model.sensors.size() && k < r.sensors.size(); ++k) {
+      const SensorReading& s = r.sensors[k];
+      out += model.sensors[k].kind == SensorSpec::Kind::plane
+                 ? fmt::format(",{:.9g}", s.flow)
+                 : fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", s.mass, s.vx, s.vy, s.vz, s.offset);
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+/// Rows of an earlier scalars.csv up to `time` (a resumed run keeps what it had computed).
+std::vector<Scalars> read_scalars(const Model& model, const std::string& path, double time) {
+  std::vector<Scalars> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::stringstream fields(line);
+    std::string cell;
+    std::vector<double> v;
+    while (std::getline(fields, cell, ',')) v.push_back(std::stod(cell));
+    if (v.size() < 12 || v[0] > time + 1e-12) break;
+    Scalars r;
+    r.time = v[0], r.step = static_cast<std::int64_t>(v[1]), r.particles = static_cast<size_t>(v[2]);
+    r.kinetic_translation = v[3], r.kinetic_rotation = v[4], r.contacts = static_cast<size_t>(v[5]);
+    r.max_overlap_ratio = v[6], r.mean_overlap_ratio = v[7], r.dt = v[8], r.lost = static_cast<std::int64_t>(v[9]);
+    r.inserted_mass = v[10], r.removed_mass = v[11];
+    // Then one column per outlet, per wall, three per mesh, lost mass, the sensors' columns.
+    const size_t outlets = model.outlets.size(), walls = model.planes.size(), meshes = model.meshes.size();
+    size_t sensor_columns = 0;
+    for (const SensorSpec& s : model.sensors) sensor_columns += s.kind == SensorSpec::Kind::plane ? 1 : 5;
+    if (v.size() != 13 + outlets + walls + 3 * meshes + sensor_columns) break;
+    size_t c = 12;
+    for (size_t k = 0; k < outlets; ++k) r.outlet_mass.push_back(v[c++]);
+    for (size_t k = 0; k < walls; ++k) r.wall_normal_force.push_back(v[c++]);
+    for (size_t k = 0; k < meshes; ++k) {
+      r.mesh_force.push_back(v[c++]);
+      r.mesh_torque.push_back(v[c++]);
+      r.mesh_power.push_back(v[c++]);
+    }
+    r.lost_mass = v[c++];
+    for (const SensorSpec& s : model.sensors) {
+      SensorReading reading;
+      if (s.kind == SensorSpec::Kind::plane) reading.flow = v[c++];
+      else reading.mass = v[c], reading.vx = v[c + 1], reading.vy = v[c + 2], reading.vz = v[c + 3], reading.offset = v[c + 4], c += 5;
+      r.sensors.push_back(reading);
+    }
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+/// The run's set-up as YAML, so every result can be traced to its inputs.
+std::string run_info(const Model& model) {
+  std::string out = fmt::format(
+      "software: demdesign {}\ncase: {}\nmodel_hash: {:016x}\ntime_step_s: {:.9g}\nmass_scaling: {:g}\n"
+      "stiffness_scaling: {:g}\nrayleigh_time_s: {:.6g}\ncontact_time_s: {:.6g}\ncontact_law:\n",
+      DEMDESIGN_VERSION, model.source, model.hash, model.dt, model.mass_scaling, model.stiffness_scaling,
+      model.advice.rayleigh_time, model.advice.contact_time);
+  for (const ActiveEffect& e : model.effects)
+    out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", kStageKeys[static_cast<int>(e.spec->stage)],
+                       e.spec->name, e.spec->citation);
+  out += "materials:\n";
+  for (const Material& m : model.materials)
+    out += fmt::format("  {}: {{density: {:.9g}, youngs_modulus: {:.9g}, poisson_ratio: {:g}}}\n", m.name, m.density,
+                       m.youngs_modulus, m.poisson_ratio);
+  return out;
+}
+
+FrameWriter make_frame_writer(const Model& model, const std::string& directory) {
+  std::vector<std::string> names;
+  for (const Material& m : model.materials) names.push_back(m.name);
+  return FrameWriter(directory, names,
+                     {{"software", fmt::format("demdesign {}", DEMDESIGN_VERSION)},
+                      {"case", model.source},
+                      {"mass_scaling", fmt::format("{:g}", model.mass_scaling)},
+                      {"stiffness_scaling", fmt::format("{:g}", model.stiffness_scaling)},
+                      {"time_step_s", fmt::format("{:.9g}", model.dt)}});
+}
+
+void write_frame(FrameWriter& writer, const State& s) {
+  // Orientation per sphere: its body's, identity for free spheres.
+  const size_t n = s.size();
+  std::vector<double> qw(n, 1.0), qx(n, 0.0), qy(n, 0.0), qz(n, 0.0);
+  for (size_t p = 0; p < n; ++p) {
+    const std::int32_t b = s.body[p];
+    if (b < 0) continue;
+    qw[p] = s.bodies.qw[b], qx[p] = s.bodies.qx[b], qy[p] = s.bodies.qy[b], qz[p] = s.bodies.qz[b];
+  }
+  ParticleFrame frame;
+  frame.time = s.time, frame.step = s.step, frame.count = n;
+  frame.id = s.id.data();
+  frame.x = s.x.data(), frame.y = s.y.data(), frame.z = s.z.data();
+  frame.vx = s.vx.data(), frame.vy = s.vy.data(), frame.vz = s.vz.data();
+  frame.wx = s.wx.data(), frame.wy = s.wy.data(), frame.wz = s.wz.data();
+  frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
+  frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
+  writer.write_frame(frame);
+}
+
+/// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
+void write_mesh_records(const Model& model, const State& s, const std::string& out) {
+  std::vector<MeshFieldSet> sets;
+  const double duration = std::max(s.time - model.output.records_from, 1e-30);  // [s] the records' interval
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const MeshWall& mesh = model.meshes[m];
+    MeshFieldSet set;
+    set.name = mesh.name;
+    set.triangles = mesh.surface->triangles;
+    const Pose pose = mesh.motion.pose(s.time);
+    for (const auto& v : mesh.surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      set.vertices.push_back({w.x(), w.y(), w.z()});
+    }
+    const TriangleRecords& r = s.records[m];
+    const auto& area = mesh.surface->areas;
+    auto per_area_rate = [&](const std::vector<double>& total) {
+      std::vector<double> rate(total.size());
+      for (size_t t = 0; t < total.size(); ++t) rate[t] = area[t] > 0 ? total[t] / (area[t] * duration) : 0.0;
+      return rate;
+    };
+    set.fields = {{"mean_pressure_Pa", per_area_rate(r.normal_impulse)},
+                  {"mean_shear_stress_Pa", per_area_rate(r.shear_impulse)},
+                  {"shear_work_rate_W_per_m2", per_area_rate(r.shear_work)},
+                  {"impact_energy_rate_W_per_m2", per_area_rate(r.impact_energy)},
+                  {"impacts_per_s_m2", per_area_rate(r.impacts)},
+                  {"shear_work_J", r.shear_work},
+                  {"impact_energy_J", r.impact_energy},
+                  {"impacts", r.impacts}};
+    sets.push_back(std::move(set));
+  }
+  write_mesh_fields(out, sets, s.time);
+}
+
+}  // namespace
+
+void write_file_atomically(const std::string& path, const std::string& content) {
+  const std::filesystem::path target(path);
+  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
+  const std::string temporary = path + ".part";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << content;
+    out.flush();
+    out.close();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw std::runtime_error(fmt::format("{}: cannot write {} bytes (disk full, file size limit or no permission?); "
+                                           "the previous {} is kept unchanged",
+                                           path, content.size(), target.filename().string()));
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, target, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    throw std::runtime_error(fmt::format("{}: cannot replace it ({}); the previous version is kept", path, error.message()));
+  }
+}
+
+void print_setup(const Model& model, const State& state, std::ostream& log) {
+  fmt::print(log, "demdesign {}: {}{}\n", DEMDESIGN_VERSION, model.source, model.title.empty() ? "" : " - " + model.title);
+  fmt::print(log, "  {} spheres ({} clumps), {} materials, {} plane walls, {} inlets, {} outlets, {} threads\n",
+             state.size(), state.bodies.size(), model.materials.size(), model.planes.size(), model.inlets.size(),
+             model.outlets.size(), omp_get_max_threads());
+  std::string law;
+  for (const ActiveEffect& e : model.effects)
+    law += fmt::format("{}{}: {}", law.empty() ? "" : ", ", kStageKeys[static_cast<int>(e.spec->stage)], e.spec->name);
+  fmt::print(log, "  contact law: {}\n", law);
+  for (const ActiveEffect& e : model.effects) fmt::print(log, "    {}: {}\n", e.spec->name, e.spec->citation);
+  fmt::print(log, "{}\n", model.advice.report);
+  if (model.mass_scaling != 1.0 || model.stiffness_scaling != 1.0)
+    fmt::print(log, "  SCALING: particle density x {:g} (mass scaling), particle Young's modulus x {:g} (reduced "
+                    "stiffness); both are written with every result\n",
+               model.mass_scaling, model.stiffness_scaling);
+  else
+    fmt::print(log, "  scaling: none (mass x 1, stiffness x 1)\n");
+  if (model.periodic())
+    fmt::print(log, "  periodic: {}{}{} (periods {:g} {:g} {:g} m)\n", model.period[0] > 0 ? "x" : "", model.period[1] > 0 ? "y" : "",
+               model.period[2] > 0 ? "z" : "", model.period[0], model.period[1], model.period[2]);
+  fmt::print(log, "  neighbour skin {:.3g} m, interaction range {:.3g} m\n", model.skin, model.interaction_range);
+  for (const std::string& note : model.notes) fmt::print(log, "  note: {}\n", note);
+}
+
+RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log) {
+  RunSummary summary;
+  summary.output_directory = options.output_directory.empty() ? model.output.directory : options.output_directory;
+  const std::string out = summary.output_directory;
+  const std::string checkpoint_path = out + "/checkpoint.bin";
+  const double duration = options.duration >= 0 ? options.duration : model.duration;
+  const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
+  // Under domain decomposition every rank steps its share with the domain's model; the root
+  // gathers the whole state wherever a result is due and writes it as one process would.
+  Domain* domain = options.domain;
+  const bool writer = domain == nullptr || domain->root();
+  const Model& stepped = domain ? domain->local_model() : model;
+  work.domain = domain;
+
+  if (options.resume) {
+    state = load_checkpoint(checkpoint_path, model);
+    if (writer) summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
+    if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
+  }
+  if (writer) print_setup(model, state, log);
+  EnergyWatch energy(model, state, model.energy_rise_limit);
+  if (domain) domain->distribute(state);
+  prepare(stepped, state, work);
+
+  // The whole state for results: the state itself, or (domain) the root's gathered copy with
+  // its lists rebuilt and, for the scalars, its contact forces evaluated on a second copy.
+  std::optional<WholeState> whole;
+  const State* results = &state;   // positions, counters, histories
+  const State* measured = &state;  // the same with this instant's forces
+  const Workspace* results_work = &work;
+  bool whole_fresh = false;
+  auto gather_whole = [&]() {
+    if (!domain) return;
+    State gathered = domain->gather(state);
+    if (!writer) return;
+    whole = ready_for_results(model, std::move(gathered));
+    results = &whole->state, measured = &whole->evaluated, results_work = &whole->work;
+    whole_fresh = true;
+  };
+  gather_whole();
+  if (!options.resume && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
+
+  const std::int64_t first_step = state.step;
+  std::int64_t last_step = end_step;
+  if (options.max_steps >= 0) last_step = std::min(last_step, first_step + options.max_steps);
+  const std::int64_t total = std::max<std::int64_t>(last_step - first_step, 0);
+  const std::int64_t every =
+      model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, end_step / 200);
+  const std::int64_t frame_every = std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::llround((model.output.frames_every > 0 ? model.output.frames_every : duration / 20) / model.dt)));
+  const std::int64_t checkpoint_every =
+      model.output.checkpoint_every > 0 ? std::max<std::int64_t>(1, std::llround(model.output.checkpoint_every / model.dt)) : 0;
+
+  std::optional<FrameWriter> frames;
+  if (options.write_files && writer) {
+    write_file_atomically(out + "/run_info.yaml", run_info(model));
+    frames.emplace(make_frame_writer(model, out));
+    if (options.resume) frames->adopt_existing();
+    else write_frame(*frames, *results);
+  }
+  // Trouble present from the start (particles created overlapping): told before the first step.
+  if (!options.resume && writer) {
+    try {
+      check_numerics(model, *results, *results_work, model.max_overlap_ratio);
+    } catch (const NumericalError& e) {
+      if (model.stop_on_trouble) throw;
+      fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+    }
+  }
+  stop_signal = 0;
+  auto previous_int = std::signal(SIGINT, on_stop_signal);
+  auto previous_term = std::signal(SIGTERM, on_stop_signal);
+  // Numerical trouble: checked every few steps (cheap next to a step), so it is caught within
+  // a few steps of its start, not at the next row of scalars.
+  const std::int64_t check_every = std::min<std::int64_t>(every, 10);
+  if (!energy.active() && writer) fmt::print(log, "  energy check: off ({})\n", energy.source());
+  std::int64_t lost_reported = state.lost, warnings = 0;
+  auto trouble = [&](const NumericalError& e) {
+    if (model.stop_on_trouble) {
+      // Keep what was computed: the rows so far (the last checkpoint stays as it was).
+      if (options.write_files && writer) {
+        try {
+          write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
+        } catch (const std::exception&) {
+        }
+      }
+      std::signal(SIGINT, previous_int);
+      std::signal(SIGTERM, previous_term);
+      throw e;
+    }
+    if (warnings++ < 20) fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+  };
+
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto last_progress = start;
+  std::int64_t particle_steps = 0;
+  // Steps until the next one that checks, records or writes run as one advance() (each closing
+  // kick gives the next step's drift, step.h); under domain decomposition one at a time.
+  const auto steps_to_next_event = [&] {
+    std::int64_t steps = last_step - state.step;
+    for (const std::int64_t every_n : {check_every, every, frame_every, checkpoint_every})
+      if (every_n > 0) steps = std::min(steps, every_n - state.step % every_n);
+    return std::max<std::int64_t>(steps, 1);
+  };
+  while (state.step < last_step) {
+    if (domain) {
+      step(stepped, state, work);
+      particle_steps += static_cast<std::int64_t>(results->size());
+    } else {
+      particle_steps += advance(stepped, state, work, steps_to_next_event());
+    }
+    const bool last = state.step == last_step;
+    const bool check_due = state.step % check_every == 0 || last;
+    // A signal stops every rank at the same step.
+    const bool stopping = domain ? check_due && domain->any(stop_signal != 0) : stop_signal != 0;
+    const bool scalars_due = state.step % every == 0 || last;
+    const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
+    const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
+    if (domain && (scalars_due || frame_due || checkpoint_due)) gather_whole();
+    if (check_due) {
+      std::optional<NumericalError> found;
+      try {
+        check_numerics(stepped, state, work, model.max_overlap_ratio);
+        if (!domain) energy.check(model, state);
+        else if (writer && whole_fresh) whole_fresh = false, energy.check(model, whole->state);
+      } catch (const NumericalError& e) {
+        found = e;
+      }
+      if (domain && domain->any(found.has_value()) && !found)
+        found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
+      if (found) trouble(*found);
+      if (writer && results->lost > lost_reported) {
+        const auto& p = results->last_lost;
+        // The first loss, then each tenfold: a leak is told, not repeated every step.
+        if (lost_reported == 0 || results->lost >= 10 * lost_reported)
+          fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; "
+                          "the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. Likely "
+                          "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
+                          "large that particles pass through a wall\n",
+                     state.time, results->lost, p.id, p.x, p.y, p.z, p.vx, p.vy, p.vz);
+        if (lost_reported == 0 || results->lost >= 10 * lost_reported) lost_reported = results->lost;
+      }
+    }
+    if (scalars_due && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
+    if (frames && frame_due) {
+      write_frame(*frames, *results);
+      if (options.on_frame) options.on_frame(model, *results, *results_work, out, last);
+    }
+    if (checkpoint_due && writer) {
+      save_checkpoint(checkpoint_path, model, *results);
+      write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
+    }
+    if (stopping) {
+      if (writer)
+        fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
+                   state.time);
+      break;
+    }
+    const auto now = Clock::now();
+    if (writer && options.progress && std::chrono::duration<double>(now - last_progress).count() >= model.output.progress_seconds) {
+      last_progress = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const std::int64_t done = state.step - first_step;
+      const double left = elapsed / static_cast<double>(done) * static_cast<double>(last_step - state.step);
+      fmt::print(log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
+                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), results->size(), particle_steps / elapsed,
+                 format_duration(left));
+      log.flush();
+    }
+  }
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  summary.steps = state.step - first_step;
+  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
+  if (!writer) return summary;
+
+  const State& final_state = *results;
+  const Scalars& final_row = summary.scalars.back();
+  fmt::print(log, "  done: {} steps to t = {:.6g} s in {:.2f} s ({:.3g} particle-steps/s, {} neighbour-list rebuilds)\n",
+             summary.steps, state.time, summary.wall_seconds, summary.particle_steps_per_second, work.rebuilds);
+  fmt::print(log, "  end: {} particles, {} contacts, kinetic energy {:.4g} J, max overlap {:.2g} % of radius{}\n",
+             final_row.particles, final_row.contacts, final_row.kinetic_translation + final_row.kinetic_rotation,
+             100 * final_row.max_overlap_ratio, final_state.lost ? fmt::format(", {} particles left the domain", final_state.lost) : "");
+  for (size_t k = 0; k < model.inlets.size(); ++k)
+    fmt::print(log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, final_state.inlets[k].inserted,
+               final_state.inlets[k].inserted_mass,
+               final_state.inlets[k].failed ? fmt::format(" ({} insertions found the region full)", final_state.inlets[k].failed) : "");
+  for (size_t k = 0; k < model.outlets.size(); ++k)
+    fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, final_state.outlets[k].removed,
+               final_state.outlets[k].removed_mass);
+  if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
+  if (options.write_files) {
+    write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    if (frames) write_paraview_script(out);
+    // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
+    write_file_atomically(out + "/run_info.yaml",
+                          run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
+                                                        "  state_hash: {:016x}\n",
+                                                        state.step >= last_step ? "true" : "false", state.time, state.step,
+                                                        final_state.size(), state_hash(final_state, model.history_width)));
+    fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", out,
+               frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
+  }
+  if (domain) fmt::print(log, "  domain (rank 0): {}\n", domain->statistics());
+  if (domain) {  // the caller (reports, renders) gets the whole state, with this instant's forces
+    state = std::move(whole->evaluated);
+    work = std::move(whole->work);
+  }
+  return summary;
+}
+
+}  // namespace dem

@@ -1,0 +1,56 @@
+// Running a compiled case from its initial state to its end time: progress with time left,
+// per-step scalars to CSV (written atomically), numerical checks.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "core/model.h"
+#include "core/state.h"
+#include "core/workspace.h"
+#include "statistics/diagnostics.h"
+
+namespace dem {
+
+class Domain;
+
+struct RunOptions {
+  double duration = -1;           ///< [s] overrides the case's when >= 0
+  std::int64_t max_steps = -1;    ///< stop after this many steps when >= 0 (shortened runs)
+  std::string output_directory;   ///< overrides the case's when not empty
+  bool write_files = true;
+  bool progress = true;
+  bool resume = false;            ///< continue from OUT/checkpoint.bin
+  /// Called after each particle frame is written (the app renders images here; the engine
+  /// knows nothing of rendering). `last` is true for the final frame of the run.
+  std::function<void(const Model&, const State&, const Workspace&, const std::string& out, bool last)> on_frame;
+  /// The ranks sharing this simulation (domain decomposition, domain.h), or null. Every rank
+  /// calls run() with the whole initial state and the same options; the root (rank 0) writes
+  /// the results and returns with the whole final state, the others with their share.
+  Domain* domain = nullptr;
+};
+
+struct RunSummary {
+  std::int64_t steps = 0;
+  double wall_seconds = 0;
+  double particle_steps_per_second = 0;
+  std::vector<Scalars> scalars;
+  std::string output_directory;
+};
+
+/// Prints the model's set-up (effects, time-step advice, notes) to `log`.
+void print_setup(const Model& model, const State& state, std::ostream& log);
+
+/// Runs from the state as it is (prepare() is called here) to the model's end time. With
+/// options.resume the state is replaced by OUT/checkpoint.bin. `log` gets the set-up, progress
+/// and summary lines. SIGINT and SIGTERM stop the run after the current step with a checkpoint.
+RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
+
+/// Writes `content` to `path` through a temporary file and a rename, so a reader never sees a
+/// half-written file. Creates the parent directory.
+void write_file_atomically(const std::string& path, const std::string& content);
+
+}  // namespace dem
