@@ -230,6 +230,78 @@ TEST(KillAndResume, CalibrationCompareKilledThenRerunEndsWithTheSameNumbers) {
   for (const auto& f : fs::directory_iterator(reference / "simulations")) EXPECT_EQ(written.at(f.path().string()), f.last_write_time()) << f.path();
 }
 
+/// ledger.yaml without its `time:` lines (when each version was written).
+std::string ledger_without_times(const fs::path& path) {
+  std::istringstream in(read_text(path));
+  std::string out;
+  for (std::string line; std::getline(in, line);)
+    if (line.find("time: ") == std::string::npos) out += line + "\n";
+  return out;
+}
+
+/// Names and write times of the kept simulations in `folder` (not the .part files being written).
+std::map<std::string, fs::file_time_type> kept_simulations(const fs::path& folder) {
+  std::map<std::string, fs::file_time_type> kept;
+  std::error_code ec;
+  for (const auto& f : fs::directory_iterator(folder, ec))
+    if (f.path().extension() != ".part") kept[f.path().filename().string()] = f.last_write_time();
+  return kept;
+}
+
+// A diagnosis of the shipped wet glass beads measurements (cases/calibration/), with few
+// design points so that it takes minutes, killed with SIGKILL after a seeded random number of
+// kept simulations and started again with the same command, writes the same ledger as an
+// uninterrupted one (every version, parameter and residual; only the times differ) and runs
+// none of the kept simulations again. Label long (a few minutes on 2 cores):
+// `ctest --test-dir build -L long -R Diagnose`.
+TEST(KillAndResumeLong, DiagnoseOfAShippedFileKilledThenRerunWritesTheSameLedger) {
+  const fs::path source(DEMDESIGN_SOURCE_DIR);
+  auto args = [&](const fs::path& out) {
+    return std::vector<std::string>{"diagnose", (source / "materials/glass_beads.yaml").string(),
+                                    (source / "cases/calibration/wet_glass_beads_measurements.yaml").string(),
+                                    "--params", "friction", "--stiffness-scaling", "1e-5", "--replicas", "1", "--rounds", "1",
+                                    "--design-factor", "0.5", "--confirm", "1", "--effects", "liquid_bridge,jkr",
+                                    "--parallel", "2", "--no-renders", "--out", out.string()};
+  };
+  const fs::path reference = kScratch / "diagnose_reference";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start(args(reference), kScratch / "diagnose_reference.log")), 0) << read_text(kScratch / "diagnose_reference.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string expected = ledger_without_times(reference / "ledger.yaml");
+  ASSERT_NE(expected.find("version: 3"), std::string::npos) << "start, calibrated and at least one candidate:\n" << expected;
+  const auto all = kept_simulations(reference / "simulations");
+  ASSERT_GE(all.size(), 20u);
+
+  std::mt19937 random(20261203);
+  const fs::path out = kScratch / "diagnose_trial";
+  const auto kept_before_kill = std::uniform_int_distribution<size_t>(all.size() / 4, 3 * all.size() / 4)(random);
+  const pid_t pid = start(args(out), kScratch / "diagnose_trial.log");
+  while (kept_simulations(out / "simulations").size() < kept_before_kill && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(5ms);
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  ASSERT_EQ(wait_exit(pid), 128 + SIGKILL) << "killed mid-run";
+  EXPECT_FALSE(fs::exists(out / "ledger.yaml")) << "the ledger is written at the end";
+  const auto before = kept_simulations(out / "simulations");
+
+  const auto t1 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start(args(out), kScratch / "diagnose_rerun.log")), 0) << read_text(kScratch / "diagnose_rerun.log");
+  const double rerun_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  EXPECT_EQ(ledger_without_times(out / "ledger.yaml"), expected);
+  const auto after = kept_simulations(out / "simulations");
+  for (const auto& [name, time] : before) {
+    ASSERT_TRUE(after.count(name)) << name;
+    EXPECT_EQ(after.at(name), time) << name << ": a kept simulation was run and written again";
+  }
+  EXPECT_EQ(after.size(), all.size());
+  // The rerun says so: one "stored" progress line per kept simulation it took.
+  std::istringstream log(read_text(kScratch / "diagnose_rerun.log"));
+  size_t stored_lines = 0;
+  for (std::string line; std::getline(log, line);) stored_lines += line.find(" done (") != std::string::npos && line.find(", stored") != std::string::npos;
+  EXPECT_GE(stored_lines, before.size());
+  std::cout << "diagnose: uninterrupted " << seconds << " s, " << all.size() << " simulations; killed after " << before.size()
+            << " kept; the rerun took " << stored_lines << " from the store and ran the other " << after.size() - before.size() << " in "
+            << rerun_seconds << " s; same ledger\n";
+}
+
 TEST(KillAndResume, SigtermWritesACheckpointAndExitsCleanly) {
   const fs::path c = checkpoint_case();
   const fs::path out = kScratch / "sigterm";
