@@ -9,7 +9,7 @@
 // Sources of the reference values: closed forms of Hertz theory and rigid-body impact; ODE
 // integrations of the same laws; Chung & Ooi (2011) figures as digitised by the Kratos
 // DEMApplication team (KratosMultiphysics/Kratos, applications/DEMApplication/test_examples/
-// basic_benchmarks/paper_data/benchmark6_graph1.dat @1bfdba24, benchmark5_graph{1,2}.dat
+// basic_benchmarks/paper_data/benchmark4_graph3.dat and benchmark6_graph1.dat @1bfdba24, benchmark5_graph{1,2}.dat
 // @650ccb26, tests/DEM3D_chung_ooi_tests/paper_data_5_to_8/benchmark8_graph1.dat @5924ef79).
 #pragma once
 
@@ -43,6 +43,7 @@ struct CurvePoint {
 };
 
 // Digitised curves (see the sources above).
+extern const std::span<const CurvePoint> kTest4PatchAngle;     ///< patch rebound angle against impact angle [deg]
 extern const std::span<const CurvePoint> kTest6Aluminium;      ///< beta against chi, chi <= 5.75
 extern const std::span<const CurvePoint> kTest6AluminiumTail;  ///< chi 7.8 ... 24: a known difference
 extern const std::span<const CurvePoint> kTest6Nylon;

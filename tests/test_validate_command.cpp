@@ -25,15 +25,15 @@ TEST(ValidateCommand, WritesTheValidationPageWithEveryCurve) {
                               "' > '" + out.string() + ".log' 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << read_text(out.string() + ".log");
   const std::string md = read_text(out / "validation.md");
-  EXPECT_NE(md.find("85 points inside their tolerance, 0 outside, 3 known differences"), std::string::npos) << md.substr(0, 400);
+  EXPECT_NE(md.find("98 points inside their tolerance, 0 outside, 3 known differences"), std::string::npos) << md.substr(0, 400);
   EXPECT_NE(md.find("## CO6 aluminium: beta"), std::string::npos);
   EXPECT_NE(md.find("![CO8 sphere on sphere: beta](plots/co8_sphere_on_sphere_beta.png)"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "plots" / "co6_nylon_beta.png"));
-  // 88 points and a header.
+  // 101 points and a header.
   std::istringstream csv(read_text(out / "validation.csv"));
   int lines = 0;
   for (std::string line; std::getline(csv, line);) ++lines;
-  EXPECT_EQ(lines, 89);
+  EXPECT_EQ(lines, 102);
   EXPECT_NE(read_text(out / "validation.html").find("data:image/png;base64"), std::string::npos);
 }
 

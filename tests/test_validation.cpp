@@ -29,7 +29,7 @@ TEST(Validation, EveryBenchmarkPointIsInsideItsToleranceOrTheStatedKnownDifferen
   }
   EXPECT_EQ(known, 3);
   EXPECT_EQ(benchmarks, (std::set<std::string>{"CO1", "CO2", "CO3", "CO4", "CO5", "CO6", "CO7", "CO8"}));
-  EXPECT_EQ(points.size(), 88u);
+  EXPECT_EQ(points.size(), 101u);
 }
 
 }  // namespace
