@@ -65,6 +65,13 @@ struct Test5Result {
 Test5Result test5(const std::string& cases_dir, double psi1);
 /// Test 6: beta = -Vtc'/Vtc at chi for the aluminium (or nylon) sphere, with this tangential cap.
 double test6_beta(const std::string& cases_dir, double chi, const std::string& coulomb_cap, bool nylon = false);
+/// Test 7: two spheres with equal and opposite spins w0 about y meet head-on; after the contact,
+/// per sphere (by id 0, 1): spin about y [rad/s] and velocity along x and z [m/s].
+struct PairRebound {
+  bool touched = false;
+  double wy[2] = {0, 0}, vx[2] = {0, 0}, vz[2] = {0, 0};
+};
+PairRebound test7_pair(const std::string& cases_dir, double w0);
 /// Test 8: beta at chi for the sphere on a larger sphere (case B of the paper's figure).
 double test8_beta(const std::string& cases_dir, double chi);
 

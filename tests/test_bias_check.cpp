@@ -14,47 +14,24 @@
 #include <sstream>
 #include <string>
 
+#include "binary_runs.h"
 #include "case/spec.h"
 #include "core/model.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using namespace dem::test;
 
 const fs::path kScratch = fs::temp_directory_path() / "demdesign_bias_check_test";
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 /// bias_check.csv of a run: metric -> (shift [%], sensitive).
 std::map<std::string, std::pair<double, bool>> shifts(const fs::path& out) {
   std::map<std::string, std::pair<double, bool>> m;
-  std::istringstream in(read_text(out / "report/bias_check.csv"));
-  std::string line;
-  std::getline(in, line);  // header: design,check,metric,as_case,checked,shift_pct,noise_pct,sensitive
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::string cell;
-    bool quoted = false;
-    for (char c : line) {
-      if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) cells.push_back(cell), cell.clear();
-      else cell += c;
-    }
-    cells.push_back(cell);
+  // design,check,metric,as_case,checked,shift_pct,noise_pct,sensitive
+  for (const auto& cells : csv_rows(out / "report/bias_check.csv"))
     if (cells.size() == 8) m[cells[2]] = {std::atof(cells[5].c_str()), cells[7] == "1"};
-  }
   return m;
-}
-
-int run(const fs::path& case_file, const fs::path& out) {
-  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' '" + case_file.string() + "' --out '" + out.string() + "' > '" +
-                              (out.string() + ".log") + "' 2>&1";
-  return std::system(command.c_str());
 }
 
 TEST(BiasCheck, ASoftPackingsDensityIsFlaggedADenseSilosFlowIsNot) {
@@ -108,14 +85,14 @@ particles:
 output: {directory: out/silo, records_from: 0.45}
 bias_check: {stiffness_factor: 4}
 )";
-  ASSERT_EQ(run(kScratch / "soft.yaml", kScratch / "soft"), 0) << read_text(kScratch / "soft.log");
+  ASSERT_EQ(run_case(kScratch / "soft.yaml", kScratch / "soft"), 0) << read_text(kScratch / "soft.log");
   const auto soft = shifts(kScratch / "soft");
   ASSERT_TRUE(soft.count("mass_in_bottom_kg")) << read_text(kScratch / "soft.log");
   EXPECT_TRUE(soft.at("mass_in_bottom_kg").second) << "shift " << soft.at("mass_in_bottom_kg").first << " %";
   EXPECT_LT(soft.at("mass_in_bottom_kg").first, -5.0) << "stiffer beads overlap less: fewer fit in the lowest 20 mm";
   EXPECT_NE(read_text(kScratch / "soft.log").find("SENSITIVE: mass_in_bottom_kg"), std::string::npos) << read_text(kScratch / "soft.log");
 
-  ASSERT_EQ(run(kScratch / "silo.yaml", kScratch / "silo"), 0) << read_text(kScratch / "silo.log");
+  ASSERT_EQ(run_case(kScratch / "silo.yaml", kScratch / "silo"), 0) << read_text(kScratch / "silo.log");
   const auto silo = shifts(kScratch / "silo");
   ASSERT_TRUE(silo.count("throughput_t_h")) << read_text(kScratch / "silo.log");
   EXPECT_FALSE(silo.at("throughput_t_h").second) << "shift " << silo.at("throughput_t_h").first << " %";
@@ -172,20 +149,16 @@ experiments:
     observed: {bulk_density: {value: 1500, sigma: 3}}
 )";
   const fs::path out = kScratch / "compare";
-  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' compare '" + (kScratch / "soft_beads.yaml").string() + "' '" +
-                              (kScratch / "measurements.yaml").string() + "' --replicas 2 --stiffness-check 10 --no-renders --quiet --out '" +
-                              out.string() + "' > '" + out.string() + ".log' 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(out.string() + ".log");
+  fs::remove_all(out);  // no simulations kept from an earlier run
+  ASSERT_EQ(run_binary({"compare", (kScratch / "soft_beads.yaml").string(), (kScratch / "measurements.yaml").string(), "--replicas", "2",
+                        "--stiffness-check", "10", "--no-renders", "--quiet", "--out", out.string()},
+                       out.string() + ".log"),
+            0)
+      << read_text(out.string() + ".log");
   std::map<std::string, std::pair<double, bool>> rows;  // observable -> (shift in measurement sigma, sensitive)
-  std::istringstream in(read_text(out / "stiffness_check.csv"));
-  std::string line;
-  std::getline(in, line);  // observable,simulated,simulated_stiffer,shift,shift_in_measurement_sigma,noise,sensitive
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream cs(line);
-    for (std::string c; std::getline(cs, c, ',');) cells.push_back(c);
+  // observable,simulated,simulated_stiffer,shift,shift_in_measurement_sigma,noise,sensitive
+  for (const auto& cells : csv_rows(out / "stiffness_check.csv"))
     if (cells.size() == 7) rows[cells[0]] = {std::atof(cells[4].c_str()), cells[6] == "1"};
-  }
   ASSERT_TRUE(rows.count("drop/restitution") && rows.count("cup/bulk_density")) << read_text(out.string() + ".log");
   EXPECT_FALSE(rows.at("drop/restitution").second) << rows.at("drop/restitution").first << " sigma";
   EXPECT_LT(std::abs(rows.at("drop/restitution").first), 1.0);

@@ -18,44 +18,14 @@
 #include <string>
 #include <vector>
 
+#include "binary_runs.h"
+
 namespace {
 
 namespace fs = std::filesystem;
+using namespace dem::test;
 
 const fs::path kScratch = fs::temp_directory_path() / "demdesign_uncertainty_runs_test";
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-int run(const fs::path& case_file, const fs::path& out) {
-  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' '" + case_file.string() + "' --out '" + out.string() + "' > '" +
-                              (out.string() + ".log") + "' 2>&1";
-  return std::system(command.c_str());
-}
-
-std::vector<std::vector<std::string>> csv_rows(const fs::path& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::istringstream in(read_text(path));
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::string cell;
-    bool quoted = false;
-    for (char c : line) {
-      if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) cells.push_back(cell), cell.clear();
-      else cell += c;
-    }
-    cells.push_back(cell);
-    rows.push_back(cells);
-  }
-  return rows;
-}
 
 /// The q-quantile of sorted values, linear between order statistics (as the report computes it).
 double quantile(const std::vector<double>& sorted, double q) {
@@ -121,7 +91,7 @@ TEST(UncertaintyRuns, SiloFlowBandEqualsADirectSweepAndTheRankingKnowsWhatItCann
     - {metric: throughput_t_h, goal: maximize}
 uncertainty: {samples: 6, seed: 2}
 )");
-  ASSERT_EQ(run(kScratch / "uncertain.yaml", kScratch / "uncertain"), 0) << read_text(kScratch / "uncertain.log");
+  ASSERT_EQ(run_case(kScratch / "uncertain.yaml", kScratch / "uncertain"), 0) << read_text(kScratch / "uncertain.log");
 
   // The friction of each run of the 30 mm design (variants v01..v06), as its case.yaml says.
   std::vector<double> friction;
@@ -143,7 +113,7 @@ uncertainty: {samples: 6, seed: 2}
     values += (values.empty() ? "" : ", ") + v.str();
   }
   std::ofstream(kScratch / "direct.yaml") << silo_case("sweep:\n  parameters:\n    materials.beads.friction: [" + values + "]\n");
-  ASSERT_EQ(run(kScratch / "direct.yaml", kScratch / "direct"), 0) << read_text(kScratch / "direct.log");
+  ASSERT_EQ(run_case(kScratch / "direct.yaml", kScratch / "direct"), 0) << read_text(kScratch / "direct.log");
   std::vector<double> direct;
   for (int s = 1; s <= samples; ++s)
     direct.push_back(metric(kScratch / "direct" / "variants" / variant(s) / "report" / "metrics.csv", "throughput_t_h"));

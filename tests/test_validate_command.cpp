@@ -7,23 +7,18 @@
 #include <sstream>
 #include <string>
 
+#include "binary_runs.h"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using namespace dem::test;
 
 TEST(ValidateCommand, WritesTheValidationPageWithEveryCurve) {
   const fs::path out = fs::temp_directory_path() / "demdesign_validate_test";
   fs::remove_all(out);
-  const std::string command = std::string("'") + DEMDESIGN_BINARY + "' validate --source '" + DEMDESIGN_SOURCE_DIR + "' --out '" + out.string() +
-                              "' > '" + out.string() + ".log' 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0) << read_text(out.string() + ".log");
+  ASSERT_EQ(run_binary({"validate", "--source", DEMDESIGN_SOURCE_DIR, "--out", out.string()}, out.string() + ".log"), 0)
+      << read_text(out.string() + ".log");
   const std::string md = read_text(out / "validation.md");
   EXPECT_NE(md.find("98 points inside their tolerance, 0 outside, 3 known differences"), std::string::npos) << md.substr(0, 400);
   EXPECT_NE(md.find("## CO6 aluminium: beta"), std::string::npos);
