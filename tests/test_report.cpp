@@ -19,6 +19,7 @@
 #include "case/spec.h"
 #include "core/model.h"
 #include "core/particles.h"
+#include "equipment.h"
 #include "output/run.h"
 #include "render/render.h"
 #include "report.h"
@@ -377,14 +378,15 @@ ViewerArea viewer_area(const render::Image& image, std::array<int, 3> colour) {
   return a;
 }
 
-// A short real run (particles fed onto the liner) reported, then opened in headless Chromium
-// with WebGL on SwiftShader: the view must say it drew, the console must show no errors, and a
-// screenshot scrolled to the view must show the canvas with walls and particles on its
-// background.
+// The main job (cases/transfer_chute.yaml, its first 0.45 s: gravel fed onto the feed belt under
+// the hood) reported, then opened in headless Chromium with WebGL on SwiftShader: the view must
+// say it drew, the console must show no errors, and a screenshot scrolled to the view must show
+// the canvas with walls and particles on its background.
 TEST(RunReport, ViewerDrawsInHeadlessChromium) {
   if (!three_js_installed()) GTEST_SKIP() << "three.js not installed (Debian package libjs-three; .ci/install-deps installs it)";
   Fixture f("demdesign_report_viewer_test");
-  CaseSpec spec = parse_case_text(kCase, "report.yaml");
+  CaseSpec spec = parse_case_file(std::string(DEMDESIGN_SOURCE_DIR) + "/cases/transfer_chute.yaml");
+  equipment::expand_equipment(spec);
   spec.simulation.duration = 0.45;
   const Model model = compile(spec);
   State state = initial_state(model);
