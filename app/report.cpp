@@ -262,9 +262,13 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
     for (std::size_t m = 0; m < model.meshes.size(); ++m) {
       const MeshWear& w = mesh_wear[m];
       h += table_row({esc(model.meshes[m].name), num(w.area), num(w.shear_power, 3), num(w.impact_power, 3), num(w.max_shear, 3), num(w.max_impact, 3),
-                      num(w.k, 3), num(w.max_wear, 3)});
+                      std::isnan(w.k) ? std::string("not given") : num(w.k, 3), std::isnan(w.k) ? std::string("&ndash;") : num(w.max_wear, 3)});
     }
-    h += "</table>\n<h3>Hot spots: the 10 triangles with the highest shear power per area</h3>\n<table>\n";
+    h += "</table>\n";
+    if (std::all_of(mesh_wear.begin(), mesh_wear.end(), [](const MeshWear& w) { return std::isnan(w.k); }))
+      h += "<p class=\"note\">No wear depth: the case gives no specific wear rate. Add <code>wear_coefficients: {default: K}</code> "
+           "(or per mesh name), K = k/H of the liner in m&sup3;/J, for the wear rate in mm/year.</p>\n";
+    h += "<h3>Hot spots: the 10 triangles with the highest shear power per area</h3>\n<table>\n";
     h += table_row({"#", "mesh", "triangle", "centroid x, y, z [m] (pose at t = 0)", "shear power [W/m&sup2;]", "impact power [W/m&sup2;]",
                     "impacts [1/(s m&sup2;)]", "wear rate [mm/yr]"},
                    true);

@@ -172,6 +172,19 @@ struct Fixture {
   }
 };
 
+// Without a specific wear rate the report says how to give one instead of showing no depth.
+TEST(RunReport, WithoutAWearCoefficientSaysHowToGiveOne) {
+  Fixture f("demdesign_report_no_wear_test");
+  f.input.wear_coefficient.clear();
+  const fs::path out = f.dir / "report";
+  const report::RunMetrics metrics = report::write_run_report(f.input, out.string());
+  const std::string html = read(out / "report.html");
+  EXPECT_NE(html.find("No wear depth: the case gives no specific wear rate. Add <code>wear_coefficients: {default: K}</code>"), std::string::npos);
+  EXPECT_NE(html.find("<td>not given</td>"), std::string::npos);
+  EXPECT_TRUE(std::isnan(metrics.get("wear_rate_max_mm_yr"))) << "no wear rate without a coefficient";
+  EXPECT_GT(metrics.get("shear_power_max_W_m2"), 0) << "the wear input is still there";
+}
+
 TEST(RunReport, SelfContainedWithSteadyIntervalMeanAndFiles) {
   Fixture f("demdesign_report_test");
   const fs::path out = f.dir / "report";
