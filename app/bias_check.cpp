@@ -18,14 +18,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// The run report's own standard deviation of `metric` ("throughput_t_h" -> "throughput_std_t_h",
-/// otherwise METRIC_std); NaN when the report gives none.
-double own_noise(const report::RunMetrics& m, const std::string& metric) {
-  const size_t unit = metric.rfind("_t_h");
-  const std::string name = unit != std::string::npos && unit + 4 == metric.size() ? metric.substr(0, unit) + "_std_t_h" : metric + "_std";
-  return m.get(name);
-}
-
 /// Not a design KPI: a run's own noise, when its steady state began, its kinetic energy (the
 /// steady-state detector's series, near zero in a bed at rest).
 bool is_noise(const std::string& metric) {
@@ -107,7 +99,7 @@ BiasSummary summarise_bias_check(const SweepPlan& plan, const std::vector<report
         if (!std::isfinite(value) || !std::isfinite(checked)) continue;
         KpiShift s{plan.design_label(d * runs), plan.bias_runs[r], metric, value, checked, kNaN, kNaN, false, ""};
         const double scale = std::abs(value);
-        const double na = own_noise(base.metrics, metric), nb = own_noise(other.metrics, metric);
+        const double na = base.metrics.noise(metric), nb = other.metrics.noise(metric);
         const double noise = std::isfinite(na) && std::isfinite(nb) ? std::hypot(na, nb) : kNaN;
         if (scale > 0) {
           s.shift_pct = 100 * (checked - value) / scale;

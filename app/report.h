@@ -52,6 +52,9 @@ struct RunMetrics {
   std::string steady_text;  ///< "steady from 1.2 s to 4 s (outflow)" or why not
   /// The value named `name`; NaN when absent.
   double get(const std::string& name) const;
+  /// The run's own standard deviation of `metric` ("throughput_t_h" -> "throughput_std_t_h",
+  /// otherwise METRIC_std); NaN when the report gives none.
+  double noise(const std::string& metric) const;
 };
 
 /// Writes report.html, plots (PNG + TSV + gnuplot script), steady_state.csv, wear_hotspots.csv

@@ -28,6 +28,11 @@ double RunMetrics::get(const std::string& name) const {
   return kNaN;
 }
 
+double RunMetrics::noise(const std::string& metric) const {
+  const size_t unit = metric.rfind("_t_h");
+  return get(unit != std::string::npos && unit + 4 == metric.size() ? metric.substr(0, unit) + "_std_t_h" : metric + "_std");
+}
+
 void write_metrics(const RunMetrics& metrics, const std::string& path) {
   std::string text = "name,value\n";
   text += fmt::format("steady,{}\n", metrics.steady ? 1 : 0);

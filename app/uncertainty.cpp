@@ -211,10 +211,7 @@ UncertaintySummary summarise_uncertainty(const SweepPlan& plan, const std::vecto
         if (!v.ok) continue;
         const double x = v.metrics.get(metric);
         if (std::isfinite(x)) values.push_back(x);
-        // The run's own noise: "throughput_t_h" -> "throughput_std_t_h", or METRIC_std.
-        const size_t unit = metric.rfind("_t_h");
-        const std::string std_name = unit != std::string::npos && unit + 4 == metric.size() ? metric.substr(0, unit) + "_std_t_h" : metric + "_std";
-        const double n = v.metrics.get(std_name);
+        const double n = v.metrics.noise(metric);  // the run's own noise
         if (std::isfinite(n)) noise.push_back(n);
       }
       std::sort(values.begin(), values.end());
