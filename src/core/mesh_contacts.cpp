@@ -39,7 +39,7 @@ struct Candidate {
 };
 
 /// Triangles that touch the feature a closest point lies on: every triangle around its vertices
-/// (an edge's two end points, or the vertex), besides its own triangle.
+/// (an edge's two end points, or the vertex), besides its own triangle, until visit returns false.
 template <typename Visit>
 void touching_triangles(const TriangleSurface& surface, std::int32_t t, Feature f, Visit visit) {
   const int k = static_cast<int>(f);
@@ -53,15 +53,22 @@ void touching_triangles(const TriangleSurface& surface, std::int32_t t, Feature 
   }
   for (int q = 0; q < count; ++q)
     for (std::int32_t i = surface.vertex_begin[vertices[q]]; i < surface.vertex_begin[vertices[q] + 1]; ++i)
-      if (surface.vertex_triangles[i] != t) visit(surface.vertex_triangles[i]);
+      if (surface.vertex_triangles[i] != t && !visit(surface.vertex_triangles[i])) return;
 }
 
 /// Keeps the candidates that are physical contacts (see mesh.h); returns how many, in place.
 int resolve_contacts(const TriangleSurface& surface, std::vector<Candidate>& list, double radius) {
+  if (list.size() <= 1) return static_cast<int>(list.size());  // a lone closest point is a contact
+  // Each candidate's distance by triangle, for the neighbours' test below: a sphere with a long
+  // interaction range (a liquid bridge's rupture distance) has tens of triangles in reach, and a
+  // scan of the list for every neighbour of every edge or vertex contact would cost their cube.
+  thread_local std::vector<std::pair<std::int32_t, double>> by_triangle;
+  by_triangle.clear();
+  for (const Candidate& c : list) by_triangle.emplace_back(c.triangle, c.closest.distance2);
+  std::sort(by_triangle.begin(), by_triangle.end());
   auto distance2_of = [&](std::int32_t u) {
-    for (const Candidate& c : list)
-      if (c.triangle == u) return c.closest.distance2;
-    return -1.0;  // not a candidate: farther than the reach
+    const auto it = std::lower_bound(by_triangle.begin(), by_triangle.end(), std::pair<std::int32_t, double>(u, -1e300));
+    return it != by_triangle.end() && it->first == u ? it->second : -1.0;  // -1: not a candidate, farther than the reach
   };
   // Faces first, then by distance: where points merge, the face (the exact plane normal) stays.
   std::sort(list.begin(), list.end(), [](const Candidate& a, const Candidate& b) {
@@ -80,6 +87,7 @@ int resolve_contacts(const TriangleSurface& surface, std::vector<Candidate>& lis
       touching_triangles(surface, c.triangle, c.closest.feature, [&](std::int32_t u) {
         const double d2 = distance2_of(u);
         if (d2 >= 0 && d2 < c.closest.distance2 * (1.0 - 1e-13)) valid = false;
+        return valid;
       });
     }
     for (int q = 0; q < kept && valid; ++q) {
