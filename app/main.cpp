@@ -122,7 +122,7 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
   const std::string out = summary.output_directory, report_dir = out + "/report";
   std::filesystem::create_directories(report_dir);
   dem::report::RunReportInput input;
-  input.model = &model, input.state = &state, input.scalars = summary.scalars;
+  input.model = &model, input.state = &state, input.scalars = summary.scalars, input.events = summary.events;
   input.case_path = case_path, input.case_text = case_text, input.version = DEMDESIGN_VERSION;
   input.wall_seconds = summary.wall_seconds;
   input.records_from = model.output.records_from;

@@ -185,6 +185,16 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
       h += table_row({esc(q.name), pm(q.at_run.mean, q.at_run.std_dev), num(q.own.std_error, 2),
                       q.own.found ? fmt::format("from {} s", num(q.own.t_start, 3)) : esc(q.own.why)});
     h += "</table>\n";
+    h += fmt::format("<p>What crosses each plane, averaged over {} (&plusmn; the standard error of the mean, from batch means): "
+                     "particles per second along the normal, and the mean velocity of the crossing material, each particle in the "
+                     "sensor&#39;s slab weighted by the mass it carries across per second.</p>\n<table>\n", interval_text);
+    h += table_row({"sensor", "particles through [1/s]", "v<sub>x</sub> [m/s]", "v<sub>y</sub> [m/s]", "v<sub>z</sub> [m/s]", "speed [m/s]"}, true);
+    for (std::size_t j = 0; j < plane_sensors.size() && 4 * j + 3 < run.plane_detail.size(); ++j) {
+      const auto se = [&](int c) { return pm(run.plane_detail[4 * j + c].at_run.mean, run.plane_detail[4 * j + c].at_run.std_error); };
+      const double vx = run.plane_detail[4 * j + 1].at_run.mean, vy = run.plane_detail[4 * j + 2].at_run.mean, vz = run.plane_detail[4 * j + 3].at_run.mean;
+      h += table_row({esc(plane_sensors[j].name), se(0), se(1), se(2), se(3), num(std::sqrt(vx * vx + vy * vy + vz * vz), 4)});
+    }
+    h += "</table>\n";
     plot::Plot p;
     p.title = "Mass flow through the plane sensors";
     p.x_label = "time [s]";
@@ -241,6 +251,26 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
     p.series.clear();
     for (std::size_t m = 0; m < torque.size(); ++m) p.series.push_back({model.meshes[m].name, t, torque[m].y});
     h += figure(p, report_dir, "mesh_torque", "Torque per mesh about its rotation axis.");
+    h += fmt::format("<h3>Loads on the meshes</h3>\n<p>The particles&#39; force on each mesh and its torque about the mesh&#39;s motion "
+                     "origin (the world origin for a static mesh), by component, averaged over {} &plusmn; the standard error of the "
+                     "mean (batch means); |F&#772;| is the magnitude of the mean force, which noise does not inflate as it does the mean "
+                     "of the magnitude. Also in mesh_loads.csv.</p>\n<table>\n", interval_text);
+    h += table_row({"mesh", "F<sub>x</sub> [N]", "F<sub>y</sub> [N]", "F<sub>z</sub> [N]", "|F&#772;| [N]", "T<sub>x</sub> [N m]",
+                    "T<sub>y</sub> [N m]", "T<sub>z</sub> [N m]"}, true);
+    for (std::size_t m = 0; m < model.meshes.size() && 6 * m + 5 < run.mesh_load.size(); ++m) {
+      const auto se = [&](int c) { return pm(run.mesh_load[6 * m + c].at_run.mean, run.mesh_load[6 * m + c].at_run.std_error); };
+      const double fx = run.mesh_load[6 * m].at_run.mean, fy = run.mesh_load[6 * m + 1].at_run.mean, fz = run.mesh_load[6 * m + 2].at_run.mean;
+      h += table_row({esc(model.meshes[m].name), se(0), se(1), se(2), num(std::sqrt(fx * fx + fy * fy + fz * fz), 4), se(3), se(4), se(5)});
+    }
+    h += "</table>\n";
+  }
+  if (!run.events.empty()) {
+    h += "<h2>First arrivals</h2>\n<p>When the first particle reached each outlet, crossed each plane sensor along its normal, or left "
+         "the domain: to the step (the run looks every few steps and traces the particle back along its velocity), not to the "
+         "spacing of the scalars&#39; rows. Also in events.csv of the run folder.</p>\n<table>\n";
+    h += table_row({"event", "time [s]", "step", "particle"}, true);
+    for (const RunEvent& e : run.events) h += table_row({esc(e.what), num(e.time, 6), std::to_string(e.step), std::to_string(e.particle)});
+    h += "</table>\n";
   }
 
   // Wear.

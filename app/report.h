@@ -15,6 +15,7 @@
 #include "core/model.h"
 #include "core/state.h"
 #include "statistics/diagnostics.h"
+#include "statistics/events.h"
 #include "viewer3d.h"
 
 namespace dem::report {
@@ -43,6 +44,7 @@ struct RunReportInput {
   std::vector<SensorSpec> sensors;
   std::vector<std::pair<std::string, double>> design;
   viewer3d::Options viewer;  ///< the interactive 3D view (three.js to inline, particle limit)
+  std::vector<RunEvent> events;  ///< the run's first arrivals (RunSummary::events)
 };
 
 /// Key numbers of a run, to rank sweep variants. Names carry their unit ("throughput_t_h").

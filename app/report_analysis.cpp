@@ -55,12 +55,43 @@ std::pair<std::string, double> belt_speed_for(const std::vector<std::pair<std::s
   return {"", kNaN};
 }
 
+/// Mean of y over [t0, t1] with each row weighted by w (a velocity by the mass flux that carries
+/// it: a row with nothing in the sensor's slab counts for nothing), its weighted standard
+/// deviation, and the standard error from the weighted means of 10 consecutive batches.
+IntervalStats weighted_over(const std::vector<double>& t, const std::vector<double>& y, const std::vector<double>& w, double t0, double t1) {
+  IntervalStats s;
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= t0 && t[i] <= t1 && w[i] > 0) rows.push_back(i);
+  double sw = 0, swy = 0;
+  for (std::size_t i : rows) sw += w[i], swy += w[i] * y[i];
+  s.samples = rows.size();
+  if (sw <= 0) return s;
+  s.mean = swy / sw;
+  double sd = 0;
+  for (std::size_t i : rows) sd += w[i] * (y[i] - s.mean) * (y[i] - s.mean);
+  s.std_dev = std::sqrt(sd / sw);
+  const std::size_t batches = std::min<std::size_t>(10, rows.size());
+  std::vector<double> means;
+  for (std::size_t b = 0; b < batches; ++b) {
+    double bw = 0, bwy = 0;
+    for (std::size_t k = rows.size() * b / batches; k < rows.size() * (b + 1) / batches; ++k) bw += w[rows[k]], bwy += w[rows[k]] * y[rows[k]];
+    if (bw > 0) means.push_back(bwy / bw);
+  }
+  double spread = 0;
+  for (double m : means) spread += (m - s.mean) * (m - s.mean);
+  s.std_error = means.size() >= 2 ? std::sqrt(spread / double(means.size() - 1) / double(means.size())) : s.std_dev;
+  return s;
+}
+
 }  // namespace
 
 std::vector<const Quantity*> RunAnalysis::all() const {
   std::vector<const Quantity*> out{&primary};
-  for (const auto* group : {&outlets, &plane_sensors, &power, &torque})
+  for (const auto* group : {&outlets, &plane_sensors, &power, &torque, &mesh_load})
     for (const Quantity& q : *group) out.push_back(&q);
+  // A plane's particle flux; not its velocities, whose mean is weighted by the mass flow (the page).
+  for (std::size_t k = 0; k < plane_detail.size(); k += 4) out.push_back(&plane_detail[k]);
   for (const BoxResult& b : boxes) out.push_back(&b.offset), out.push_back(&b.mass);
   for (const Quantity* q : {&holdup_q, &kinetic, &particles, &contacts}) out.push_back(q);
   return out;
@@ -163,6 +194,25 @@ RunAnalysis analyse_run(const RunReportInput& in) {
   finish(primary);
   for (Quantity& q : outlets) finish(q);
   for (Quantity& q : plane_sensors) finish(q);
+  for (std::size_t j = 0; j < plane_index.size(); ++j) {
+    const std::size_t k = plane_index[j];
+    const std::string& name = in.sensors[k].name;
+    const auto series = [&](const char* what, const char* unit, double SensorReading::*field) {
+      Quantity q{fmt::format("sensor {} {}", name, what), unit,
+                 column(rows, [k, field](const Scalars& r) { return k < r.sensors.size() ? r.sensors[k].*field : 0.0; }), {}, {}};
+      finish(q);
+      run.plane_detail.push_back(std::move(q));
+    };
+    series("particles through", "1/s", &SensorReading::count_flow);
+    series("velocity x", "m/s", &SensorReading::vx);
+    series("velocity y", "m/s", &SensorReading::vy);
+    series("velocity z", "m/s", &SensorReading::vz);
+    // The velocity of what crosses: rows weighted by the mass flow through the plane.
+    std::vector<double> carried = plane_sensors[j].y;
+    for (double& v : carried) v = std::abs(v);
+    for (std::size_t c = run.plane_detail.size() - 3; c < run.plane_detail.size(); ++c)
+      run.plane_detail[c].at_run = weighted_over(t, run.plane_detail[c].y, carried, run_t0, run_t1);
+  }
 
   // ---- spillage, blockage ---------------------------------------------------------------------
   const std::vector<double> outflow = rate_of(t, out_cumulative);
@@ -197,7 +247,15 @@ RunAnalysis analyse_run(const RunReportInput& in) {
     torque.push_back({"torque " + model.meshes[m].name, "N m", column(rows, [m](const Scalars& r) { return at(r.mesh_torque, m); }), {}, {}});
     finish(power.back());
     finish(torque.back());
+    static constexpr const char* kComponents[6] = {"force x", "force y", "force z", "torque x", "torque y", "torque z"};
+    for (int c = 0; c < 6; ++c) {
+      run.mesh_load.push_back({fmt::format("{} {}", kComponents[c], model.meshes[m].name), c < 3 ? "N" : "N m",
+                               column(rows, [m, c](const Scalars& r) { return m < r.mesh_load.size() ? r.mesh_load[m][c] : 0.0; }), {}, {}});
+      finish(run.mesh_load.back());
+    }
   }
+  run.events = in.events;
+  std::stable_sort(run.events.begin(), run.events.end(), [](const RunEvent& a, const RunEvent& b) { return a.step < b.step; });
 
   // ---- wear per triangle ----------------------------------------------------------------
   const double record_time = run.record_time = state.time - in.records_from;  // [s]
@@ -293,6 +351,10 @@ RunAnalysis analyse_run(const RunReportInput& in) {
     for (const Quantity& q : outlets) metric(key(q.name) + "_t_h", q.at_run.mean);
   }
   for (const Quantity& q : plane_sensors) metric(key(q.name) + "_t_h", q.at_run.mean);
+  for (std::size_t j = 0; j < plane_sensors.size(); ++j) {
+    const double vx = run.plane_detail[4 * j + 1].at_run.mean, vy = run.plane_detail[4 * j + 2].at_run.mean, vz = run.plane_detail[4 * j + 3].at_run.mean;
+    metric(key(plane_sensors[j].name) + "_speed_m_s", std::sqrt(vx * vx + vy * vy + vz * vz));
+  }
   if (!std::isnan(capacity) && capacity > 0 && !model.outlets.empty()) metric("throughput_of_capacity_pct", 100 * primary.at_run.mean / capacity);
   metric("spillage_kg", spillage);
   metric("spillage_pct", spillage_pct);
@@ -303,6 +365,9 @@ RunAnalysis analyse_run(const RunReportInput& in) {
     metric("power_" + model.meshes[m].name + "_W", power[m].at_run.mean);
     metric("torque_" + model.meshes[m].name + "_N_m", torque[m].at_run.mean);
     total_power += power[m].at_run.mean;
+    // The magnitude of the mean force, not the mean of the magnitude (which noise inflates).
+    const double fx = run.mesh_load[6 * m].at_run.mean, fy = run.mesh_load[6 * m + 1].at_run.mean, fz = run.mesh_load[6 * m + 2].at_run.mean;
+    metric("force_" + model.meshes[m].name + "_N", std::sqrt(fx * fx + fy * fy + fz * fz));
   }
   if (!power.empty()) metric("power_total_W", total_power);
   if (!model.meshes.empty() && record_time > 0) {
@@ -344,6 +409,16 @@ void write_run_tables(const RunAnalysis& run, const Model& model, const std::str
                          q->own.t_start, q->own.t_end, q->own.mean, q->own.std_dev, q->own.std_error, q->own.trend_per_s, why);
     }
     write_file_atomically((fs::path(report_dir) / "steady_state.csv").string(), csv);
+    // Loads per mesh and component over the run's interval: what a structural check reads.
+    static constexpr const char* kComponentKeys[6] = {"fx", "fy", "fz", "tx", "ty", "tz"};
+    std::string loads = "mesh,component,unit,mean,std_error,std_dev,samples,t_start_s,t_end_s\n";
+    for (std::size_t m = 0; m < model.meshes.size() && 6 * m + 5 < run.mesh_load.size(); ++m)
+      for (int c = 0; c < 6; ++c) {
+        const IntervalStats& s = run.mesh_load[6 * m + c].at_run;
+        loads += fmt::format("{},{},{},{:.6g},{:.6g},{:.6g},{},{:.6g},{:.6g}\n", model.meshes[m].name, kComponentKeys[c],
+                             c < 3 ? "N" : "N m", s.mean, s.std_error, s.std_dev, s.samples, run.run_t0, run.run_t1);
+      }
+    if (!model.meshes.empty()) write_file_atomically((fs::path(report_dir) / "mesh_loads.csv").string(), loads);
     std::string hot = "rank,mesh,triangle,x_m,y_m,z_m,area_m2,shear_power_W_m2,impact_power_W_m2,impacts_per_s_m2,wear_rate_mm_yr\n";
     for (std::size_t r = 0; r < spots.size(); ++r) {
       const Hotspot& h = spots[r];

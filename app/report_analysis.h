@@ -56,6 +56,13 @@ struct RunAnalysis {
   Scalars last;                                ///< the last row
   std::vector<bool> intended;                  ///< per outlet
   std::vector<Quantity> outlets, plane_sensors, power, torque;
+  /// Per mesh, six series: the particles' force on it (x, y, z) [N] and its torque about the
+  /// mesh's motion origin (x, y, z) [N m], each averaged over the run's interval with its
+  /// standard error (mesh_loads.csv).
+  std::vector<Quantity> mesh_load;
+  /// Per plane sensor (in the order of plane_sensors), four series: particles through it [1/s]
+  /// and the mean velocity of what crosses it (x, y, z) [m/s].
+  std::vector<Quantity> plane_detail;
   Quantity primary;                            ///< the series that defines the run's steady state
   std::vector<double> inserted, removed, lost, holdup;  ///< [kg] cumulative masses per row
   bool steady = false;
@@ -69,6 +76,7 @@ struct RunAnalysis {
   std::vector<Hotspot> spots;                  ///< the 10 triangles with the highest shear power per area
   std::vector<MeshWear> mesh_wear;             ///< per mesh
   std::vector<BoxResult> boxes;
+  std::vector<RunEvent> events;                ///< first arrivals, in the order they happened
   Quantity kinetic, particles, holdup_q, contacts;
   RunMetrics metrics;
   /// Every series, in the order of steady_state.csv.

@@ -180,6 +180,10 @@ struct InletSpec {
 struct OutletSpec {
   std::string name;
   Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m]
+  /// `region: domain`: takes what leaves the domain (simulation.domain) through any face, the
+  /// way out of a case whose material falls off the end of the model; such particles are then
+  /// product of this outlet, not spillage. At most one outlet per case.
+  bool domain = false;
   bool spillage = false;  ///< collects spilled material (the report counts it as spillage, not product)
   SourceLocation location;
 };

@@ -126,7 +126,15 @@ OutletSpec read_outlet(const YAML::Node& node, const std::string& file, size_t i
   OutletSpec out;
   out.location = map.location();
   out.name = map.string("name", fmt::format("outlet{}", index));
-  read_box(map, "region", file, out.region_min, out.region_max);
+  const YAML::Node region = map.node("region");
+  if (region && region.IsScalar()) {
+    if (region.as<std::string>() != "domain")
+      map.fail("region", fmt::format("'{}' is not a region; give a box {{min: [x,y,z], max: [x,y,z]}} or `domain` (what leaves the "
+                                     "domain through any face)", region.as<std::string>()));
+    out.domain = true;
+  } else {
+    read_box(map, "region", file, out.region_min, out.region_max);
+  }
   out.spillage = map.boolean("spillage", false);
   map.finish();
   return out;

@@ -378,6 +378,18 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     model.inlets.push_back(std::move(inlet));
   }
   model.outlets = spec.outlets;
+  for (size_t k = 0; k < spec.outlets.size(); ++k) {
+    if (!spec.outlets[k].domain) continue;
+    if (!spec.simulation.has_domain)
+      throw CaseError(fmt::format("{}: outlets[{}].region: `domain` takes what leaves simulation.domain, and the case has none; "
+                                  "give simulation.domain {{min: [x,y,z], max: [x,y,z]}}, or a box for the outlet",
+                                  spec.outlets[k].location.str(), k));
+    if (model.domain_outlet >= 0)
+      throw CaseError(fmt::format("{}: outlets[{}].region: `domain` is already the region of outlets[{}] ('{}'); one outlet takes "
+                                  "what leaves the domain", spec.outlets[k].location.str(), k, model.domain_outlet,
+                                  spec.outlets[model.domain_outlet].name));
+    model.domain_outlet = static_cast<int>(k);
+  }
   for (size_t k = 0; k < spec.inlets.size(); ++k)
     if (!spec.inlets[k].port.empty() && !(spec.inlets[k].region_max.array() > spec.inlets[k].region_min.array()).all())
       throw CaseError(fmt::format("{}: inlets[{}].port: '{}' names an equipment port that was not resolved: the "

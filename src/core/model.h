@@ -133,6 +133,7 @@ struct Model {
   bool has_attached = false;  ///< some particle source is glued to a wall
   std::vector<Inlet> inlets;
   std::vector<OutletSpec> outlets;
+  int domain_outlet = -1;  ///< the outlet with `region: domain` (takes what leaves the domain), or -1
   std::vector<SensorSpec> sensors;  ///< normals and `across` unit, plane thickness > 0
   /// Design values of the equipment (name with unit -> value) and the camera that suits it.
   std::vector<std::pair<std::string, double>> design;

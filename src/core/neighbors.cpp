@@ -40,17 +40,21 @@ bool find_lost(const Model& model, State& state, std::vector<std::uint8_t>& keep
   for (size_t p = 0; p < n; ++p) {
     int verdict = -2;
     for (size_t k = 0; k < model.outlets.size() && verdict == -2; ++k)
-      if (inside(state.x[p], state.y[p], state.z[p], model.outlets[k].region_min, model.outlets[k].region_max))
+      if (!model.outlets[k].domain && inside(state.x[p], state.y[p], state.z[p], model.outlets[k].region_min, model.outlets[k].region_max))
         verdict = static_cast<int>(k);
     if (verdict == -2 && model.has_domain) {
       for (int a = 0; a < 3; ++a) {
         if (model.period[a] > 0) continue;
         const double c = a == 0 ? state.x[p] : a == 1 ? state.y[p] : state.z[p];
-        if (c < model.domain_min[a] || c > model.domain_max[a]) verdict = -1;
+        if (c < model.domain_min[a] || c > model.domain_max[a]) verdict = model.domain_outlet;  // -1 without one: lost
       }
     }
     if (verdict == -2) continue;
     any = true;
+    // Removals happen at a list rebuild, after the step's drift: the positions are of time + dt.
+    if (verdict >= 0 && state.first_removed.size() < model.outlets.size()) state.first_removed.resize(model.outlets.size());
+    State::Removal& first = verdict >= 0 ? state.first_removed[verdict] : state.first_lost;
+    if (first.time < 0) first = {state.time + model.dt, {state.id[p], state.x[p], state.y[p], state.z[p], state.vx[p], state.vy[p], state.vz[p]}};
     if (state.body[p] >= 0) {
       std::int32_t& b = body_outlet[state.body[p]];
       if (b == -2 || verdict >= 0) b = verdict;

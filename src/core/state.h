@@ -105,6 +105,15 @@ struct State {
     std::int64_t id = -1;
     double x = 0, y = 0, z = 0, vx = 0, vy = 0, vz = 0;
   } last_lost;
+  /// The first particle each outlet removed and the first that left the domain, with the time
+  /// [s] of the positions they were removed at (-1: none yet), for the run's first-arrival
+  /// times (events.h); not checkpointed: a resumed run keeps its events in events.csv.
+  struct Removal {
+    double time = -1;
+    LostParticle particle;
+  };
+  std::vector<Removal> first_removed;  ///< per outlet (sized when the first is removed)
+  Removal first_lost;
 
   // Particles (n): hot columns. 18 doubles + 16 bytes = 160 bytes a particle.
   std::vector<double> x, y, z;     // [m] centre

@@ -42,10 +42,11 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
   for (const OutletSpec& o : model.outlets) out += fmt::format(",outlet_{}_kg", o.name);
   for (const PlaneWall& w : model.planes) out += fmt::format(",wall_{}_normal_force_N", w.name);
   for (const MeshWall& m : model.meshes)
-    out += fmt::format(",mesh_{0}_force_N,mesh_{0}_torque_Nm,mesh_{0}_power_W", m.name);
+    out += fmt::format(",mesh_{0}_force_N,mesh_{0}_torque_Nm,mesh_{0}_power_W,mesh_{0}_fx_N,mesh_{0}_fy_N,mesh_{0}_fz_N,mesh_{0}_tx_Nm,"
+                       "mesh_{0}_ty_Nm,mesh_{0}_tz_Nm", m.name);
   out += ",lost_mass_kg";
   for (const SensorSpec& s : model.sensors)
-    out += s.kind == SensorSpec::Kind::plane ? fmt::format(",sensor_{}_flow_kg_s", s.name)
+    out += s.kind == SensorSpec::Kind::plane ? fmt::format(",sensor_{0}_flow_kg_s,sensor_{0}_count_flow_1_s,sensor_{0}_vx_m_s,sensor_{0}_vy_m_s,sensor_{0}_vz_m_s", s.name)
                                              : fmt::format(",sensor_{0}_mass_kg,sensor_{0}_vx_m_s,sensor_{0}_vy_m_s,sensor_{0}_vz_m_s,sensor_{0}_offset_m", s.name);
   out += "\n";
   for (const Scalars& r : rows) {
@@ -54,13 +55,16 @@ std::string scalars_csv(const Model& model, const std::vector<Scalars>& rows) {
                        r.dt, r.lost, r.inserted_mass, r.removed_mass);
     for (double m : r.outlet_mass) out += fmt::format(",{:.9g}", m);
     for (double f : r.wall_normal_force) out += fmt::format(",{:.9g}", f);
-    for (size_t m = 0; m < r.mesh_force.size(); ++m)
+    for (size_t m = 0; m < r.mesh_force.size(); ++m) {
       out += fmt::format(",{:.9g},{:.9g},{:.9g}", r.mesh_force[m], r.mesh_torque[m], r.mesh_power[m]);
+      const std::array<double, 6> load = m < r.mesh_load.size() ? r.mesh_load[m] : std::array<double, 6>{};
+      out += fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", load[0], load[1], load[2], load[3], load[4], load[5]);
+    }
     out += fmt::format(",{:.9g}", r.lost_mass);
     for (size_t k = 0; k < model.sensors.size() && k < r.sensors.size(); ++k) {
       const SensorReading& s = r.sensors[k];
       out += model.sensors[k].kind == SensorSpec::Kind::plane
-                 ? fmt::format(",{:.9g}", s.flow)
+                 ? fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", s.flow, s.count_flow, s.vx, s.vy, s.vz)
                  : fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", s.mass, s.vx, s.vy, s.vz, s.offset);
     }
     out += "\n";
@@ -85,11 +89,9 @@ std::vector<Scalars> read_scalars(const Model& model, const std::string& path, d
     r.kinetic_translation = v[3], r.kinetic_rotation = v[4], r.contacts = static_cast<size_t>(v[5]);
     r.max_overlap_ratio = v[6], r.mean_overlap_ratio = v[7], r.dt = v[8], r.lost = static_cast<std::int64_t>(v[9]);
     r.inserted_mass = v[10], r.removed_mass = v[11];
-    // Then one column per outlet, per wall, three per mesh, lost mass, the sensors' columns.
+    // Then one column per outlet, per wall, nine per mesh, lost mass, five per sensor.
     const size_t outlets = model.outlets.size(), walls = model.planes.size(), meshes = model.meshes.size();
-    size_t sensor_columns = 0;
-    for (const SensorSpec& s : model.sensors) sensor_columns += s.kind == SensorSpec::Kind::plane ? 1 : 5;
-    if (v.size() != 13 + outlets + walls + 3 * meshes + sensor_columns) break;
+    if (v.size() != 13 + outlets + walls + 9 * meshes + 5 * model.sensors.size()) break;
     size_t c = 12;
     for (size_t k = 0; k < outlets; ++k) r.outlet_mass.push_back(v[c++]);
     for (size_t k = 0; k < walls; ++k) r.wall_normal_force.push_back(v[c++]);
@@ -97,12 +99,15 @@ std::vector<Scalars> read_scalars(const Model& model, const std::string& path, d
       r.mesh_force.push_back(v[c++]);
       r.mesh_torque.push_back(v[c++]);
       r.mesh_power.push_back(v[c++]);
+      r.mesh_load.push_back({v[c], v[c + 1], v[c + 2], v[c + 3], v[c + 4], v[c + 5]});
+      c += 6;
     }
     r.lost_mass = v[c++];
     for (const SensorSpec& s : model.sensors) {
       SensorReading reading;
-      if (s.kind == SensorSpec::Kind::plane) reading.flow = v[c++];
-      else reading.mass = v[c], reading.vx = v[c + 1], reading.vy = v[c + 2], reading.vz = v[c + 3], reading.offset = v[c + 4], c += 5;
+      if (s.kind == SensorSpec::Kind::plane) reading.flow = v[c], reading.count_flow = v[c + 1], reading.vx = v[c + 2], reading.vy = v[c + 3], reading.vz = v[c + 4];
+      else reading.mass = v[c], reading.vx = v[c + 1], reading.vy = v[c + 2], reading.vz = v[c + 3], reading.offset = v[c + 4];
+      c += 5;
       r.sensors.push_back(reading);
     }
     rows.push_back(r);
@@ -264,6 +269,11 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   }
   if (writer) print_setup(model, state, log);
   EnergyWatch energy(model, state, model.energy_rise_limit);
+  // First arrivals to the step (events.h); one process only: under domain decomposition each rank
+  // holds a share of the particles.
+  EventWatch events(model);
+  if (options.resume && writer) events.restore(read_events(out + "/events.csv", state.time));
+  double last_check = state.time;
   if (domain) domain->distribute(state);
   prepare(stepped, state, work);
 
@@ -326,6 +336,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       if (options.write_files && writer) {
         try {
           write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
     if (frames) write_paraview_script(out);
         } catch (const std::exception&) {
         }
@@ -376,6 +387,10 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       if (domain && domain->any(found.has_value()) && !found)
         found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
       if (found) trouble(*found);
+      if (!domain && events.check(stepped, state, last_check) && writer && options.progress)
+        for (auto e = events.fired().rbegin(); e != events.fired().rend() && e->step > state.step - check_every; ++e)
+          fmt::print(log, "  t = {:.6g} s (step {}): {} (particle {})\n", e->time, e->step, e->what, e->particle);
+      last_check = state.time;
       if (writer && results->lost > lost_reported) {
         const auto& p = results->last_lost;
         // The first loss, then each tenfold: a leak is told, not repeated every step.
@@ -396,6 +411,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     if (checkpoint_due && writer) {
       save_checkpoint(checkpoint_path, model, *results);
       write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
     if (frames) write_paraview_script(out);
     }
     if (stopping) {
@@ -419,6 +435,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   summary.steps = state.step - first_step;
+  summary.events = events.fired();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
   if (!writer) return summary;
@@ -440,6 +457,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
   if (options.write_files) {
     write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
     if (frames) write_paraview_script(out);
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
     write_file_atomically(out + "/run_info.yaml",

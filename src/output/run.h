@@ -12,6 +12,7 @@
 #include "core/state.h"
 #include "core/workspace.h"
 #include "statistics/diagnostics.h"
+#include "statistics/events.h"
 
 namespace dem {
 
@@ -38,6 +39,7 @@ struct RunSummary {
   double wall_seconds = 0;
   double particle_steps_per_second = 0;
   std::vector<Scalars> scalars;
+  std::vector<RunEvent> events;  ///< first arrivals at outlets and plane sensors, first loss (events.h)
   std::string output_directory;
 };
 

@@ -48,7 +48,7 @@ std::uint64_t mix(std::uint64_t h, double v) {
 static void measure_sensors(const Model& model, const State& s, std::vector<SensorReading>& out) {
   out.assign(model.sensors.size(), {});
   if (model.sensors.empty()) return;
-  std::vector<double> moment(model.sensors.size(), 0.0);
+  std::vector<double> moment(model.sensors.size(), 0.0), carried(model.sensors.size(), 0.0);
   auto add = [&](double x, double y, double z, double vx, double vy, double vz, double m) {
     for (size_t k = 0; k < model.sensors.size(); ++k) {
       const SensorSpec& sensor = model.sensors[k];
@@ -59,7 +59,13 @@ static void measure_sensors(const Model& model, const State& s, std::vector<Sens
       if (sensor.kind == SensorSpec::Kind::plane) {
         const Vec3& n = sensor.normal;
         const double distance = (x - sensor.point.x()) * n.x() + (y - sensor.point.y()) * n.y() + (z - sensor.point.z()) * n.z();
-        if (std::abs(distance) <= 0.5 * sensor.thickness) r.flow += m * (vx * n.x() + vy * n.y() + vz * n.z()) / sensor.thickness;
+        if (std::abs(distance) <= 0.5 * sensor.thickness) {
+          const double along = vx * n.x() + vy * n.y() + vz * n.z(), weight = m * std::abs(along);
+          r.flow += m * along / sensor.thickness;
+          r.count_flow += along / sensor.thickness;
+          r.vx += weight * vx, r.vy += weight * vy, r.vz += weight * vz;
+          carried[k] += weight;
+        }
       } else {
         const Vec3 centre = 0.5 * (sensor.region_min + sensor.region_max);
         r.mass += m;
@@ -72,6 +78,8 @@ static void measure_sensors(const Model& model, const State& s, std::vector<Sens
     if (s.body[p] < 0) add(s.x[p], s.y[p], s.z[p], s.vx[p], s.vy[p], s.vz[p], 1.0 / s.inv_mass[p]);
   const Bodies& b = s.bodies;
   for (size_t k = 0; k < b.size(); ++k) add(b.x[k], b.y[k], b.z[k], b.vx[k], b.vy[k], b.vz[k], b.mass[k]);
+  for (size_t k = 0; k < out.size(); ++k)
+    if (carried[k] > 0) out[k].vx /= carried[k], out[k].vy /= carried[k], out[k].vz /= carried[k];
   for (size_t k = 0; k < out.size(); ++k)
     if (out[k].mass > 0) {
       out[k].vx /= out[k].mass, out[k].vy /= out[k].mass, out[k].vz /= out[k].mass;
@@ -130,6 +138,7 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
     const Eigen::Vector3d w = model.meshes[m].motion.velocity(s.time).angular, torque(loads.tx[m], loads.ty[m], loads.tz[m]);
     out.mesh_torque.push_back(w.norm() > 0 ? torque.dot(w.normalized()) : torque.norm());
     out.mesh_power.push_back(loads.power[m]);
+    out.mesh_load.push_back({loads.fx[m], loads.fy[m], loads.fz[m], loads.tx[m], loads.ty[m], loads.tz[m]});
   }
   return out;
 }

@@ -2,6 +2,7 @@
 // numerical trouble.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -13,11 +14,16 @@
 
 namespace dem {
 
-/// What a sensor (SensorSpec) saw at one instant. Plane sensors fill `flow`; box sensors the rest.
+/// What a sensor (SensorSpec) saw at one instant. Plane sensors fill `flow`, `count_flow` and
+/// the velocity; box sensors `mass`, the velocity and `offset`.
 struct SensorReading {
   double flow = 0;        // [kg/s] plane: mass flow through it along its normal
+  double count_flow = 0;  // [1/s] plane: particles through it along its normal (net)
   double mass = 0;        // [kg] box: mass of the particles inside
-  double vx = 0, vy = 0, vz = 0;  // [m/s] box: mass-weighted mean velocity
+  /// [m/s] box: mass-weighted mean velocity of the particles inside. Plane: mean velocity of
+  /// what crosses it, each particle in the slab weighted by the mass it carries across per
+  /// second, m |v.n| (the velocity a flux-averaging probe would give; both directions count).
+  double vx = 0, vy = 0, vz = 0;
   double offset = 0;      // [m] box: centroid offset along `across` from the box centre
 };
 
@@ -39,6 +45,10 @@ struct Scalars {
   std::vector<double> mesh_force;        // [N] per mesh, magnitude of the particles' force on it
   std::vector<double> mesh_torque;       // [N m] per mesh, about its rotation axis (|T| if it does not rotate)
   std::vector<double> mesh_power;        // [W] per mesh, rate of work it does on the particles
+  /// Per mesh: the particles' force on it [N] (x, y, z) and its torque about the mesh's motion
+  /// origin (the world origin when it does not move) [N m] (x, y, z), as components, so that a
+  /// noisy force is averaged before its magnitude is taken.
+  std::vector<std::array<double, 6>> mesh_load;
   double lost_mass = 0;                  // [kg] left the domain (outside every outlet): spillage
   std::vector<SensorReading> sensors;    ///< per sensor, in the model's order
 };

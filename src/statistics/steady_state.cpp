@@ -198,6 +198,13 @@ IntervalStats average_over(std::span<const double> t, std::span<const double> y,
   for (std::size_t i = 0; i < n; ++i)
     if (t[i] >= t0 - slack && t[i] <= t1 + slack) sum2 += (y[i] - s.mean) * (y[i] - s.mean);
   s.std_dev = s.samples > 1 ? std::sqrt(sum2 / double(s.samples - 1)) : 0.0;
+  s.std_error = s.std_dev / std::sqrt(double(s.samples));
+  if (s.samples >= 20) {
+    std::size_t begin = 0;
+    while (begin < n && t[begin] < t0 - slack) ++begin;
+    const Batches b = batch_means(t, y, begin, begin + s.samples);
+    if (b.value.size() >= 2) s.std_error = std_dev_of(b.value) / std::sqrt(double(b.value.size()));
+  }
   return s;
 }
 

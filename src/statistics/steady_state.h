@@ -44,9 +44,11 @@ SteadyState find_steady_state(std::span<const double> t, std::span<const double>
 /// uneven row spacing is handled. window <= 0: ten times the median row spacing.
 std::vector<double> rate_of(std::span<const double> t, std::span<const double> cumulative, double window = 0);
 
-/// Mean and standard deviation of the samples with t in [t0, t1].
+/// Mean and standard deviation of the samples with t in [t0, t1], and the standard error of
+/// the mean from non-overlapping batch means (10 to 30 batches, so that correlated samples do
+/// not make it look smaller than it is; the standard deviation over sqrt(n) below 10 samples).
 struct IntervalStats {
-  double mean = 0, std_dev = 0;
+  double mean = 0, std_dev = 0, std_error = 0;
   std::size_t samples = 0;
 };
 IntervalStats average_over(std::span<const double> t, std::span<const double> y, double t0, double t1);
