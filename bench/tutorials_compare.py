@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Figures of a LIGGGHTS tutorial run by both codes, side by side (bench/tutorials_side_by_side.sh).
+
+  tutorials_compare.py chute_wear DEMDESIGN_RUN_FOLDER LIGGGHTS_THERMO_LOG T0 T1
+
+Averages over [T0, T1] s: particles and their mass in the domain, the mass flow out of the domain
+(slope of the mass that left), the particles' force on the chute by component, and the
+mass-weighted velocity of the particles in the box after the chute's lip. demdesign: scalars.csv
+(outlet `exit` with region: domain, mesh `chute`, box sensor `falling`); LIGGGHTS: the thermo
+rows of bench/liggghts/chute_wear.in (step atoms mass inserted_mass Fx Fy Fz box_mass box_mvx
+box_mvz), time = step x 1e-5 s. Prints a table and one CSV row per figure.
+"""
+import csv
+import sys
+
+
+def slope(t, y):
+    n = len(t)
+    mt, my = sum(t) / n, sum(y) / n
+    sxx = sum((a - mt) ** 2 for a in t)
+    return sum((a - mt) * (b - my) for a, b in zip(t, y)) / sxx if sxx > 0 else float("nan")
+
+
+def mean(v):
+    return sum(v) / len(v) if v else float("nan")
+
+
+def batches(t, f, n=10):
+    """f over n consecutive batches of the rows (t, indices) -> the standard error of the whole
+    figure from the spread of its batch values (correlated rows do not shrink it)."""
+    m = len(t)
+    values = [f(list(range(m * b // n, m * (b + 1) // n))) for b in range(n)]
+    values = [v for v in values if v == v]
+    if len(values) < 2:
+        return float("nan")
+    mu = sum(values) / len(values)
+    return (sum((v - mu) ** 2 for v in values) / (len(values) - 1) / len(values)) ** 0.5
+
+
+def figure(t, f):
+    """(value over all rows, standard error from batches)"""
+    return f(list(range(len(t)))), batches(t, f)
+
+
+def demdesign_figures(folder, t0, t1):
+    rows = [r for r in csv.DictReader(open(folder + "/scalars.csv")) if t0 <= float(r["time_s"]) <= t1]
+    t = [float(r["time_s"]) for r in rows]
+    col = lambda name: [float(r[name]) for r in rows]
+    held = [i - o - l for i, o, l in zip(col("inserted_mass_kg"), col("outlet_exit_kg"), col("lost_mass_kg"))]
+    box = col("sensor_falling_mass_kg")
+    return figures(t, col("particles"), held, col("outlet_exit_kg"), col("mesh_chute_fx_N"), col("mesh_chute_fy_N"),
+                   col("mesh_chute_fz_N"), box, [m * v for m, v in zip(box, col("sensor_falling_vx_m_s"))],
+                   [m * v for m, v in zip(box, col("sensor_falling_vz_m_s"))])
+
+
+def figures(t, count, held, out, fx, fy, fz, box, box_mvx, box_mvz):
+    """Each figure with its standard error; out is the cumulative mass that left."""
+    avg = lambda v: (lambda rows: mean([v[i] for i in rows]))
+    ratio = lambda a, b: (lambda rows: sum(a[i] for i in rows) / sum(b[i] for i in rows) if sum(b[i] for i in rows) > 0 else float("nan"))
+    rate = lambda rows: slope([t[i] for i in rows], [out[i] for i in rows])
+    return {
+        "particles in the domain": figure(t, avg(count)),
+        "mass in the domain [kg]": figure(t, avg(held)),
+        "mass flow out of the domain [kg/s]": figure(t, rate),
+        "force on the chute Fx [N]": figure(t, avg(fx)),
+        "force on the chute Fy [N]": figure(t, avg(fy)),
+        "force on the chute Fz [N]": figure(t, avg(fz)),
+        "falling stream vx [m/s]": figure(t, ratio(box_mvx, box)),
+        "falling stream vz [m/s]": figure(t, ratio(box_mvz, box)),
+    }
+
+
+def liggghts_figures(log, t0, t1, dt=1e-5):
+    rows = []
+    for line in open(log):
+        f = line.split()
+        if len(f) == 10 and f[0].isdigit():
+            v = [float(x) for x in f]
+            if t0 <= v[0] * dt <= t1:
+                rows.append(v)
+    t = [r[0] * dt for r in rows]
+    c = lambda k: [r[k] for r in rows]
+    return figures(t, c(1), c(2), [r[3] - r[2] for r in rows], c(4), c(5), c(6), c(7), c(8), c(9))
+
+
+def main():
+    case, folder, log, t0, t1 = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
+    d, g = demdesign_figures(folder, t0, t1), liggghts_figures(log, t0, t1)
+    print(f"{case}: averages over {t0:g} to {t1:g} s")
+    print(f"  {'figure':36s} {'demdesign':>20s} {'LIGGGHTS':>20s} {'difference':>11s} {'in std errors':>13s}")
+    for k in d:
+        (a, sa), (b, sb) = d[k], g[k]
+        diff = (a - b) / abs(b) * 100 if b else float("nan")
+        sigmas = (a - b) / (sa * sa + sb * sb) ** 0.5 if sa == sa and sb == sb and sa + sb > 0 else float("nan")
+        print(f"  {k:36s} {a:11.5g} +- {sa:<6.2g} {b:11.5g} +- {sb:<6.2g} {diff:+10.1f} % {sigmas:+12.1f}")
+    for k in d:
+        print(f"csv,{case},{k},{d[k][0]:.6g},{d[k][1]:.3g},{g[k][0]:.6g},{g[k][1]:.3g}")
+
+
+if __name__ == "__main__":
+    main()
