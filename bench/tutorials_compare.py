@@ -1,7 +1,12 @@
 #!/usr/bin/env python3
 """Figures of a LIGGGHTS tutorial run by both codes, side by side (bench/tutorials_side_by_side.sh).
 
-  tutorials_compare.py chute_wear DEMDESIGN_RUN_FOLDER LIGGGHTS_THERMO_LOG T0 T1
+  tutorials_compare.py chute_wear|conveyor DEMDESIGN_RUN_FOLDER LIGGGHTS_THERMO_LOG T0 T1
+
+conveyor: the mass on the belt, the belt's power on the material (LIGGGHTS: -F . v_belt from the
+belt's mesh/surface/stress force), the force on the belt, and the mass-weighted velocity of the
+material in the box it is thrown through (x -0.3 to -0.1 m); LIGGGHTS thermo rows of
+bench/liggghts/conveyor.in (step atoms mass Fx Fy Fz belt_mass box_mass box_mvx box_mvz).
 
 Averages over [T0, T1] s: particles and their mass in the domain, the mass flow out of the domain
 (slope of the mass that left), the particles' force on the chute by component, and the
@@ -70,7 +75,37 @@ def figures(t, count, held, out, fx, fy, fz, box, box_mvx, box_mvz):
     }
 
 
-def liggghts_figures(log, t0, t1, dt=1e-5):
+def conveyor_demdesign(folder, t0, t1):
+    rows = [r for r in csv.DictReader(open(folder + "/scalars.csv")) if t0 <= float(r["time_s"]) <= t1]
+    t = [float(r["time_s"]) for r in rows]
+    col = lambda name: [float(r[name]) for r in rows]
+    box = col("sensor_thrown_mass_kg")
+    return conveyor_figures(t, col("sensor_on_belt_mass_kg"), col("mesh_belt_power_W"), col("mesh_belt_fx_N"), col("mesh_belt_fz_N"),
+                            box, [m * v for m, v in zip(box, col("sensor_thrown_vx_m_s"))], [m * v for m, v in zip(box, col("sensor_thrown_vz_m_s"))])
+
+
+def conveyor_liggghts(log, t0, t1, dt=1e-5):
+    rows = thermo_rows(log, t0, t1, dt)
+    t = [r[0] * dt for r in rows]
+    c = lambda k: [r[k] for r in rows]
+    # The belt's power on the material: -F . v_belt with v_belt = (-4.5, 0, 0).
+    return conveyor_figures(t, c(6), [4.5 * r[3] for r in rows], c(3), c(5), c(7), c(8), c(9))
+
+
+def conveyor_figures(t, on_belt, power, fx, fz, box, box_mvx, box_mvz):
+    avg = lambda v: (lambda rows: mean([v[i] for i in rows]))
+    ratio = lambda a, b: (lambda rows: sum(a[i] for i in rows) / sum(b[i] for i in rows) if sum(b[i] for i in rows) > 0 else float("nan"))
+    return {
+        "mass on the belt [kg]": figure(t, avg(on_belt)),
+        "belt power on the material [W]": figure(t, avg(power)),
+        "force on the belt Fx [N]": figure(t, avg(fx)),
+        "force on the belt Fz [N]": figure(t, avg(fz)),
+        "thrown material vx [m/s]": figure(t, ratio(box_mvx, box)),
+        "thrown material vz [m/s]": figure(t, ratio(box_mvz, box)),
+    }
+
+
+def thermo_rows(log, t0, t1, dt):
     rows = []
     for line in open(log):
         f = line.split()
@@ -78,6 +113,11 @@ def liggghts_figures(log, t0, t1, dt=1e-5):
             v = [float(x) for x in f]
             if t0 <= v[0] * dt <= t1:
                 rows.append(v)
+    return rows
+
+
+def liggghts_figures(log, t0, t1, dt=1e-5):
+    rows = thermo_rows(log, t0, t1, dt)
     t = [r[0] * dt for r in rows]
     c = lambda k: [r[k] for r in rows]
     return figures(t, c(1), c(2), [r[3] - r[2] for r in rows], c(4), c(5), c(6), c(7), c(8), c(9))
@@ -85,7 +125,10 @@ def liggghts_figures(log, t0, t1, dt=1e-5):
 
 def main():
     case, folder, log, t0, t1 = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
-    d, g = demdesign_figures(folder, t0, t1), liggghts_figures(log, t0, t1)
+    if case == "conveyor":
+        d, g = conveyor_demdesign(folder, t0, t1), conveyor_liggghts(log, t0, t1)
+    else:
+        d, g = demdesign_figures(folder, t0, t1), liggghts_figures(log, t0, t1)
     print(f"{case}: averages over {t0:g} to {t1:g} s")
     print(f"  {'figure':36s} {'demdesign':>20s} {'LIGGGHTS':>20s} {'difference':>11s} {'in std errors':>13s}")
     for k in d:

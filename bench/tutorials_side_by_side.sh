@@ -4,7 +4,9 @@
 #   bench/tutorials_side_by_side.sh
 # chute_wear: cases/liggghts_chute_wear.yaml (the tutorial's own chute mesh) against
 # bench/liggghts/chute_wear.in (the tutorial's deck, 3 s instead of 1 s, with thermo figures);
-# averages over 1.5 to 3 s. Appends the figures to bench/results/tutorials_side_by_side.csv.
+# averages over 1.5 to 3 s. conveyor: cases/liggghts_conveyor.yaml against
+# bench/liggghts/conveyor.in, averages over 0.3 to 1.1 s (while the feed runs). Appends the
+# figures to bench/results/tutorials_side_by_side.csv.
 set -e
 BUILD=${BUILD:-build}
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -19,17 +21,22 @@ fi
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 COMMIT=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)
-echo "chute_wear: demdesign (1 thread) and LIGGGHTS (1 process), 3 s each; commit $COMMIT, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
-start=$(date +%s)
-"$ROOT/$BUILD/app/demdesign" "$ROOT/cases/liggghts_chute_wear.yaml" --threads 1 --no-report --quiet --out "$WORK/demdesign" > "$WORK/dem.log" 2>&1 ||
-  { tail -20 "$WORK/dem.log"; exit 1; }
-mid=$(date +%s)
-(cd "$WORK" && liggghts -in "$HERE/liggghts/chute_wear.in" -var dir "$TUTORIALS/chute_wear" -log none -echo none > lig.txt 2>&1) ||
-  { tail -20 "$WORK/lig.txt"; exit 1; }
-end=$(date +%s)
-echo "wall time: demdesign $((mid - start)) s, LIGGGHTS $((end - mid)) s"
-python3 "$HERE/tutorials_compare.py" chute_wear "$WORK/demdesign" "$WORK/lig.txt" 1.5 3.0 > "$WORK/table.txt"
-grep -v '^csv,' "$WORK/table.txt"
 CSV="$HERE/results/tutorials_side_by_side.csv"
 [ -f "$CSV" ] || echo "date,commit,tutorial,figure,demdesign,demdesign_std_error,liggghts,liggghts_std_error" > "$CSV"
-grep '^csv,' "$WORK/table.txt" | sed "s/^csv,/$(date +%F),$COMMIT,/" >> "$CSV"
+echo "commit $COMMIT, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); demdesign on 1 thread, LIGGGHTS on 1 process"
+# side TUTORIAL T0 T1: both codes, then the figures averaged over [T0, T1] s
+side() {
+  start=$(date +%s)
+  "$ROOT/$BUILD/app/demdesign" "$ROOT/cases/liggghts_$1.yaml" --threads 1 --no-report --quiet --out "$WORK/$1_demdesign" > "$WORK/$1_dem.log" 2>&1 ||
+    { tail -20 "$WORK/$1_dem.log"; exit 1; }
+  mid=$(date +%s)
+  (cd "$WORK" && liggghts -in "$HERE/liggghts/$1.in" -var dir "$TUTORIALS/$1" -log none -echo none > "$1_lig.txt" 2>&1) ||
+    { tail -20 "$WORK/$1_lig.txt"; exit 1; }
+  end=$(date +%s)
+  echo "$1: wall time demdesign $((mid - start)) s, LIGGGHTS $((end - mid)) s"
+  python3 "$HERE/tutorials_compare.py" "$1" "$WORK/$1_demdesign" "$WORK/$1_lig.txt" "$2" "$3" > "$WORK/$1_table.txt"
+  grep -v '^csv,' "$WORK/$1_table.txt"
+  grep '^csv,' "$WORK/$1_table.txt" | sed "s/^csv,/$(date +%F),$COMMIT,/" >> "$CSV"
+}
+side chute_wear 1.5 3.0
+side conveyor 0.3 1.1
