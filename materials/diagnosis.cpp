@@ -228,6 +228,32 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     std::vector<size_t> confirming;
     for (size_t rank = 0; rank < d.candidates.size() && static_cast<int>(confirming.size()) < options.confirm_candidates + 2; ++rank)
       if (chosen(d.candidates[rank], static_cast<int>(rank))) confirming.push_back(rank);
+    // With a budget, the confirmations are fitted into what is left of it, at the cost per
+    // simulation this diagnosis has measured so far: a candidate's simulations (cohesion, a wetter
+    // bed) may cost several times the first comparison's, on which the plan was made. The leader
+    // is always confirmed.
+    if (given.budget_seconds > 0 && command.outermost() && count.done() > 0 && confirming.size() > 1) {
+      const double per_simulation = count.elapsed() / count.done();
+      double left = given.budget_seconds - count.elapsed();
+      std::vector<size_t> kept;
+      std::vector<std::string> dropped;
+      double each = 0;
+      for (const size_t rank : confirming) {
+        const double cost = experiments * detail::calibration_passes(options, d.candidates[rank].k) * per_simulation;
+        if (kept.empty() || cost <= left) kept.push_back(rank), left -= cost;
+        else dropped.push_back(d.candidates[rank].name), each = cost;
+      }
+      if (!dropped.empty()) {
+        confirming = kept;
+        const auto gone = [&](const std::string& name) { return std::find(dropped.begin(), dropped.end(), name) != dropped.end(); };
+        std::erase_if(undecided, gone), std::erase_if(nonlinear, gone);
+        d.words.push_back(fmt::format("Within the budget of {} ({} spent, at {:.1f} s a simulation), {} {} not recalibrated (about {} each): run "
+                                      "again with a larger --budget, or with --effects {} (the simulations done are kept in the store).",
+                                      detail::duration_text(given.budget_seconds), detail::duration_text(count.elapsed()), per_simulation,
+                                      join(dropped, ", "), dropped.size() == 1 ? "was" : "were", detail::duration_text(each), join(dropped, ",")));
+        if (options.progress) options.progress("diagnose: " + d.words.back());
+      }
+    }
     if (command.outermost()) {
       int passes = 0;
       for (const size_t rank : confirming) passes += detail::calibration_passes(options, d.candidates[rank].k);
