@@ -30,8 +30,11 @@ CalibrationResult gravel_fit() {
   return r;
 }
 
+/// A folder of the running test's own: ctest runs tests in parallel processes, and two tests
+/// sharing one folder would remove each other's files.
 fs::path scratch() {
-  const fs::path dir = fs::temp_directory_path() / "demdesign_calibrated_material";
+  const fs::path dir = fs::temp_directory_path() /
+                       (std::string("demdesign_calibrated_material_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
