@@ -60,6 +60,12 @@ bool EventWatch::check(const Model& model, const State& s, double since) {
   const double now = s.time, dt = model.dt;
   const double domain_lo[3] = {model.domain_min[0], model.domain_min[1], model.domain_min[2]};
   const double domain_hi[3] = {model.domain_max[0], model.domain_max[1], model.domain_max[2]};
+  // When a centre outside the domain (along a non-periodic axis) left it; never when inside.
+  const auto left_domain = [&](const double x[3], const double v[3]) {
+    bool out = false;
+    for (int a = 0; a < 3; ++a) out |= model.period[a] <= 0 && (x[a] < domain_lo[a] || x[a] > domain_hi[a]);
+    return out ? exit_time(x, v, domain_lo, domain_hi, now) : kNever;
+  };
   bool any = false;
   for (Watch& w : watches_) {
     if (w.done) continue;
@@ -71,9 +77,7 @@ bool EventWatch::check(const Model& model, const State& s, double since) {
       if (w.kind == Watch::Kind::outlet) {
         const OutletSpec& o = model.outlets[w.index];
         if (o.domain) {
-          bool out = false;
-          for (int a = 0; a < 3; ++a) out |= model.period[a] <= 0 && (x[a] < domain_lo[a] || x[a] > domain_hi[a]);
-          if (out) at = exit_time(x, v, domain_lo, domain_hi, now);
+          at = left_domain(x, v);
         } else {
           const double lo[3] = {o.region_min.x(), o.region_min.y(), o.region_min.z()}, hi[3] = {o.region_max.x(), o.region_max.y(), o.region_max.z()};
           if (x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1] && x[2] >= lo[2] && x[2] <= hi[2]) at = entry_time(x, v, lo, hi, now);
@@ -88,9 +92,7 @@ bool EventWatch::check(const Model& model, const State& s, double since) {
         const double along = v[0] * n.x() + v[1] * n.y() + v[2] * n.z();
         if (past >= 0 && past <= 0.5 * sensor.thickness && along > 0) at = now - past / along;
       } else {
-        bool out = false;
-        for (int a = 0; a < 3; ++a) out |= model.period[a] <= 0 && (x[a] < domain_lo[a] || x[a] > domain_hi[a]);
-        if (out) at = exit_time(x, v, domain_lo, domain_hi, now);
+        at = left_domain(x, v);
       }
       if (at < best) best = at, who = s.id[p];
     }
