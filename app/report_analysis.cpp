@@ -232,8 +232,9 @@ RunAnalysis analyse_run(const RunReportInput& in) {
     const auto kgs = design_value(in.design, {"capacity", "_kg_s"});
     if (!std::isnan(th.second)) capacity = th.second, capacity_label = "design capacity", capacity_source = th.first;
     else if (!std::isnan(kgs.second)) capacity = kgs.second * 3.6, capacity_label = "design capacity", capacity_source = kgs.first;
-    else if (!model.inlets.empty()) {
-      capacity = 0;
+    else if (!model.inlets.empty() &&
+             std::all_of(model.inlets.begin(), model.inlets.end(), [](const Inlet& inlet) { return inlet.spec.mass_rate > 0; })) {
+      capacity = 0;  // an inlet that fills its region (`count` alone) has no rate
       for (const Inlet& inlet : model.inlets) capacity += inlet.spec.mass_rate * 3.6;
       capacity_label = "feed rate of the inlets", capacity_source = "sum of the inlets' mass rates";
     }

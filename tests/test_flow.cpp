@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
+#include <cstdio>
+#include <numbers>
 
 #include "output/checkpoint.h"
 #include "output/run.h"
@@ -32,6 +35,44 @@ TEST(Inlet, DeliversItsMassRateWithinTwoPercent) {
   EXPECT_EQ(sim.state.lost, 0);
   // Inserted particles never overlap much (no insertion into others or into walls).
   EXPECT_LT(measure(sim.model, sim.state, sim.work).max_overlap_ratio, 0.05);
+}
+
+// An inlet with `count` and no mass rate fills its region at each insertion (LIGGGHTS insert/pack)
+// until that many particles are in. Without gravity the spheres leave the 0.1 m box at 1 m/s, so
+// each insertion finds it empty: the first two place about the same number, at a solids fraction
+// below the saturation of random sequential addition of spheres, 0.3841 (Zhang & Torquato 2013,
+// Phys. Rev. E 88, 053312), and above two thirds of it; the third places the rest of the 1500 and
+// the inlet stops. An inlet with a mass rate and a count stops at the count too.
+TEST(Inlet, CountAloneFillsTheRegionAtEachInsertionUntilTheCount) {
+  const CaseSpec spec = parse_case_text(R"(
+simulation: {duration: 1.0, time_step: 1.0e-5, gravity: [0, 0, 0]}
+materials: {beads: {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.25, restitution: 0.5, friction: 0.5}}
+contact: {normal: hertz, damping: restitution, tangential: mindlin}
+inlets:
+  - {name: pack, material: beads, diameter: 0.01, count: 1500, interval: 0.2, velocity: [0, 0, -1],
+     region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}
+  - {name: feed, material: beads, diameter: 0.01, mass_rate_kgs: 0.1, count: 10, velocity: [0, 0, -1],
+     region: {min: [1, 0, 0], max: [1.1, 0.1, 0.1]}}
+)");
+  Sim sim(spec);
+  std::vector<std::int64_t> after;  // particles of `pack` after each insertion
+  while (sim.state.time < 1.0) {
+    const std::int64_t before = sim.state.inlets[0].inserted;
+    sim.advance();
+    if (sim.state.inlets[0].inserted != before) after.push_back(sim.state.inlets[0].inserted);
+  }
+  ASSERT_EQ(after.size(), 3u);
+  const double first = after[0], second = after[1] - after[0];
+  const double fraction = first * std::numbers::pi / 6 * 1e-6 / 1e-3;  // spheres' volume / the box's
+  std::printf("insertions: %lld, %lld, %lld; first fills %.3f of the box\n", static_cast<long long>(after[0]),
+              static_cast<long long>(after[1] - after[0]), static_cast<long long>(after[2] - after[1]), fraction);
+  EXPECT_LT(fraction, 0.3841);
+  EXPECT_GT(fraction, 2.0 / 3.0 * 0.3841);
+  EXPECT_NEAR(second, first, 0.1 * first);
+  EXPECT_EQ(after[2], 1500);
+  EXPECT_EQ(sim.state.inlets[0].failed, 0) << "a full region ends a filling insertion; it is not a failure";
+  EXPECT_EQ(sim.state.inlets[1].inserted, 10);
+  EXPECT_EQ(static_cast<std::int64_t>(sim.state.size()), 1510);
 }
 
 TEST(Scaling, MassAndStiffnessFactorsReachTheMaterialsAndAreReported) {

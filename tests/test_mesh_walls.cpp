@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <cstdio>
 
@@ -433,6 +434,47 @@ TEST(Stepping, AdvanceGivesBitwiseTheRunOfSingleSteps) {
   omp_set_num_threads(saved);
   EXPECT_EQ(single.second.drifts_ahead, 0);
   EXPECT_GE(single.second.rebuilds, 10) << "the spheres' motion and each moved sphere must cause rebuilds";
+}
+
+// A lid meshed at z = 0 that becomes a wall at 0.3 s (`active_from`), over an analytic floor at
+// z = -1 m. Sphere A (from z = 0.1 m) falls through the lid's place before then: at 0.29 s it
+// is where free fall puts it, z = 0.1 - g t^2 / 2 (exact under the kick-drift-kick integrator),
+// and the lid has felt nothing. Sphere B (from z = 1 m) reaches the lid at 0.45 s, after it
+// switched on, and comes to rest on it: its centre one radius above, with the lid carrying its
+// weight (5 %), while A lies on the floor below.
+TEST(MeshWalls, AMeshSwitchedOnLaterIsPassedThroughBeforeAndHoldsAfter) {
+  const CaseSpec spec = parse_case_text(R"(
+simulation: {duration: 1.0, time_step: 1.0e-5, gravity: [0, 0, -9.81]}
+materials: {beads: {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.25, restitution: 0.2, friction: 0.5}}
+contact: {normal: hertz, damping: restitution, tangential: mindlin}
+walls: [{name: floor, material: beads, plane: {point: [0, 0, -1], normal: [0, 0, 1]}}]
+meshes:
+  - name: lid
+    material: beads
+    vertices: [[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]]
+    triangles: [[0, 1, 2], [0, 2, 3]]
+    active_from: 0.3
+particles:
+  - {material: beads, diameter: 0.02, positions: [[-0.2, 0, 0.1], [0.2, 0, 1.0]]}
+)");
+  Sim sim(spec);
+  ASSERT_EQ(sim.model.meshes.size(), 1u);
+  EXPECT_EQ(sim.model.meshes[0].active_from, 0.3);
+  const size_t a = sim.slot(0), b = sim.slot(1);
+  const double g = 9.81, dt = sim.model.dt, r = 0.01;
+  double lid_force_before = 0;
+  while (sim.state.time < 0.29 - 0.5 * dt) {
+    sim.advance();
+    lid_force_before = std::max(lid_force_before, std::abs(sim.state.mesh_loads.fz.empty() ? 0.0 : sim.state.mesh_loads.fz[0]));
+  }
+  const double t = sim.state.time;
+  EXPECT_NEAR(sim.state.z[a], 0.1 - 0.5 * g * t * t, 1e-9) << "sphere A must have fallen freely through the lid's place";
+  EXPECT_EQ(lid_force_before, 0.0);
+  while (sim.state.time < 1.0 - 0.5 * dt) sim.advance();
+  const double mass = 2500 * std::numbers::pi / 6 * 0.02 * 0.02 * 0.02;
+  EXPECT_NEAR(sim.state.z[b], r, 0.01 * r) << "sphere B rests on the lid";
+  EXPECT_NEAR(sim.state.mesh_loads.fz[0], -mass * g, 0.05 * mass * g) << "the lid carries B's weight";
+  EXPECT_NEAR(sim.state.z[a], -1 + r, 0.01 * r) << "sphere A lies on the floor";
 }
 
 }  // namespace

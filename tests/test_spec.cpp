@@ -184,5 +184,21 @@ TEST(Output, ExplicitCameraIsReadAndCheckedPresetsListed) {
   EXPECT_NE(error_of(parallel).find("parallel"), std::string::npos) << error_of(parallel);
 }
 
+TEST(Inlets, AFeedNeedsAMassRateOrACountAndACountIsRead) {
+  const std::string fill = std::string(kGood) + "inlets:\n  - {material: glass, diameter: 0.004, count: 500, region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}\n";
+  const CaseSpec spec = parse_case_text(fill, "case.yaml");
+  ASSERT_EQ(spec.inlets.size(), 1u);
+  EXPECT_EQ(spec.inlets[0].count, 500);
+  EXPECT_EQ(spec.inlets[0].mass_rate, 0.0);
+  const std::string neither = replace(fill, "count: 500, ", "");
+  EXPECT_NE(error_of(neither).find("inlets[0].mass_rate_tph: missing"), std::string::npos) << error_of(neither);
+  EXPECT_NE(error_of(neither).find("`count` alone"), std::string::npos) << error_of(neither);
+  const std::string both = replace(fill, "count: 500", "mass_rate_tph: 1, mass_rate_kgs: 1");
+  EXPECT_NE(error_of(both).find("not both"), std::string::npos) << error_of(both);
+  const std::string mesh = std::string(kGood) +
+                           "meshes:\n  - {material: glass, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], triangles: [[0, 1, 2]], active_from: -1}\n";
+  EXPECT_NE(error_of(mesh).find("meshes[0].active_from"), std::string::npos) << error_of(mesh);
+}
+
 }  // namespace
 }  // namespace dem::test

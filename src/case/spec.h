@@ -148,6 +148,7 @@ struct MeshWallSpec {
   std::string material;
   Motion motion;                          ///< rigid motion of the whole mesh
   SurfaceVelocitySpec surface;
+  double active_from = 0;                 // [s] a wall from then on; before, particles pass through it
   SourceLocation location;
 };
 
@@ -159,13 +160,15 @@ struct ClumpTemplateSpec {
   SourceLocation location;
 };
 
-/// Inserts particles at a mass rate inside a box, without overlaps.
+/// Inserts particles at a mass rate inside a box, without overlaps; or, with `count` and no mass
+/// rate, as many as the box takes at each insertion until `count` are in (LIGGGHTS insert/pack).
 struct InletSpec {
   std::string name;
   std::string material;
   SizeDistributionSpec diameter;
   std::string clump;              ///< template name, or "" for spheres
-  double mass_rate = 0;           // [kg/s] (YAML: mass_rate_tph in t/h, or mass_rate_kgs)
+  double mass_rate = 0;           // [kg/s] (YAML: mass_rate_tph in t/h, or mass_rate_kgs); 0: fill the box
+  std::int64_t count = 0;         ///< particles after which the inlet stops; 0: no limit
   Vec3 region_min{0, 0, 0}, region_max{0, 0, 0};  // [m]
   Vec3 velocity{0, 0, 0};         // [m/s]
   double start = 0, stop = 1e300; // [s]

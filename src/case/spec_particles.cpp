@@ -109,8 +109,13 @@ InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t ind
   in.diameter = read_diameter(map, file);
   in.port = map.string("port", "");
   const bool tph = map.has("mass_rate_tph"), kgs = map.has("mass_rate_kgs");
-  if (tph == kgs) map.fail("mass_rate_tph", "give exactly one of mass_rate_tph [t/h] or mass_rate_kgs [kg/s]");
-  in.mass_rate = tph ? map.number("mass_rate_tph", 0, 1e-9, 1e6, "t/h") / 3.6 : map.number("mass_rate_kgs", 0, 1e-12, 1e6, "kg/s");
+  in.count = map.integer("count", 0, 1, 1'000'000'000);
+  if (tph && kgs) map.fail("mass_rate_kgs", "give one of mass_rate_tph [t/h] or mass_rate_kgs [kg/s], not both");
+  if (!tph && !kgs && in.count == 0)
+    map.fail("mass_rate_tph", "missing: give mass_rate_tph [t/h] or mass_rate_kgs [kg/s] (a feed), or `count` alone (fill the "
+                              "region at each insertion until that many particles are in)");
+  if (tph || kgs)
+    in.mass_rate = tph ? map.number("mass_rate_tph", 0, 1e-9, 1e6, "t/h") / 3.6 : map.number("mass_rate_kgs", 0, 1e-12, 1e6, "kg/s");
   if (in.port.empty()) read_box(map, "region", file, in.region_min, in.region_max);
   else if (map.has("region")) map.fail("region", fmt::format("give either `port: {}` (the equipment's feed point) or `region`, not both", in.port));
   in.velocity = map.vec3("velocity", in.velocity);

@@ -77,6 +77,7 @@ MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t i
   } else if (m.file.empty()) {
     map.fail("file", "missing: a mesh file (STL, OBJ, PLY, glTF, 3MF, ...) or inline vertices and triangles");
   }
+  m.active_from = map.number("active_from", 0.0, 0.0, 1e9, "s");
   if (const YAML::Node motion = map.node("motion")) m.motion = read_motion(motion, file, map.key_path("motion"), base_dir);
   if (const YAML::Node surface = map.node("surface_velocity")) {
     MapReader sv(surface, file, map.key_path("surface_velocity"));

@@ -274,6 +274,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     wall.bvh = std::make_shared<TriangleBvh>(*surface);
     wall.motion = m.motion;
     wall.surface_velocity = m.surface;
+    wall.active_from = m.active_from;
     model.meshes.push_back(std::move(wall));
   }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 
 #include "base/parallel.h"
@@ -166,9 +167,12 @@ void place_meshes(const Model& model, double time, Workspace& work) {
 
 double mesh_displacement_since_build(const Model& model, const State& state, double time) {
   double most = 0;
-  for (const MeshWall& mesh : model.meshes)
+  for (const MeshWall& mesh : model.meshes) {
+    // A mesh switched on since the lists were built has no candidates yet: rebuild now.
+    if (state.lists_built_time < mesh.active_from && time >= mesh.active_from) return std::numeric_limits<double>::infinity();
     if (!mesh.motion.is_static())
       most = std::max(most, mesh.motion.max_displacement(state.lists_built_time, time, mesh.surface->bounding_radius));
+  }
   return most;
 }
 
@@ -184,6 +188,7 @@ void find_mesh_candidates(const Model& model, State& s, Workspace& work, double 
               thread_local std::vector<std::int32_t> near;  // the BVH's answer for one mesh
               const double x[3] = {s.x[p], s.y[p], s.z[p]};
               for (size_t m = 0; m < model.meshes.size(); ++m) {
+                if (work.mesh_time < model.meshes[m].active_from) continue;  // not a wall yet
                 const double d[3] = {x[0] - work.mesh_translation[m][0], x[1] - work.mesh_translation[m][1],
                                      x[2] - work.mesh_translation[m][2]};
                 double local[3];

@@ -73,6 +73,7 @@ struct MeshWall {
   std::shared_ptr<const TriangleBvh> bvh;
   Motion motion;
   SurfaceVelocitySpec surface_velocity;
+  double active_from = 0;  // [s] no contacts before (a wall switched on after the particles settled through it)
 };
 
 /// A clump template in its principal frame with the centre of mass at the origin, scaled to a

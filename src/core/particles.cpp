@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <unordered_map>
 
@@ -262,6 +263,7 @@ State initial_state(const Model& model) {
 bool inlet_due(const Model& model, const State& state, int k) {
   const Inlet& inlet = model.inlets[k];
   const InletState& st = state.inlets[k];
+  if (inlet.spec.count > 0 && st.inserted >= inlet.spec.count) return false;
   return !(state.time < inlet.spec.start || state.time < st.next_time || state.time > inlet.spec.stop);
 }
 
@@ -282,8 +284,12 @@ std::int64_t run_inlet(const Model& model, State& state, int k, const std::vecto
   InletState& st = state.inlets[k];
   if (!inlet_due(model, state, k)) return 0;
   st.next_time = state.time + inlet.interval;
-  // Each batch delivers what is owed by the next insertion, so the flow starts at `start`.
-  const double owed = inlet.spec.mass_rate * (std::min(st.next_time, inlet.spec.stop) - inlet.spec.start);  // [kg]
+  // Each batch delivers what is owed by the next insertion, so the flow starts at `start`. Without
+  // a mass rate (`count` alone) each batch fills the region: it ends at the first sphere that finds
+  // no free place in 5000 random tries (near the random packing limit), which is then no failure.
+  const bool fill = inlet.spec.mass_rate <= 0;
+  const double owed = fill ? std::numeric_limits<double>::infinity()
+                           : inlet.spec.mass_rate * (std::min(st.next_time, inlet.spec.stop) - inlet.spec.start);  // [kg]
   const double density = model.materials[inlet.material].density;
   const double volume_per_d3 = inlet.clump >= 0 ? model.clumps[inlet.clump].volume : std::numbers::pi / 6.0;
   // Spheres near the region, for the overlap checks.
@@ -302,11 +308,11 @@ std::int64_t run_inlet(const Model& model, State& state, int k, const std::vecto
     if (st.pending_diameter == 0) st.pending_diameter = draw_diameter(inlet.spec.diameter, random);
     const double d = st.pending_diameter;
     const double mass = density * volume_per_d3 * d * d * d;
-    if (st.inserted_mass + 0.5 * mass > owed) break;
+    if (st.inserted_mass + 0.5 * mass > owed || (inlet.spec.count > 0 && st.inserted >= inlet.spec.count)) break;
     const Shape shape{inlet.material, inlet.clump, d};
     if (!try_place(model, state, grid, random, shape, inlet.spec.region_min, inlet.spec.region_max, inlet.spec.velocity,
-                   Vec3::Zero(), 200)) {
-      ++st.failed;  // region full: the deficit is carried to the next insertion
+                   Vec3::Zero(), fill ? 5000 : 200)) {
+      if (!fill) ++st.failed;  // region full: the deficit is carried to the next insertion
       break;
     }
     st.inserted_mass += mass;
