@@ -4,10 +4,12 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "case/spec.h"
 #include "core/model.h"
 #include "core/particles.h"
+#include "core/forces.h"
 #include "core/state.h"
 #include "core/step.h"
 #include "core/workspace.h"
@@ -42,5 +44,30 @@ inline double overlap_of(const State& s, size_t i, size_t j) {
   const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
   return s.radius[i] + s.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);
 }
+
+/// A one-contact batch between two spheres of radius r (or a sphere and a wall), for evaluating
+/// the model's effects directly at a chosen overlap.
+struct OneContact {
+  ContactBatch b{};
+  std::vector<double> history;
+  OneContact(const Model& model, double r_i, double r_j, double mass) : history(std::max(model.history_width, 1), 0.0) {
+    b.count = 1;
+    b.pair_type[0] = 0;
+    b.nx[0] = 1, b.ny[0] = 0, b.nz[0] = 0;
+    b.vn[0] = b.vtx[0] = b.vty[0] = b.vtz[0] = b.wx[0] = b.wy[0] = b.wz[0] = 0;
+    b.radius_i[0] = r_i;
+    b.radius_j[0] = r_j;
+    b.r_eff[0] = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
+    b.m_eff[0] = mass;
+    b.inertia_eff[0] = 1.4 * mass * r_i * r_i;
+    b.history[0] = history.data();
+  }
+  double force_at(const Model& model, double overlap) {
+    b.overlap[0] = overlap;
+    b.count = 1;
+    evaluate_effects(model, b);
+    return b.fn[0];
+  }
+};
 
 }  // namespace dem::test

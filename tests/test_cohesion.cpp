@@ -13,31 +13,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-/// A one-contact batch between two spheres of radius r (or a sphere and a wall), for evaluating
-/// the model's effects directly at a chosen overlap.
-struct OneContact {
-  ContactBatch b{};
-  std::vector<double> history;
-  OneContact(const Model& model, double r_i, double r_j, double mass) : history(std::max(model.history_width, 1), 0.0) {
-    b.count = 1;
-    b.pair_type[0] = 0;
-    b.nx[0] = 1, b.ny[0] = 0, b.nz[0] = 0;
-    b.vn[0] = b.vtx[0] = b.vty[0] = b.vtz[0] = b.wx[0] = b.wy[0] = b.wz[0] = 0;
-    b.radius_i[0] = r_i;
-    b.radius_j[0] = r_j;
-    b.r_eff[0] = r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i;
-    b.m_eff[0] = mass;
-    b.inertia_eff[0] = 1.4 * mass * r_i * r_i;
-    b.history[0] = history.data();
-  }
-  double force_at(const Model& model, double overlap) {
-    b.overlap[0] = overlap;
-    b.count = 1;
-    evaluate_effects(model, b);
-    return b.fn[0];
-  }
-};
-
 TEST(LiquidBridge, ForceFollowsWillettEquation12) {
   // Water, R = 1 mm beads, theta = 0, V = 0.419 nL (liquid content 0.003 shared by 6 bridges):
   // F(S) from validation E, column "Willett eq12" [mN]; F(0) = 2 pi R gamma = 0.45239 mN.

@@ -1,4 +1,5 @@
 // Oblique impacts and spin: Chung & Ooi (2011) tests 4 to 8 (validation CO-4 to CO-7).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -6,6 +7,7 @@
 #include <numbers>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "sim.h"
 #include "validation.h"
@@ -200,6 +202,34 @@ TEST(ChungOoi, Test7SpinningPairWithoutSlipKeepsItsSpin) {
       EXPECT_NEAR(r.wy[p], sign * w0, 1e-6 * w0) << w0;
       EXPECT_NEAR(r.vz[p], 0.0, 1e-6 * 0.2) << w0;
       EXPECT_NEAR(std::abs(r.vx[p]), 0.5 * 0.2, 0.005 * 0.1) << w0;  // e = 0.5
+    }
+  }
+}
+
+TEST(CoulombCap, SpringAbsFnCapsTheSpringAtMuTimesTheWholeNormalForce) {
+  // One Hertz contact with restitution damping (e = 0.5), friction 0.2, its spring stretched far
+  // beyond the limit so that it slides: the tangential force is the capped spring alone, mu times
+  // the elastic normal force (`spring`) or mu times |elastic + damping| (`spring_abs_fn`, LIGGGHTS
+  // tangential history). Approaching, the damping adds to the load; parting fast, the damped
+  // normal force pulls (tension) and its magnitude is still the load.
+  for (const std::string cap : {"spring", "spring_abs_fn"}) {
+    const Model model = compile(parse_case_text(R"(
+simulation: {duration: 1.0e-5, time_step: 1.0e-7, gravity: [0, 0, 0]}
+materials: {alumina: {density: 4000, youngs_modulus: 3.8e11, poisson_ratio: 0.23, restitution: 0.5, friction: 0.2}}
+contact: {normal: hertz, damping: restitution, tangential: {model: mindlin, coulomb_cap: )" + cap + R"(}}
+particles: [{material: alumina, diameter: 0.005, positions: [[0, 0, 0]]}]
+)"));
+    for (const double vn : {-2.0, 5.0}) {  // [m/s] approaching, parting
+      ASSERT_EQ(model.history_width, 3) << "the spring is the only history";
+      OneContact c(model, 0.0025, 0.0025, 1.3e-4);  // normal along x
+      c.history[1] = 1.0;  // [m] the spring, along y, stretched far beyond any limit
+      c.b.vn[0] = vn;
+      c.force_at(model, 1e-6);
+      const double ft = std::hypot(c.b.ftx[0], c.b.fty[0], c.b.ftz[0]);
+      const double load = cap == "spring" ? c.b.fn_elastic[0] : std::abs(c.b.fn[0]);
+      EXPECT_NEAR(ft, 0.2 * load, 1e-12 * load) << cap << ", vn " << vn;
+      if (vn > 0) EXPECT_LT(c.b.fn[0], 0.0) << "the damping pulls: the test must reach tension";
+      if (vn < 0) EXPECT_GT(c.b.fn[0], 1.5 * c.b.fn_elastic[0]) << "the damping must weigh in the load";
     }
   }
 }
