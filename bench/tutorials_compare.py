@@ -2,13 +2,17 @@
 """Figures of a LIGGGHTS tutorial run by both codes, side by side (bench/tutorials_side_by_side.sh).
 
   tutorials_compare.py chute_wear|conveyor DEMDESIGN_RUN_FOLDER LIGGGHTS_THERMO_LOG T0 T1
+  tutorials_compare.py moving_mesh DEMDESIGN_RUN_FOLDERS LIGGGHTS_THERMO_LOGS   (comma-separated, one per seed)
 
 conveyor: the mass on the belt, the belt's power on the material (LIGGGHTS: -F . v_belt from the
 belt's mesh/surface/stress force), the force on the belt, and the mass-weighted velocity of the
 material in the box it is thrown through (x -0.3 to -0.1 m); LIGGGHTS thermo rows of
 bench/liggghts/conveyor.in (step atoms mass Fx Fy Fz belt_mass box_mass box_mvx box_mvz).
 
-Averages over [T0, T1] s: particles and their mass in the domain, the mass flow out of the domain
+moving_mesh: see moving_mesh_figures; demdesign: box sensors `bed` (its offset across z is the mean
+height) and `lifted`, mesh `bucket`; LIGGGHTS: the thermo rows of bench/liggghts/moving_mesh.in.
+
+chute_wear: averages over [T0, T1] s: particles and their mass in the domain, the mass flow out of the domain
 (slope of the mass that left), the particles' force on the chute by component, and the
 mass-weighted velocity of the particles in the box after the chute's lip. demdesign: scalars.csv
 (outlet `exit` with region: domain, mesh `chute`, box sensor `falling`); LIGGGHTS: the thermo
@@ -123,13 +127,69 @@ def liggghts_figures(log, t0, t1, dt=1e-5):
     return figures(t, c(1), c(2), [r[3] - r[2] for r in rows], c(4), c(5), c(6), c(7), c(8), c(9))
 
 
+def moving_mesh_figures(t, bed_z, lifted, fx, fz):
+    """One run of movingMeshGran: the bed's mean height before the bucket moves (1.4-1.5 s), the
+    bucket's mean force while it digs in (1.5-2.25 s) and while it turns (2.25-3.5 s), and the mass
+    it lifts clear of the bed (above z = -0.1 m): mean over 2.5-3.5 s and peak while it turns."""
+    def over(v, a, b):
+        return mean([x for ti, x in zip(t, v) if a - 1e-9 <= ti <= b + 1e-9])
+    return {
+        "bed mean height at 1.4-1.5 s [m]": over(bed_z, 1.4, 1.5),
+        "bucket Fx while digging [N]": over(fx, 1.5, 2.25),
+        "bucket Fz while digging [N]": over(fz, 1.5, 2.25),
+        "bucket Fx while turning [N]": over(fx, 2.25, 3.5),
+        "bucket Fz while turning [N]": over(fz, 2.25, 3.5),
+        "mass lifted, mean 2.5-3.5 s [kg]": over(lifted, 2.5, 3.5),
+        "mass lifted, peak after 2.25 s [kg]": max(x for ti, x in zip(t, lifted) if ti >= 2.25),
+    }
+
+
+def moving_mesh_demdesign(folder):
+    rows = list(csv.DictReader(open(folder + "/scalars.csv")))
+    col = lambda name: [float(r[name]) for r in rows]
+    return moving_mesh_figures(col("time_s"), col("sensor_bed_offset_m"), col("sensor_lifted_mass_kg"), col("mesh_bucket_fx_N"),
+                               col("mesh_bucket_fz_N"))
+
+
+def moving_mesh_liggghts(log, dt=5e-5):
+    """Thermo rows of bench/liggghts/moving_mesh.in: step atoms mass sum(m z) lifted_mass
+    lifted_sum(m z) Fx Fy Fz."""
+    rows = {}
+    for line in open(log):
+        f = line.split()
+        if len(f) == 9 and f[0].isdigit():
+            rows[int(f[0])] = [float(x) for x in f]  # a step printed twice (end and start of runs) once
+    rows = [rows[k] for k in sorted(rows)]
+    t = [r[0] * dt for r in rows]
+    return moving_mesh_figures(t, [r[3] / r[2] if r[2] > 0 else float("nan") for r in rows], [r[4] for r in rows], [r[6] for r in rows],
+                               [r[8] for r in rows])
+
+
+def over_replicas(runs):
+    """{figure: (mean over the runs, its standard error)} from one dict per run."""
+    out = {}
+    for k in runs[0]:
+        v = [r[k] for r in runs]
+        mu = mean(v)
+        out[k] = (mu, (sum((x - mu) ** 2 for x in v) / (len(v) - 1) / len(v)) ** 0.5 if len(v) > 1 else float("nan"))
+    return out
+
+
 def main():
-    case, folder, log, t0, t1 = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
-    if case == "conveyor":
-        d, g = conveyor_demdesign(folder, t0, t1), conveyor_liggghts(log, t0, t1)
+    case, folder, log = sys.argv[1], sys.argv[2], sys.argv[3]
+    if case == "moving_mesh":
+        # Comma-separated run folders and logs, one per seed: a transient run, so the figures' noise
+        # is their spread over independent fills, not over batches of one run.
+        d = over_replicas([moving_mesh_demdesign(f) for f in folder.split(",")])
+        g = over_replicas([moving_mesh_liggghts(f) for f in log.split(",")])
+        print(f"{case}: means over {len(folder.split(','))} and {len(log.split(','))} runs with different fills")
     else:
-        d, g = demdesign_figures(folder, t0, t1), liggghts_figures(log, t0, t1)
-    print(f"{case}: averages over {t0:g} to {t1:g} s")
+        t0, t1 = float(sys.argv[4]), float(sys.argv[5])
+        if case == "conveyor":
+            d, g = conveyor_demdesign(folder, t0, t1), conveyor_liggghts(log, t0, t1)
+        else:
+            d, g = demdesign_figures(folder, t0, t1), liggghts_figures(log, t0, t1)
+        print(f"{case}: averages over {t0:g} to {t1:g} s")
     print(f"  {'figure':36s} {'demdesign':>20s} {'LIGGGHTS':>20s} {'difference':>11s} {'in std errors':>13s}")
     for k in d:
         (a, sa), (b, sb) = d[k], g[k]
