@@ -139,8 +139,8 @@ def moving_mesh_figures(t, bed_z, lifted, fx, fz):
         "bucket Fz while digging [N]": over(fz, 1.5, 2.25),
         "bucket Fx while turning [N]": over(fx, 2.25, 3.5),
         "bucket Fz while turning [N]": over(fz, 2.25, 3.5),
-        "mass lifted, mean 2.5-3.5 s [kg]": over(lifted, 2.5, 3.5),
-        "mass lifted, peak after 2.25 s [kg]": max(x for ti, x in zip(t, lifted) if ti >= 2.25),
+        "mass lifted (mean 2.5-3.5 s) [kg]": over(lifted, 2.5, 3.5),
+        "mass lifted (peak after 2.25 s) [kg]": max(x for ti, x in zip(t, lifted) if ti >= 2.25),
     }
 
 

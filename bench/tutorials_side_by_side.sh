@@ -7,7 +7,7 @@
 # averages over 1.5 to 3 s. conveyor: cases/liggghts_conveyor.yaml against
 # bench/liggghts/conveyor.in, averages over 0.3 to 1.1 s (while the feed runs). moving_mesh:
 # cases/liggghts_moving_mesh.yaml against bench/liggghts/moving_mesh.in (movingMeshGran), a
-# transient run, so each code runs SEEDS fills (default 6) and the figures are their means. Appends
+# transient run, so each code runs SEEDS fills (default 12) and the figures are their means. Appends
 # the figures to bench/results/tutorials_side_by_side.csv.
 set -e
 BUILD=${BUILD:-build}
@@ -20,8 +20,8 @@ if [ ! -d "$TUTORIALS/chute_wear" ]; then
   sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
   $sudo_cmd apt-get install -y -q liggghts-doc >/dev/null
 fi
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
+# KEEP=DIR keeps the runs in DIR; otherwise they go to a temporary folder removed at the end.
+if [ -n "$KEEP" ]; then WORK=$KEEP; mkdir -p "$WORK"; else WORK=$(mktemp -d); trap 'rm -rf "$WORK"' EXIT; fi
 COMMIT=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)
 CSV="$HERE/results/tutorials_side_by_side.csv"
 [ -f "$CSV" ] || echo "date,commit,tutorial,figure,demdesign,demdesign_std_error,liggghts,liggghts_std_error" > "$CSV"
@@ -68,7 +68,7 @@ print(n)" "$seed")
   grep -v '^csv,' "$WORK/$1_table.txt"
   grep '^csv,' "$WORK/$1_table.txt" | sed "s/^csv,/$(date +%F),$COMMIT,/" >> "$CSV"
 }
-SEEDS=${SEEDS:-"1 2 3 4 5 6"}
+SEEDS=${SEEDS:-"1 2 3 4 5 6 7 8 9 10 11 12"}
 case "${1:-all}" in
   chute_wear) side chute_wear 1.5 3.0 ;;
   conveyor) side conveyor 0.3 1.1 ;;
