@@ -167,13 +167,16 @@ TEST(ParaView, OpensTheResultsAndRendersTheRunsScript) {
   const fs::path png = out / "paraview.png";
   // Debian's ParaView renders through X: without a display, in a virtual one (Debian xvfb). The
   // server picks a free display and writes its number once it accepts connections (-displayfd).
+  // Under ctest -j2 pvbatch was once refused by a server that had just written its number ("bad X
+  // server connection"): the render is tried up to three times, a second apart.
   const std::string render = "pvbatch open_in_paraview.py --png " + png.string();
   const std::string command =
       std::getenv("DISPLAY") || !on_path("Xvfb")
           ? "cd " + out.string() + " && " + render
           : "cd " + out.string() + " && rm -f display.txt && (Xvfb -displayfd 3 -nolisten tcp -screen 0 1280x1024x24 3>display.txt >/dev/null 2>&1 & "
             "echo $! > xvfb.pid) && for i in $(seq 300); do [ -s display.txt ] && break; sleep 0.1; done && "
-            "DISPLAY=:$(cat display.txt) " + render + "; status=$?; kill $(cat xvfb.pid); exit $status";
+            "for try in 1 2 3; do DISPLAY=:$(cat display.txt) " + render + "; status=$?; [ $status -eq 0 ] && break; sleep 1; done; "
+            "kill $(cat xvfb.pid); exit $status";
   ASSERT_EQ(run(command, log), 0) << log;
   ASSERT_TRUE(fs::exists(png)) << log;
   EXPECT_GT(fs::file_size(png), 20000u) << "a 1280 x 720 view of particles and walls";
