@@ -2,14 +2,15 @@
 // compile, and step it while recording what a test needs.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "case/spec.h"
 #include "core/model.h"
-#include "core/particles.h"
 #include "core/forces.h"
+#include "core/particles.h"
 #include "core/state.h"
 #include "core/step.h"
 #include "core/workspace.h"

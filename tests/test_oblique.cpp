@@ -1,5 +1,4 @@
 // Oblique impacts and spin: Chung & Ooi (2011) tests 4 to 8 (validation CO-4 to CO-7).
-#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,7 +6,6 @@
 #include <numbers>
 #include <span>
 #include <string>
-#include <utility>
 
 #include "sim.h"
 #include "validation.h"
