@@ -311,7 +311,7 @@ EffectCandidate clump_candidate() {
 
 std::vector<EffectCandidate> missing_effects(const MaterialModel& model) {
   std::vector<EffectCandidate> out;
-  const ParticleScale scale{model.particle.density, typical_diameter(model.diameter)};
+  const ParticleScale scale{model.particle.density, typical_diameter(model.diameter), model.particle.youngs_modulus, model.particle.poisson_ratio};
   for (const EffectSpec* e : effect_table())
     if (e->candidate && stage_free(model.contact, *e)) out.push_back(contact_candidate(*e, scale));
   if (model.shape.empty()) out.push_back(clump_candidate());

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -215,7 +216,7 @@ TEST(MaterialModel, ReadsALibraryFile) {
   // Gravel already rolls: its candidates are cohesion and shape.
   std::vector<std::string> names;
   for (const auto& c : missing_effects(m)) names.push_back(c.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"jkr", "liquid_bridge", "clump_shape"}));  // in the effect table's order
+  EXPECT_EQ(names, (std::vector<std::string>{"jkr", "sjkr", "liquid_bridge", "clump_shape"}));  // in the effect table's order
   // Measured size, density and walls replace the library's.
   const MeasurementSet measured = parse_measurements(kGood, "m.yaml");
   apply_measured(m, measured);
@@ -227,7 +228,7 @@ TEST(MaterialModel, CandidatesAddTheirEffects) {
   MaterialModel m = read_material_model(kMaterials + "/glass_beads.yaml");
   EXPECT_EQ(m.contact.rolling.model, "none");
   const auto candidates = missing_effects(m);
-  ASSERT_EQ(candidates.size(), 4u);
+  ASSERT_EQ(candidates.size(), 5u);
   for (const auto& c : candidates) {
     MaterialModel with = m;
     c.add(with);
@@ -244,7 +245,8 @@ TEST(MaterialModel, CandidatesAddTheirEffects) {
 // ---- analytic stand-ins -------------------------------------------------------------------
 
 /// Known responses: friction mu, rolling friction mr (0 without rolling), liquid content lc,
-/// surface energy g (JKR), clump aspect a, restitution e. Noise from the seed (packing).
+/// surface energy g (JKR), cohesion energy density k (sjkr, in MJ/m^3: a strength that grows
+/// with the load), clump aspect a, restitution e. Noise from the seed (packing).
 struct Analytic {
   double noise = 1.0;  ///< scales the packing noise
   bool product = false;  ///< angle depends on friction x restitution only
@@ -254,7 +256,11 @@ struct Analytic {
     bool wet = false;
     for (const auto& c : m.contact.extra) wet = wet || c.model == "liquid_bridge";
     const double lc = wet ? get_parameter(m, "liquid_content") : 0.0;
-    const double g = m.contact.adhesion.empty() ? 0.0 : get_parameter(m, "surface_energy") / 10.0;
+    const auto adhesion = [&](const char* name) {
+      return std::any_of(m.contact.adhesion.begin(), m.contact.adhesion.end(), [&](const ContactSpec::Choice& c) { return c.model == name; });
+    };
+    const double g = adhesion("jkr") ? get_parameter(m, "surface_energy") / 10.0 : 0.0;
+    const double k = adhesion("sjkr") ? get_parameter(m, "cohesion_energy_density") / 1e6 : 0.0;
     const double a = get_parameter(m, "clump_aspect_ratio") - 1.0;
     std::mt19937_64 random(o.seed * 7919 + std::hash<std::string>{}(s.test));
     std::normal_distribution<double> n(0.0, noise);
@@ -262,14 +268,17 @@ struct Analytic {
     if (s.test == "drop_rebound") out.observables["restitution"] = e + 0.002 * n(random);
     else if (s.test == "angle_of_repose_cylinder")
       out.observables["angle_deg"] = product ? 20 + 40 * mu * e + 0.3 * n(random)
-                                             : 18 + 12 * mu + 40 * mr + 400 * lc + 300 * g + 10 * a + 0.3 * n(random);
-    else if (s.test == "bulk_density") out.observables["bulk_density"] = 1600 - 250 * mu - 100 * mr - 2000 * lc - 1000 * g - 100 * a + 3 * n(random);
+                                             : 18 + 12 * mu + 40 * mr + 400 * lc + 300 * g + 200 * k + 10 * a + 0.3 * n(random);
+    else if (s.test == "bulk_density")
+      out.observables["bulk_density"] = 1600 - 250 * mu - 100 * mr - 2000 * lc - 1000 * g - 300 * k - 100 * a + 3 * n(random);
     else if (s.test == "rotating_drum")
-      out.observables["dynamic_angle_deg"] = 22 + 8 * mu + 35 * mr + 100 * lc + 80 * g + 5 * a + (0.15 + 0.5 * mr) * s.numbers.at("rpm") + 0.3 * n(random);
-    else if (s.test == "hopper_discharge") out.observables["mass_flow_rate"] = 2.0 - 0.6 * mu - 0.2 * mr - 30 * lc - 5 * g - 0.1 * a + 0.005 * n(random);
+      out.observables["dynamic_angle_deg"] =
+          22 + 8 * mu + 35 * mr + 100 * lc + 80 * g + 60 * k + 5 * a + (0.15 + 0.5 * mr) * s.numbers.at("rpm") + 0.3 * n(random);
+    else if (s.test == "hopper_discharge") out.observables["mass_flow_rate"] = 2.0 - 0.6 * mu - 0.2 * mr - 30 * lc - 5 * g - 4 * k - 0.1 * a + 0.005 * n(random);
     else if (s.test == "direct_shear") {
       const double sn = s.numbers.at("normal_stress");
-      out.observables["peak_shear_stress"] = (0.3 + 0.5 * mu + 0.3 * mr + 0.2 * a) * sn + 2e5 * lc + 3e4 * g * (1 + sn / 4000) + 10 * n(random);
+      out.observables["peak_shear_stress"] =
+          (0.3 + 0.5 * mu + 0.3 * mr + 0.2 * a + 0.5 * k) * sn + 2e5 * lc + 3e4 * g * (1 + sn / 4000) + 10 * n(random);
     }
     return out;
   }

@@ -100,8 +100,8 @@ TEST(CrossEngine, RollingFrictionEpsd2IsFound) { expect_effect_found(diagnose_se
 TEST(CrossEngine, RollingFrictionCdtIsFound) { expect_effect_found(diagnose_set("rolling_cdt"), "epsd"); }
 
 // LIGGGHTS sjkr cohesion (cohesion energy density 1.5e5 J/m^3, a force on the contact area):
-// van der Waals cohesion (jkr).
-TEST(CrossEngine, CohesionSjkrIsFound) { expect_effect_found(diagnose_set("cohesion_sjkr"), "jkr"); }
+// the same law (sjkr), which the diagnosis offers beside JKR's pull-off.
+TEST(CrossEngine, CohesionSjkrIsFound) { expect_effect_found(diagnose_set("cohesion_sjkr"), "sjkr"); }
 
 }  // namespace
 }  // namespace dem::materials

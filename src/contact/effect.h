@@ -152,8 +152,10 @@ struct StartValue {
 /// The particles' scale, for effects whose natural strength depends on it (a cohesion in units
 /// of the particle weight).
 struct ParticleScale {
-  double density;   ///< [kg/m^3]
-  double diameter;  ///< [m] typical (median) diameter
+  double density;        ///< [kg/m^3]
+  double diameter;       ///< [m] typical (median) diameter
+  double youngs_modulus; ///< [Pa]
+  double poisson_ratio;  ///< [-]
 };
 
 /// What `diagnose` and `calibrate` need to propose an effect a material lacks: the effect's own
