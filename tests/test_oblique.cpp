@@ -226,8 +226,11 @@ particles: [{material: alumina, diameter: 0.005, positions: [[0, 0, 0]]}]
       const double ft = std::hypot(c.b.ftx[0], c.b.fty[0], c.b.ftz[0]);
       const double load = cap == "spring" ? c.b.fn_elastic[0] : std::abs(c.b.fn[0]);
       EXPECT_NEAR(ft, 0.2 * load, 1e-12 * load) << cap << ", vn " << vn;
-      if (vn > 0) EXPECT_LT(c.b.fn[0], 0.0) << "the damping pulls: the test must reach tension";
-      if (vn < 0) EXPECT_GT(c.b.fn[0], 1.5 * c.b.fn_elastic[0]) << "the damping must weigh in the load";
+      if (vn > 0) {
+        EXPECT_LT(c.b.fn[0], 0.0) << "the damping pulls: the test must reach tension";
+      } else {
+        EXPECT_GT(c.b.fn[0], 1.5 * c.b.fn_elastic[0]) << "the damping must weigh in the load";
+      }
     }
   }
 }

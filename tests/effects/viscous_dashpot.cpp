@@ -45,6 +45,7 @@ const EffectSpec viscous_dashpot{
     .history = {},
     .kernel = dashpot_kernel,
     .range = nullptr,
+    .requires_normal = "",
     .candidate = &kCandidate,
 };
 
