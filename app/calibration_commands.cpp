@@ -79,6 +79,8 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
       (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
       (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)");
       (*cmd)->add_option("--design-factor", design_factor_, "design points per round = max(b+1, ceil(factor b)+2), b quadratic coefficients");
+      (*cmd)->add_flag("--no-walls-first", no_walls_first_,
+                       "leave each wall pair's restitution as the material gives it, instead of fitting it first to the drop tests on that wall");
       (*cmd)->add_option("--budget", budget_,
                          "wall time to fit in, e.g. 30m, 2h, 900s: after the first comparison the rest is planned to fit (fewer rounds, design "
                          "points, packings, candidates) and the report says what was given up");
@@ -174,6 +176,7 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.replicas = replicas_;
   options.rounds = rounds_;
   options.design_factor = design_factor_;
+  options.walls_first = !no_walls_first_;
   options.confirm_candidates = confirm_;
   options.effects = split(effects_);
   options.size_factor = size_factor_;

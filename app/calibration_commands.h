@@ -44,7 +44,7 @@ class CalibrationCommands {
   double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
   double stiffness_check_ = 0;  ///< compare --stiffness-check: factor of the second comparison (0: none)
   int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
-  bool no_store_ = false, no_renders_ = false;
+  bool no_store_ = false, no_renders_ = false, no_walls_first_ = false;
   long long noise_seed_ = 1;
   int write_synthetic();
   /// compare --stiffness-check: the comparison again with stiffer particles, each observable's

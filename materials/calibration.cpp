@@ -202,22 +202,27 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 
 }  // namespace
 
-CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
+CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
                             const CalibrationOptions& given, const Comparison* before) {
   const Clock::time_point t0 = Clock::now();
   CalibrationOptions options = given;  // a budget may reduce it
   CalibrationResult result;
-  if (parameters.empty()) parameters = fit_parameters(model);
+  if (parameters.empty()) parameters = fit_parameters(given_model);
   if (parameters.empty()) throw std::invalid_argument("nothing to calibrate: the material declares no `tunable:` ranges and none were given");
   result.parameters = parameters;
   const int p = static_cast<int>(parameters.size());
-  for (const FitParameter& f : parameters) result.start.push_back(get_parameter(model, f.key));
+  for (const FitParameter& f : parameters) result.start.push_back(get_parameter(given_model, f.key));
+  // Stage one: the wall pairs' restitution from their drop tests (walls_first.cpp). The design
+  // starts from that model; `before` stays the comparison of the model as given.
+  const detail::WallsFirst walls = detail::fit_walls_first(given_model, measured, parameters, options);
+  const MaterialModel& model = walls.model;
+  result.words = walls.words;
 
   const int n = static_cast<int>(measured.experiments.size());
   const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
   // The start, with replicas: its simulation noise stands for the noise everywhere.
   if (before) result.before = *before;
-  else result.before = compare(model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+  else result.before = compare(given_model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
   std::string budget_words;
   if (options.budget_seconds > 0) {
     const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0);

@@ -110,6 +110,11 @@ struct CalibrationOptions {
   bool propose_experiments = true;
   double separation_needed = 3.0;  ///< [sigma] a proposed experiment decides when the two predictions lie this far apart
   bool wall_candidates = true;      ///< diagnose also tries the wall parameters the fit leaves out
+  /// Before the bulk fit, each particle-wall pair's restitution is fitted to the rebound heights
+  /// of the drop tests on that wall alone (walls_first.cpp): a single contact measures it
+  /// directly, and a guessed wall restitution would otherwise misfit like missing physics.
+  /// Skipped for a pair whose restitution was measured or is among the fitted parameters.
+  bool walls_first = true;
   /// [s] wall time the command may take; 0: no limit. After the first comparison (which measures
   /// what a simulation of each experiment costs) the rest is planned to fit: fewer surrogate
   /// rounds and design points, fewer packings, fewer candidates, in that order, and the result

@@ -86,9 +86,23 @@ class CommandProgress {
 
  private:
   friend class CommandScope;
+  friend class Uncounted;
   int depth_ = 0, planned_ = 0, done_ = 0;
   std::string what_;
   Clock::time_point t0_;
+};
+
+/// Simulations run inside it are left out of the command's count (the cheap single-contact fit
+/// that precedes a calibration): the count and the plan are as they were before it.
+class Uncounted {
+ public:
+  Uncounted() : done_(CommandProgress::shared().done_), planned_(CommandProgress::shared().planned_) {}
+  ~Uncounted() { CommandProgress::shared().done_ = done_, CommandProgress::shared().planned_ = planned_; }
+  Uncounted(const Uncounted&) = delete;
+  Uncounted& operator=(const Uncounted&) = delete;
+
+ private:
+  int done_, planned_;
 };
 
 /// Marks a command's run: the outermost scope starts the command's count with `planned`
@@ -194,6 +208,16 @@ struct Job {
 std::vector<BatchOutcome> run_batch(const std::vector<Job>& jobs, const CalibrationOptions& options,
                                     const std::function<void(size_t, const BatchOutcome&)>& done,
                                     const std::function<bool(const BatchOutcome&)>& fatal);
+
+/// The model with each particle-wall pair's restitution fitted to the rebound heights of the
+/// drop tests on that wall (options.walls_first), and what was done in words (empty when
+/// nothing was). `parameters` are those the calibration fits itself: their pairs are left.
+struct WallsFirst {
+  MaterialModel model;
+  std::vector<std::string> words;
+};
+WallsFirst fit_walls_first(const MaterialModel& model, const MeasurementSet& measured, const std::vector<FitParameter>& parameters,
+                           const CalibrationOptions& options);
 
 /// The error of a batch outcome thrown again, with its kind.
 [[noreturn]] void rethrow(const BatchOutcome& b);

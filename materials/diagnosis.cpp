@@ -30,7 +30,8 @@ namespace {
 
 /// Wall parameters the fit leaves out (friction and restitution of each particle-wall pair, the
 /// rolling friction when the model rolls), as candidates: a test that misses because of a wall
-/// points at the wall's parameter, not at missing physics. Measured ones are inputs: not offered.
+/// points at the wall's parameter, not at missing physics. Measured ones are inputs, and those
+/// fitted first to their own drop tests are settled: neither is offered.
 std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& model, const std::vector<FitParameter>& fitted) {
   std::vector<EffectCandidate> out;
   std::vector<std::string> keys = {"friction", "restitution"};
@@ -42,7 +43,7 @@ std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& mode
     const std::string wall = pair.material_a == model.name ? pair.material_b : pair.material_a;
     for (const std::string& key : keys) {
       const std::string full = wall + "." + key;
-      if (listed(fitted_keys, full) || listed(fitted_keys, "wall." + key) || listed(model.known, full)) continue;
+      if (listed(fitted_keys, full) || listed(fitted_keys, "wall." + key) || listed(model.known, full) || listed(model.fitted_first, full)) continue;
       const ParamSpec* p = find_param(key);
       if (!p) continue;
       const double lo = p->min_value, hi = std::min(p->max_value, 1.0);  // friction above 1 is not a wall liner's

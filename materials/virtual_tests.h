@@ -35,6 +35,9 @@ struct MaterialModel {
   std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max]
   /// Keys the measurement file gave as measured (inputs, never fitted), in file order.
   std::vector<std::string> known;
+  /// Wall-pair keys fitted first to their single-contact tests (walls_first.cpp): not offered
+  /// again as wall-parameter candidates.
+  std::vector<std::string> fitted_first;
   double mass_scaling = 1.0, stiffness_scaling = 1.0;  ///< applied to the virtual tests (reported)
 };
 
