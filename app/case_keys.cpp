@@ -345,7 +345,9 @@ void contact_tables(std::string& out, bool markdown) {
   heading(out, 2, "Contact parameters", markdown);
   out += "Keys of `materials.NAME`, `interactions[]`, a material file's `properties` and `walls.NAME`, and a "
          "measurement file's `particles` and `walls.NAME` (what was measured). A pair's value is mixed from its two "
-         "materials' values unless `interactions` gives it. From the effect table; `demdesign effects` prints it with "
+         "materials' values unless `interactions` gives it; a material that does not state the key leaves the pair "
+         "the other's value (a wall that says nothing of rolling resistance or cohesion takes the particles'), and the "
+         "default applies only when neither states it. From the effect table; `demdesign effects` prints it with "
          "each effect's source.\n\n";
   if (markdown) out += "| key | effect | unit | default | valid | pair value | tunable |\n|---|---|---|---|---|---|---|\n";
   for (const EffectSpec* e : effect_table())

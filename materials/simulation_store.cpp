@@ -42,7 +42,10 @@ std::string file_of(const std::string& folder, const std::string& test, const st
 }  // namespace
 
 std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
-  std::string out = fmt::format("engine: demdesign {}\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
+  // `meaning` counts changes of what the same inputs simulate within one version, so a stored
+  // simulation of an older meaning is run again. 2: a wall that does not state a contact
+  // parameter leaves it to the particles (before: mixed with the parameter's default).
+  std::string out = fmt::format("engine: demdesign {}\nmeaning: 2\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
   for (const auto& [k, v] : setup.numbers) out += fmt::format("setup.{}: {}\n", k, number(v));
   for (const auto& [k, v] : setup.words) out += fmt::format("setup.{}: {}\n", k, v);
   out += fmt::format("seed: {}\nsize_factor: {}\nmass_scaling: {}\nstiffness_scaling: {}\n", options.seed, number(options.size_factor),

@@ -188,12 +188,15 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
                                   c.normal.location.str(), e.spec->name, e.spec->requires_normal, c.normal.model));
   }
 
-  // Pair table: mixed material values, then explicit interactions, then derived values.
+  // Pair table: mixed material values, then explicit interactions, then derived values. A
+  // material that does not state a parameter leaves the pair's value to the one that does (the
+  // particles' rolling resistance or cohesion acts on a wall that says nothing of it, as their
+  // own property); neither states it: the default.
   const int n = model.n_materials();
   model.pair_table.assign(static_cast<size_t>(n) * n * model.pair_stride, 0.0);
-  auto value_of = [&](const MaterialSpec& m, const ParamSpec& p) {
+  auto stated = [&](const MaterialSpec& m, const ParamSpec& p) -> const double* {
     const auto it = m.params.find(std::string(p.key));
-    return it == m.params.end() ? p.default_value : it->second;
+    return it == m.params.end() ? nullptr : &it->second;
   };
   for (int a = 0; a < n; ++a) {
     for (int b = 0; b < n; ++b) {
@@ -203,7 +206,8 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
       for (const ActiveEffect& e : model.effects)
         for (size_t k = 0; k < e.spec->params.size(); ++k) {
           const ParamSpec& p = e.spec->params[k];
-          row[e.param_offset + k] = mix(p.mixing, value_of(spec.materials[a], p), value_of(spec.materials[b], p));
+          const double *va = stated(spec.materials[a], p), *vb = stated(spec.materials[b], p);
+          row[e.param_offset + k] = va && vb ? mix(p.mixing, *va, *vb) : va ? *va : vb ? *vb : p.default_value;
         }
     }
   }
