@@ -110,6 +110,23 @@ TEST(CaseReading, MixingRulesAndInteractionOverrides) {
   EXPECT_DOUBLE_EQ(model.pair_param(glass, glass, "friction"), 0.5);
 }
 
+// A material that does not state a parameter leaves the pair the other's value: the glass's
+// rolling resistance and cohesion act on a steel wall that says nothing of them (mixed with the
+// defaults, 0, they would be halved and, by the geometric mean, gone). Neither states it: the default.
+TEST(CaseReading, AnUnstatedParameterLeavesThePairTheOthersValue) {
+  const std::string text =
+      replace(std::string(kGood) + "contact: {rolling: epsd, adhesion: [sjkr]}\n", "particles:",
+              "  steel: {density: 7800, youngs_modulus: 2e11}\n  rubber: {density: 1100, youngs_modulus: 1e7, rolling_friction: 0.1}\nparticles:");
+  const Model model = compile(parse_case_text(
+      replace(text, "restitution: 0.5}", "restitution: 0.5, rolling_friction: 0.3, cohesion_energy_density: 1.5e5}"), "case.yaml"));
+  const int glass = model.material_index("glass"), steel = model.material_index("steel"), rubber = model.material_index("rubber");
+  EXPECT_DOUBLE_EQ(model.pair_param(glass, steel, "rolling_friction"), 0.3);
+  EXPECT_DOUBLE_EQ(model.pair_param(steel, glass, "cohesion_energy_density"), 1.5e5);
+  EXPECT_DOUBLE_EQ(model.pair_param(glass, rubber, "rolling_friction"), 0.2);  // both state it: arithmetic mean
+  EXPECT_DOUBLE_EQ(model.pair_param(steel, rubber, "cohesion_energy_density"), 0.0);  // neither: the default
+  EXPECT_DOUBLE_EQ(model.pair_param(steel, steel, "rolling_friction"), 0.0);
+}
+
 }  // namespace
 }  // namespace dem::test
 
