@@ -52,9 +52,16 @@ CrossEngineRun diagnose_set(const std::string& set) {
   std::printf("%s: %.0f s; plain model chi^2/n %.2f before, %.2f calibrated\n", set.c_str(), run.seconds, d.base.before.chi2_per_n(),
               d.base.after.chi2_per_n());
   for (const std::string& w : d.words) std::printf("  %s\n", w.c_str());
+  const auto fitted = [](const CalibrationResult& r) {
+    std::string out;
+    for (size_t k = 0; k < r.parameters.size(); ++k) out += fmt::format("{}{} {:.4g} +- {:.2g}", k ? ", " : "", r.parameters[k].key, r.value[k], r.sigma[k]);
+    return out;
+  };
+  std::printf("  plain model fitted: %s\n", fitted(d.base).c_str());
   for (const CandidateResult& c : d.candidates)
     std::printf("  %-16s explained %3.0f %%%s\n", c.name.c_str(), 100 * c.explained,
-                c.confirmed ? fmt::format(", confirmed: chi^2/n {:.2f}, delta BIC {:+.1f}", c.fit.after.chi2_per_n(), c.delta_bic).c_str() : "");
+                c.confirmed ? fmt::format(", confirmed: chi^2/n {:.2f}, delta BIC {:+.1f}; {}", c.fit.after.chi2_per_n(), c.delta_bic, fitted(c.fit)).c_str()
+                            : "");
   if (!keep) fs::remove_all(store);
   return run;
 }
