@@ -588,6 +588,22 @@ TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
   EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
 }
 
+/// Dry spheres with friction 0.3 and a guessed steel restitution of 0.5, and what `sim` measures
+/// of friction 0.5 and a steel restitution of 0.8: two drops on steel, a heap and a density.
+std::pair<MaterialModel, MeasurementSet> guessed_wall(const Simulator& sim) {
+  MaterialModel start = dry_spheres();
+  set_parameter(start, "friction", 0.3), set_parameter(start, "steel.restitution", 0.5);
+  MaterialModel truth = start;
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "steel.restitution", 0.8);
+  MeasurementSet set;
+  add(set, "drop_low", "drop_rebound", {{"drop_height", 0.1}}, "restitution", 0.02);
+  add(set, "drop_high", "drop_rebound", {{"drop_height", 0.5}}, "restitution", 0.02);
+  for (Experiment& e : set.experiments) e.setup.words["plate"] = "steel";
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  return {start, synthesise(set, truth, sim, 3)};
+}
+
 // A drop test misses because the particles' restitution on the steel plate is off, while the
 // flow tests fit: the diagnosis points at the wall parameter, not at missing physics.
 TEST(Diagnose, AWallParameterTheFitLeftOutIsNamedAsAParameter) {
@@ -602,17 +618,7 @@ TEST(Diagnose, AWallParameterTheFitLeftOutIsNamedAsAParameter) {
     if (s.test == "bulk_density") out.observables["bulk_density"] = 1650 - 150 * mu - 300 * mr + 3 * n(random);
     return out;
   };
-  MaterialModel start = dry_spheres();
-  set_parameter(start, "friction", 0.3), set_parameter(start, "steel.restitution", 0.5);
-  MaterialModel truth = start;
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "steel.restitution", 0.8);
-  MeasurementSet set;
-  add(set, "drop_low", "drop_rebound", {{"drop_height", 0.1}}, "restitution", 0.02);
-  add(set, "drop_high", "drop_rebound", {{"drop_height", 0.5}}, "restitution", 0.02);
-  for (Experiment& e : set.experiments) e.setup.words["plate"] = "steel";
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  set = synthesise(set, truth, sim, 3);
+  const auto [start, set] = guessed_wall(sim);
   CalibrationOptions options = analytic_options(sim);
   options.walls_first = false;  // (on, the drops settle the restitution first: the next test)
   const Diagnosis d = diagnose(start, set, {{"friction", 0.1, 0.9}}, options);
@@ -643,17 +649,7 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
     if (s.test == "bulk_density") out.observables["bulk_density"] = 1650 - 150 * mu + 3 * n(random);
     return out;
   };
-  MaterialModel start = dry_spheres();
-  set_parameter(start, "friction", 0.3), set_parameter(start, "steel.restitution", 0.5);
-  MaterialModel truth = start;
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "steel.restitution", 0.8);
-  MeasurementSet set;
-  add(set, "drop_low", "drop_rebound", {{"drop_height", 0.1}}, "restitution", 0.02);
-  add(set, "drop_high", "drop_rebound", {{"drop_height", 0.5}}, "restitution", 0.02);
-  for (Experiment& e : set.experiments) e.setup.words["plate"] = "steel";
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  set = synthesise(set, truth, sim, 3);
+  const auto [start, set] = guessed_wall(sim);
   const CalibrationResult fit = calibrate(start, set, {{"friction", 0.1, 0.9}}, analytic_options(sim));
   for (const std::string& w : fit.words) std::cout << w << "\n";
   // Two drops of sigma 0.02: the mean restitution to within 3 x 0.02 / sqrt(2).
