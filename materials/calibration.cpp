@@ -88,13 +88,55 @@ Surrogate fit_surrogate(const std::vector<FitParameter>& box, const std::vector<
                         const Eigen::MatrixXd& values, const Eigen::VectorXd& sigma) {
   Surrogate s;
   s.box = box, s.terms = terms, s.points = points, s.values = values;
-  const int n = static_cast<int>(points.rows()), p = static_cast<int>(box.size());
-  Eigen::MatrixXd X(n, basis_size(p));
+  const int n = static_cast<int>(points.rows()), p = static_cast<int>(box.size()), b = basis_size(p);
+  Eigen::MatrixXd X(n, b);
   for (int i = 0; i < n; ++i) X.row(i) = basis(to_unit(box, points.row(i).transpose())).transpose();
-  // Least squares through a rank-revealing QR: a design too small for a full quadratic still
-  // gives the minimum-norm-like fit of what it can resolve.
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> qr(X);
-  s.coefficients = qr.solve(values).transpose();
+  // Three forms, each a subset of the quadratic basis: linear (1, u_i), separable (and u_i^2),
+  // full (and u_i u_j). Each term takes the form with the smallest leave-one-out error (PRESS,
+  // from the hat matrix: e_i / (1 - h_ii)): a design of a few points more than the full quadratic
+  // has coefficients would otherwise fit the simulation noise and a response that is not
+  // quadratic (a heap that stops forming) with wild curvature between the points.
+  std::vector<std::vector<int>> forms(3);
+  for (int k = 0; k < b; ++k) {
+    const bool linear = k <= p;
+    bool square = false;
+    for (int i = 0, c = p + 1; i < p; ++i)
+      for (int j = i; j < p; ++j, ++c)
+        if (c == k) square = i == j;
+    if (linear) forms[0].push_back(k);
+    if (linear || square) forms[1].push_back(k);
+    forms[2].push_back(k);
+  }
+  s.coefficients = Eigen::MatrixXd::Zero(values.cols(), b);
+  s.form.assign(values.cols(), "quadratic");
+  const char* names[] = {"linear", "separable", "quadratic"};
+  std::vector<double> best_press(values.cols(), std::numeric_limits<double>::infinity());
+  for (int f = 0; f < 3; ++f) {
+    const int m = static_cast<int>(forms[f].size());
+    if (n < m) continue;
+    Eigen::MatrixXd Xf(n, m);
+    for (int c = 0; c < m; ++c) Xf.col(c) = X.col(forms[f][c]);
+    // Least squares through a rank-revealing QR: a design too small for the form still gives the
+    // minimum-norm fit of what it can resolve.
+    const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> qr(Xf);
+    const Eigen::MatrixXd coef = qr.solve(values);  // (m x terms)
+    const Eigen::MatrixXd hat = Xf * qr.pseudoInverse();
+    const Eigen::MatrixXd residual = values - Xf * coef;
+    for (int t = 0; t < values.cols(); ++t) {
+      double press = 0;
+      for (int i = 0; i < n && std::isfinite(press); ++i) {
+        const double leverage = 1.0 - hat(i, i);
+        press = leverage > 1e-6 ? press + std::pow(residual(i, t) / leverage, 2) : std::numeric_limits<double>::infinity();
+      }
+      // With no finite leave-one-out error (every point needed), the largest form that fits.
+      if (press < best_press[t] * (1 - 1e-9) || (!std::isfinite(best_press[t]) && !std::isfinite(press))) {
+        best_press[t] = press;
+        s.coefficients.row(t).setZero();
+        for (int c = 0; c < m; ++c) s.coefficients(t, forms[f][c]) = coef(c, t);
+        s.form[t] = names[f];
+      }
+    }
+  }
   const Eigen::MatrixXd fitted = X * s.coefficients.transpose();
   for (int t = 0; t < values.cols(); ++t) {
     const double rms = std::sqrt((fitted.col(t) - values.col(t)).squaredNorm() / std::max(1, n));
@@ -255,28 +297,38 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   for (const Experiment& e : measured.experiments) progress.plan(e, rounds * points);
   std::vector<FitParameter> box = parameters;
   Eigen::VectorXd x_best(p);
-  for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].min, parameters[i].max);
+  for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].lowest(), parameters[i].highest());
   Surrogate full_range;  // of round 1, over the whole parameter box: drawn in the contour maps
   Eigen::MatrixXd all_points(0, p), all_values(0, static_cast<Eigen::Index>(names.size()));
-  for (int round = 0; round < rounds; ++round) {
-    if (round > 0) {
-      // A box a quarter of each range wide around the last optimum.
-      for (int i = 0; i < p; ++i) {
-        const double half = 0.125 * (parameters[i].max - parameters[i].min);
-        const double lo = std::max(parameters[i].min, x_best[i] - half), hi = std::min(parameters[i].max, x_best[i] + half);
-        box[i].min = lo, box[i].max = hi;
-        if (hi - lo < 2 * half) {  // at a bound: keep the width
-          if (lo == parameters[i].min) box[i].max = lo + 2 * half;
-          else box[i].min = hi - 2 * half;
-        }
+  const auto add_point = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+    all_points.conservativeResize(all_points.rows() + 1, p);
+    all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
+    all_points.row(all_points.rows() - 1) = x.transpose();
+    all_values.row(all_values.rows() - 1) = v.transpose();
+  };
+  // A box `share` of the last box wide around x, inside the limits (at a limit it keeps its width).
+  const auto zoom = [&](const Eigen::VectorXd& x, const std::vector<FitParameter>& last, double share) {
+    std::vector<FitParameter> next = last;
+    for (int i = 0; i < p; ++i) {
+      const double lowest = parameters[i].lowest(), highest = parameters[i].highest();
+      const double half = 0.5 * share * (last[i].max - last[i].min);
+      const double lo = std::max(lowest, x[i] - half), hi = std::min(highest, x[i] + half);
+      next[i].min = lo, next[i].max = hi;
+      if (hi - lo < 2 * half) {
+        if (lo == lowest) next[i].max = std::min(highest, lo + 2 * half);
+        else next[i].min = std::max(lowest, hi - 2 * half);
       }
     }
+    return next;
+  };
+  // One round: a Latin hypercube in `box`, every experiment at every point as one batch (common
+  // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
+  // far inside the box; its optimum from several starts. A point whose simulation fails is
+  // skipped; bad input (CaseError) stops the calibration.
+  const auto design_round = [&](int round) {
     const Eigen::MatrixXd design = latin_hypercube(box, points, options.seed + 7919u * static_cast<std::uint64_t>(round));
     Eigen::MatrixXd values(points, static_cast<Eigen::Index>(names.size()));
     values.setConstant(kNaN);
-    // The round's simulations, every experiment at every point, as one batch (common random
-    // numbers: the same packing seed everywhere). A point whose simulation fails is skipped; bad
-    // input (CaseError) stops the calibration.
     std::vector<MaterialModel> models;
     for (int k = 0; k < points; ++k) models.push_back(with_values(model, parameters, design.row(k).transpose()));
     const size_t n_experiments = measured.experiments.size();
@@ -294,7 +346,6 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
           progress.step(e, fmt::format("round {} point {} {}{}", round + 1, k + 1, e.id, b.stored ? ", stored" : ""), b.stored ? 0.0 : b.outcome.wall_seconds);
         },
         [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
-    std::vector<int> good;
     for (int k = 0; k < points; ++k) {
       bool ok = true;
       for (size_t x = 0; x < n_experiments; ++x) {
@@ -311,14 +362,8 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
           if (it != index.end()) values(k, it->second) = v;
         }
       }
-      if (ok && values.row(k).allFinite()) good.push_back(k);
-    }
-    // Round 1 and 2 points both feed the last surrogate when they lie in its box.
-    for (int k : good) {
-      all_points.conservativeResize(all_points.rows() + 1, p);
-      all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
-      all_points.row(all_points.rows() - 1) = design.row(k);
-      all_values.row(all_values.rows() - 1) = values.row(k);
+      // Every round's points feed the later surrogates when they lie in their box.
+      if (ok && values.row(k).allFinite()) add_point(design.row(k).transpose(), values.row(k).transpose());
     }
     std::vector<int> inside;
     for (int k = 0; k < all_points.rows(); ++k) {
@@ -332,13 +377,15 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     for (size_t r = 0; r < inside.size(); ++r) P.row(r) = all_points.row(inside[r]), V.row(r) = all_values.row(inside[r]);
     result.surrogate = fit_surrogate(box, names, P, V, sigma);
     if (round == 0) full_range = result.surrogate;
-    // Starts: the best design points and the centre of the box.
+    // Starts: the best design points, the centre of the box and the last optimum when inside.
     SurrogateObjective objective{&result.surrogate, measured_values, sigma};
     std::vector<std::pair<double, int>> ranked;
     for (int r = 0; r < P.rows(); ++r) ranked.push_back({objective.chi2(P.row(r).transpose()), r});
     std::sort(ranked.begin(), ranked.end());
     std::vector<Eigen::VectorXd> starts = {from_unit(box, Eigen::VectorXd::Zero(p))};
-    if (round == 0) starts.push_back(x_best);
+    bool last_inside = true;
+    for (int i = 0; i < p; ++i) last_inside = last_inside && x_best[i] >= box[i].min && x_best[i] <= box[i].max;
+    if (last_inside) starts.push_back(x_best);
     for (int s = 0; s < std::min<int>(options.starts, static_cast<int>(ranked.size())); ++s) starts.push_back(P.row(ranked[s].second).transpose());
     x_best = minimise(objective, starts);
     result.surrogate_chi2 = objective.chi2(x_best);
@@ -350,6 +397,64 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                      return join(v);
                                    }(),
                                    result.surrogate_chi2 / static_cast<double>(names.size())));
+  };
+  for (int round = 0; round < rounds; ++round) {
+    if (round > 0) box = zoom(x_best, parameters, 0.25);  // a quarter of each range around the last optimum
+    design_round(round);
+  }
+
+  // Confirmation with real simulations (replicas; noise floor from the start where one replica).
+  const auto confirm = [&] {
+    const Comparison c = compare(with_values(model, parameters, x_best), measured, options);
+    result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+    Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
+    v.setConstant(kNaN);
+    for (const Term& t : c.terms)
+      if (const auto it = index.find(t.name()); it != index.end()) v[it->second] = t.simulated;
+    if (v.allFinite()) add_point(x_best, v);  // a point of the next surrogate, like a design point
+    return c;
+  };
+  result.after = confirm();
+  // Refinement: when the simulations miss what the surrogate predicted, or the optimum lies on an
+  // edge of the box that is not the parameter's limit, one more round in half the box around the
+  // best point simulated so far (the confirmed optimum or a design point), confirmed in turn.
+  const auto real_chi2 = [&](int row) { return ((all_values.row(row).transpose() - measured_values).array() / sigma.array()).square().sum(); };
+  for (int refine = 0; refine < options.refine_rounds; ++refine) {
+    const double real = result.after.chi2_per_n(), predicted = result.surrogate_chi2 / static_cast<double>(names.size());
+    const bool missed = real > options.fits_within_noise && real > 2 * predicted + 1;
+    std::vector<std::string> edges;
+    for (int i = 0; i < p; ++i) {
+      const double tol = 0.01 * (box[i].max - box[i].min);
+      if ((x_best[i] <= box[i].min + tol && box[i].min > parameters[i].lowest() + tol) || (x_best[i] >= box[i].max - tol && box[i].max < parameters[i].highest() - tol))
+        edges.push_back(parameters[i].key);
+    }
+    if (!missed && edges.empty()) break;
+    int best_row = 0;
+    for (int r = 1; r < all_points.rows(); ++r)
+      if (real_chi2(r) < real_chi2(best_row)) best_row = r;
+    const Eigen::VectorXd centre = all_points.rows() > 0 ? Eigen::VectorXd(all_points.row(best_row).transpose()) : x_best;
+    const std::string why = missed ? fmt::format("the simulations at the surrogate's optimum give chi^2/n {:.2f} where it predicted {:.2f}", real, predicted)
+                                   : fmt::format("the optimum lies on the edge of the searched box in {}", join(edges));
+    const Comparison kept_after = result.after;
+    const Surrogate kept_surrogate = result.surrogate;
+    const Eigen::VectorXd kept_x = x_best;
+    const double kept_chi2 = result.surrogate_chi2;
+    box = missed ? zoom(centre, box, 0.5) : zoom(x_best, box, 1.0);
+    if (options.progress) options.progress(fmt::format("calibrate: {}: one more round around the best point simulated so far", why));
+    const int n_experiments = static_cast<int>(measured.experiments.size());
+    for (const Experiment& e : measured.experiments) progress.plan(e, points);
+    if (detail::CommandProgress::shared().active()) detail::CommandProgress::shared().plan_more(n_experiments * (points + std::max(1, options.replicas)));
+    x_best = centre;
+    design_round(rounds + refine);
+    result.after = confirm();
+    if (result.after.chi2 <= kept_after.chi2) {
+      result.words.push_back(fmt::format("One more surrogate round: {}; refined, the simulations give chi^2/n {:.2f}.", why, result.after.chi2_per_n()));
+    } else {
+      result.words.push_back(fmt::format("One more surrogate round: {}; its optimum simulated gives chi^2/n {:.2f}, so the first optimum is kept.", why,
+                                         result.after.chi2_per_n()));
+      result.after = kept_after, result.surrogate = kept_surrogate, x_best = kept_x, result.surrogate_chi2 = kept_chi2;
+      break;
+    }
   }
   for (int i = 0; i < p; ++i) result.value.push_back(x_best[i]);
   result.fitted = with_values(model, parameters, x_best);
@@ -359,7 +464,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   const Eigen::VectorXd w = sigma.cwiseInverse().cwiseAbs2();
   const Eigen::MatrixXd F = J.transpose() * w.asDiagonal() * J;
   Eigen::VectorXd half(p);
-  for (int i = 0; i < p; ++i) half[i] = 0.5 * (parameters[i].max - parameters[i].min);
+  for (int i = 0; i < p; ++i) half[i] = 0.5 * (parameters[i].highest() - parameters[i].lowest());
   const Eigen::MatrixXd Fn = half.asDiagonal() * F * half.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Fn);
   const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
@@ -386,7 +491,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   result.correlation.assign(p, std::vector<double>(p, kNaN));
   for (int i = 0; i < p; ++i) {
     result.sigma.push_back(std::sqrt(cov_n(i, i)) * half[i]);
-    if (result.sigma.back() > 0.25 * (parameters[i].max - parameters[i].min)) flagged[i] = true;
+    if (result.sigma.back() > 0.25 * (parameters[i].highest() - parameters[i].lowest())) flagged[i] = true;
     for (int j = 0; j < p; ++j)
       result.correlation[i][j] = std::isfinite(cov_n(i, j)) && std::isfinite(cov_n(i, i) * cov_n(j, j)) && cov_n(i, i) > 0 && cov_n(j, j) > 0
                                      ? cov_n(i, j) / std::sqrt(cov_n(i, i) * cov_n(j, j))
@@ -395,16 +500,16 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   for (int i = 0; i < p; ++i)
     if (flagged[i]) result.unidentified.push_back(parameters[i].key);
 
-  // Confirmation with real simulations (replicas; noise floor from the start where one replica).
-  result.after = compare(result.fitted, measured, options);
-  result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
   result.wall_seconds = seconds_since(t0);
 
   // Words.
   std::vector<std::string> fitted;
   for (int i = 0; i < p; ++i)
-    fitted.push_back(fmt::format("{} = {:.4g} +- {:.2g} (start {:.4g}, range [{:g}, {:g}])", parameters[i].key, result.value[i], result.sigma[i],
-                                 result.start[i], parameters[i].min, parameters[i].max));
+    fitted.push_back(fmt::format("{} = {:.4g} +- {:.2g} (start {:.4g}, range [{:g}, {:g}]{})", parameters[i].key, result.value[i], result.sigma[i],
+                                 result.start[i], parameters[i].lowest(), parameters[i].highest(),
+                                 parameters[i].min > parameters[i].lowest() || parameters[i].max < parameters[i].highest()
+                                     ? fmt::format(", first designed over [{:g}, {:g}]", parameters[i].min, parameters[i].max)
+                                     : ""));
   if (!budget_words.empty()) result.words.push_back(budget_words);
   result.words.push_back("Fitted: " + join(fitted, "; ") + ".");
   result.words.push_back(fmt::format("chi^2/n from {:.2f} at the start to {:.2f} at the fit (real simulations, n = {}); the surrogate predicted {:.2f}.",

@@ -33,8 +33,10 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -90,6 +92,11 @@ struct CalibrationOptions {
   /// b the quadratic coefficients (3 for one parameter, 6 for two). Below 2 for fast screening.
   double design_factor = 2.0;
   int rounds = 2;               ///< surrogate rounds; round 2 spans a quarter of each range around round 1's optimum
+  /// Rounds added when the confirming simulations miss what the surrogate predicted (chi^2/n
+  /// above fits_within_noise and above 2 x predicted + 1) or the optimum lies on an edge of the
+  /// box inside the parameter's limit: each spans half the last box around the best point
+  /// simulated so far, and is confirmed in turn. The better confirmed point is the result.
+  int refine_rounds = 1;
   int starts = 8;               ///< NLopt starts (best design points and the centre)
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise
@@ -206,7 +213,13 @@ std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms);
 
 struct FitParameter {
   std::string key;
-  double min = 0, max = 1;
+  double min = 0, max = 1;  ///< the box the first round's design spans
+  /// The range the fit may leave the box for, when its optimum lies on an edge of the box (NaN:
+  /// the box is the range). A diagnosis designs a candidate's first round over the strengths its
+  /// signature points to and keeps the effect's whole range as the limit.
+  double limit_min = std::numeric_limits<double>::quiet_NaN(), limit_max = std::numeric_limits<double>::quiet_NaN();
+  double lowest() const { return std::isnan(limit_min) ? min : limit_min; }
+  double highest() const { return std::isnan(limit_max) ? max : limit_max; }
 };
 
 /// The model's tunable ranges; with `keys`, only those (each must have a range, from the
@@ -221,11 +234,14 @@ struct Surrogate {
   Eigen::MatrixXd points;           ///< (design points x parameters), physical units
   Eigen::MatrixXd values;           ///< (design points x terms)
   std::vector<double> fit_rms;      ///< per term: RMS of the fit residual, in units of the term's sigma
+  /// Per term, the form chosen by leave-one-out error: "linear", "separable" or "quadratic".
+  std::vector<std::string> form;
   Eigen::VectorXd predict(const Eigen::VectorXd& x) const;   ///< x physical -> (terms)
   Eigen::MatrixXd jacobian(const Eigen::VectorXd& x) const;  ///< (terms x parameters), physical units
 };
 
-/// Fits quadratic surfaces to values (points x terms) at points (points x parameters).
+/// Fits a surface to each term's values (points x terms) at points (points x parameters): linear,
+/// separable quadratic or full quadratic, whichever predicts the left-out points best.
 Surrogate fit_surrogate(const std::vector<FitParameter>& box, const std::vector<std::string>& terms, const Eigen::MatrixXd& points,
                         const Eigen::MatrixXd& values, const Eigen::VectorXd& sigma);
 

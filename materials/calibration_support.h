@@ -82,6 +82,8 @@ class CommandProgress {
   double elapsed() const { return seconds_since(t0_); }
   /// From now on `more` simulations remain to be done in all.
   void plan_remaining(int more) { planned_ = done_ + std::max(more, 0); }
+  /// `more` simulations added to the plan (a round the results asked for).
+  void plan_more(int more) { planned_ += std::max(more, 0); }
   void step() { ++done_; }
 
  private:

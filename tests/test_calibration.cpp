@@ -462,6 +462,60 @@ TEST(Calibration, FlagsParametersThatOnlyEnterAsAProduct) {
   EXPECT_NEAR(both.value[0], 0.6, 0.05);
 }
 
+TEST(Calibration, SurrogateFormsAreChosenByLeaveOneOutError) {
+  // Twelve points in two parameters: a plane with noise takes the linear form (a full quadratic
+  // would fit the noise), a saddle the quadratic one (no other form reproduces u1 u2).
+  const std::vector<FitParameter> box = {{"a", 0.0, 1.0}, {"b", -1.0, 1.0}};
+  const Eigen::MatrixXd points = latin_hypercube(box, 12, 5);
+  std::mt19937_64 random(11);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  Eigen::MatrixXd values(12, 2);
+  for (int k = 0; k < 12; ++k) {
+    const double u1 = 2 * points(k, 0) - 1, u2 = points(k, 1);
+    values(k, 0) = 1 + 2 * u1 - u2 + noise(random);
+    values(k, 1) = u1 * u2;
+  }
+  const Surrogate s = fit_surrogate(box, {"plane", "saddle"}, points, values, Eigen::Vector2d(0.05, 0.05));
+  ASSERT_EQ(s.form.size(), 2u);
+  EXPECT_EQ(s.form[0], "linear");
+  EXPECT_EQ(s.form[1], "quadratic");
+  EXPECT_LT(s.fit_rms[0], 1.5);  // the noise, in its sigma
+  EXPECT_LT(s.fit_rms[1], 1e-9);
+  EXPECT_NEAR(s.predict(Eigen::Vector2d(1.0, 1.0))[1], 1.0, 1e-9);
+}
+
+TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) {
+  // An angle that saturates within a narrow band of friction (a heap that stops forming below
+  // 0.4): four design points cannot draw it as a quadratic, and the surrogate's optimum, simulated,
+  // misses. One more round in half the box around the best point simulated so far finds it.
+  const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions&) {
+    const double mu = get_parameter(m, "friction");
+    SimulatedOutcome out;
+    if (s.test == "angle_of_repose_cylinder") out.observables["angle_deg"] = 20 + 12 * std::tanh((mu - 0.45) / 0.05);
+    else out.observables["dynamic_angle_deg"] = 25 + 4 * std::tanh((mu - 0.45) / 0.05);
+    return out;
+  };
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 0.5);
+  add(set, "drum", "rotating_drum", {{"rpm", 20}}, "dynamic_angle_deg", 0.5);
+  MaterialModel truth = dry_spheres();
+  set_parameter(truth, "friction", 0.5);
+  for (Experiment& e : set.experiments)
+    for (auto& [key, obs] : e.observed) obs.value = sim(truth, e.setup, TestOptions{}).observables.at(key);
+  CalibrationOptions o = analytic_options(sim);
+  o.replicas = 2, o.rounds = 1, o.design_factor = 0.5;
+  o.refine_rounds = 0;
+  const CalibrationResult once = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  o.refine_rounds = 1;
+  const CalibrationResult refined = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  EXPECT_GT(once.after.chi2_per_n(), 2 * once.surrogate_chi2 / 2 + 1) << "the stand-in no longer defeats one round";
+  EXPECT_LT(refined.after.chi2_per_n(), once.after.chi2_per_n() / 2);
+  EXPECT_LT(std::abs(refined.value[0] - 0.5), std::abs(once.value[0] - 0.5));
+  EXPECT_TRUE(std::any_of(refined.words.begin(), refined.words.end(), [](const std::string& w) { return w.starts_with("One more surrogate round"); }));
+  fmt::print("one round: friction {:.4f}, chi^2/n {:.2f}; refined: friction {:.4f}, chi^2/n {:.2f}\n", once.value[0], once.after.chi2_per_n(),
+             refined.value[0], refined.after.chi2_per_n());
+}
+
 struct HiddenCase {
   const char* effect;
   MeasurementSet set;
