@@ -150,11 +150,15 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   const bool removable = A.cols() > 0 && A.norm() > 0;
   const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> fitted_directions(removable ? A : Eigen::MatrixXd::Zero(nt, 1));
   const auto orthogonal = [&](const Eigen::VectorXd& s) { return removable ? Eigen::VectorXd(s - A * fitted_directions.solve(s)) : s; };
+  // Multiple of the added strength that best cancels r (0 when the step does not reduce it).
+  const auto cancelling = [&](const Eigen::VectorXd& s_perp, const Eigen::VectorXd& s) {
+    const double ss = s_perp.squaredNorm();
+    if (!(ss > 1e-12 * std::max(1.0, s.squaredNorm()) && r.squaredNorm() > 0)) return 0.0;
+    return std::max(0.0, -s_perp.dot(r) / ss);
+  };
   const auto explained_by = [&](const Eigen::VectorXd& s_perp, const Eigen::VectorXd& s) {
     const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
-    if (!(ss > 1e-12 * std::max(1.0, s.squaredNorm()) && rr > 0)) return 0.0;
-    const double alpha = -s_perp.dot(r) / ss;  // multiple of the added strength that best cancels r
-    return alpha > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
+    return cancelling(s_perp, s) > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
   };
   for (const EffectCandidate& c : effects) {
     CandidateResult cr;
@@ -162,6 +166,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
     cr.k = static_cast<int>(parameters.size() + cr.adds.size());
     Eigen::VectorXd perp[2];
+    double strength_needed = 0;  // of the added parameter, from the linear screen at either strength
     // A candidate the apparatus cannot take (clumps too large to fill a drum from a lattice) is
     // left out with the reason, not the whole diagnosis.
     std::string cannot;
@@ -197,6 +202,11 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
           if (u.name() == base.terms[i].name()) s[i] = (u.simulated - base.terms[i].simulated) / sig[i];
       perp[strength] = orthogonal(s);
       (strength == 0 ? cr.explained_start : cr.explained_stronger) = explained_by(perp[strength], s);
+      if (c.parameters.size() == 1) {
+        const auto& [key, range] = *c.parameters.begin();
+        const auto at = strength == 1 && c.stronger.count(key) ? c.stronger.at(key) : c.start.at(key);
+        strength_needed = std::max(strength_needed, range.first + cancelling(perp[strength], s) * (at - range.first));
+      }
       if (strength == 0) {
         cr.signature.assign(s.data(), s.data() + s.size());
         at_start[c.name] = changed;
@@ -208,6 +218,15 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       continue;
     }
     cr.explained = std::max(cr.explained_start, cr.explained_stronger);
+    // An effect's recalibration designs its first round over the strengths the screen points to,
+    // twice what it needs and at least the stronger step, with the effect's whole range as the
+    // limit the fit may move into: a cohesion range spans strengths at which the bed clings to the
+    // drum and arches in the hopper, simulations several times as long that say only "too strong".
+    if (cr.kind != "parameter" && cr.adds.size() == 1 && c.stronger.count(cr.adds[0].key)) {
+      FitParameter& added = cr.adds[0];
+      const double upper = std::clamp(std::max(c.stronger.at(added.key), 2.0 * strength_needed), added.min, added.max);
+      if (upper < added.max) added.limit_min = added.min, added.limit_max = added.max, added.max = upper;
+    }
     const double norms = perp[0].norm() * perp[1].norm();
     cr.agreement = norms > 0 ? perp[0].dot(perp[1]) / norms : 1.0;
     d.candidates.push_back(std::move(cr));
