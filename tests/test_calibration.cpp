@@ -1,26 +1,23 @@
-// Measurement files, material models, compare / calibrate / diagnose. The calibration machinery
-// is tested on analytic stand-ins for the virtual tests (known answers, no DEM); the hidden-effect
-// tests with real simulations are in test_diagnose_real.cpp.
+// Measurement files, material models, compare and calibrate, on analytic stand-ins for the virtual
+// tests (analytic_lab.h: known answers, no DEM). Diagnosis, budget and ledger: test_diagnose.cpp;
+// the hidden-effect tests with real simulations: test_diagnose_real.cpp.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <random>
 
+#include "analytic_lab.h"
 #include "calibration.h"
-#include "calibration_report.h"
 #include "material_model.h"
 #include "measurements.h"
 
 namespace dem::materials {
 namespace {
 
-const std::string kMaterials = DEMDESIGN_SOURCE_DIR "/materials";
+using namespace analytic;
 
 std::string error_of(const std::string& text) {
   try {
@@ -242,99 +239,6 @@ TEST(MaterialModel, CandidatesAddTheirEffects) {
   EXPECT_NEAR(get_parameter(wet, "clump_aspect_ratio"), 1.6, 1e-12);
 }
 
-// ---- analytic stand-ins -------------------------------------------------------------------
-
-/// Known responses: friction mu, rolling friction mr (0 without rolling), liquid content lc,
-/// surface energy g (JKR), cohesion energy density k (sjkr, in MJ/m^3: a strength that grows
-/// with the load), clump aspect a, restitution e. Noise from the seed (packing).
-struct Analytic {
-  double noise = 1.0;  ///< scales the packing noise
-  bool product = false;  ///< angle depends on friction x restitution only
-  SimulatedOutcome operator()(const MaterialModel& m, const TestSetup& s, const TestOptions& o) const {
-    const double mu = get_parameter(m, "friction"), e = get_parameter(m, "restitution");
-    const double mr = m.contact.rolling.model == "none" ? 0.0 : get_parameter(m, "rolling_friction");
-    bool wet = false;
-    for (const auto& c : m.contact.extra) wet = wet || c.model == "liquid_bridge";
-    const double lc = wet ? get_parameter(m, "liquid_content") : 0.0;
-    const auto adhesion = [&](const char* name) {
-      return std::any_of(m.contact.adhesion.begin(), m.contact.adhesion.end(), [&](const ContactSpec::Choice& c) { return c.model == name; });
-    };
-    const double g = adhesion("jkr") ? get_parameter(m, "surface_energy") / 10.0 : 0.0;
-    const double k = adhesion("sjkr") ? get_parameter(m, "cohesion_energy_density") / 1e6 : 0.0;
-    const double a = get_parameter(m, "clump_aspect_ratio") - 1.0;
-    std::mt19937_64 random(o.seed * 7919 + std::hash<std::string>{}(s.test));
-    std::normal_distribution<double> n(0.0, noise);
-    SimulatedOutcome out;
-    if (s.test == "drop_rebound") out.observables["restitution"] = e + 0.002 * n(random);
-    else if (s.test == "angle_of_repose_cylinder")
-      out.observables["angle_deg"] = product ? 20 + 40 * mu * e + 0.3 * n(random)
-                                             : 18 + 12 * mu + 40 * mr + 400 * lc + 300 * g + 200 * k + 10 * a + 0.3 * n(random);
-    else if (s.test == "bulk_density")
-      out.observables["bulk_density"] = 1600 - 250 * mu - 100 * mr - 2000 * lc - 1000 * g - 300 * k - 100 * a + 3 * n(random);
-    else if (s.test == "rotating_drum")
-      out.observables["dynamic_angle_deg"] =
-          22 + 8 * mu + 35 * mr + 100 * lc + 80 * g + 60 * k + 5 * a + (0.15 + 0.5 * mr) * s.numbers.at("rpm") + 0.3 * n(random);
-    else if (s.test == "hopper_discharge") out.observables["mass_flow_rate"] = 2.0 - 0.6 * mu - 0.2 * mr - 30 * lc - 5 * g - 4 * k - 0.1 * a + 0.005 * n(random);
-    else if (s.test == "direct_shear") {
-      const double sn = s.numbers.at("normal_stress");
-      out.observables["peak_shear_stress"] =
-          (0.3 + 0.5 * mu + 0.3 * mr + 0.2 * a + 0.5 * k) * sn + 2e5 * lc + 3e4 * g * (1 + sn / 4000) + 10 * n(random);
-    }
-    return out;
-  }
-};
-
-void add(MeasurementSet& set, const std::string& id, const std::string& test, std::map<std::string, double> numbers, const std::string& observable,
-         double sigma) {
-  Experiment e;
-  e.id = id;
-  e.setup.test = test;
-  e.setup.numbers = std::move(numbers);
-  e.observed[observable] = Observation{0.0, sigma, {}};
-  set.experiments.push_back(e);
-}
-
-/// Synthetic measurements: the truth simulated (its own packing) plus measurement noise.
-MeasurementSet synthesise(MeasurementSet set, const MaterialModel& truth, const Simulator& sim, std::uint64_t seed) {
-  std::mt19937_64 random(seed);
-  std::normal_distribution<double> n(0.0, 1.0);
-  for (Experiment& e : set.experiments) {
-    TestOptions o;
-    o.seed = 1000 + seed;
-    const SimulatedOutcome out = sim(truth, e.setup, o);
-    for (auto& [key, obs] : e.observed) obs.value = out.observables.at(key) + obs.sigma * n(random);
-  }
-  return set;
-}
-
-MaterialModel dry_spheres() {
-  MaterialModel m = read_material_model(kMaterials + "/gravel.yaml");
-  m.contact.rolling.model = "none";
-  m.particle.params.erase("rolling_friction");
-  m.tunable.erase("rolling_friction");
-  return m;
-}
-
-MeasurementSet flow_tests() {
-  MeasurementSet set;
-  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
-  add(set, "aor_1", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "aor_2", "angle_of_repose_cylinder", {{"fill_height", 0.15}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  add(set, "drum_10", "rotating_drum", {{"rpm", 10}}, "dynamic_angle_deg", 1.0);
-  add(set, "drum_20", "rotating_drum", {{"rpm", 20}}, "dynamic_angle_deg", 1.0);
-  add(set, "drum_30", "rotating_drum", {{"rpm", 30}}, "dynamic_angle_deg", 1.0);
-  add(set, "hopper", "hopper_discharge", {{"orifice_diameter", 0.05}}, "mass_flow_rate", 0.02);
-  return set;
-}
-
-CalibrationOptions analytic_options(const Simulator& sim) {
-  CalibrationOptions o;
-  o.simulator = sim;
-  o.replicas = 3;
-  return o;
-}
-
 TEST(Calibration, CompareFormsNormalisedResidualsWithSimulationNoise) {
   const Analytic sim;
   MaterialModel model = dry_spheres();
@@ -516,179 +420,6 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
              refined.value[0], refined.after.chi2_per_n());
 }
 
-struct HiddenCase {
-  const char* effect;
-  MeasurementSet set;
-  MaterialModel truth;
-};
-
-TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
-  const Analytic sim;
-  const MaterialModel start = dry_spheres();
-  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
-  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
-  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
-  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);  // the starting model fails visibly
-  ASSERT_FALSE(d.candidates.empty());
-  EXPECT_EQ(d.candidates.front().name, "epsd") << d.words.front();
-  EXPECT_EQ(d.recommended, "epsd") << d.words.front();
-  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
-  EXPECT_GT(d.candidates.front().explained, 0.5);
-  // The report: self-contained HTML with the diagnosis, contour maps and the ledger.
-  const std::string dir = (std::filesystem::temp_directory_path() / "demdesign_calibration_report").string();
-  std::filesystem::remove_all(dir);
-  report::CalibrationReportInput in;
-  in.title = "diagnose gravel";
-  in.diagnosis = &d;
-  in.ledger = append_ledger(dir + "/ledger.yaml", "gravel", {ledger_entry(start, d.base.before, "start", {"friction"}),
-                                                             ledger_entry(d.candidates.front().fit.fitted, d.candidates.front().fit.after, "+ rolling", {"friction"})});
-  const std::string html = report::write_calibration_report(in, dir);
-  std::ifstream file(html);
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("Most likely missing: epsd"), std::string::npos);
-  EXPECT_NE(text.find("Error ledger"), std::string::npos);
-  EXPECT_EQ(text.find("http"), std::string::npos);
-  // Per experiment, the observable that drives its misfit.
-  EXPECT_NE(text.find("what drives its misfit"), std::string::npos);
-  const materials::Term* worst = nullptr;
-  for (const materials::Term& t : d.base.before.terms)
-    if (t.experiment == d.base.before.runs.front().id && (!worst || std::abs(t.residual) > std::abs(worst->residual))) worst = &t;
-  ASSERT_NE(worst, nullptr);
-  EXPECT_NE(text.find(fmt::format("<td>{}</td><td>{} {:+.2f} &sigma;</td>", worst->experiment, worst->observable, worst->residual)), std::string::npos);
-  if (std::filesystem::exists(dir + "/plots/base_contour0.png")) {
-    EXPECT_NE(text.find("data:image/png;base64"), std::string::npos);
-  }
-}
-
-/// The dry spheres with liquid bridges of this liquid content, at friction 0.5.
-MaterialModel wet_spheres(double liquid_content) {
-  MaterialModel m = dry_spheres();
-  for (const EffectCandidate& c : missing_effects(m))
-    if (c.name == "liquid_bridge") c.add(m);
-  set_parameter(m, "liquid_content", liquid_content), set_parameter(m, "friction", 0.5);
-  return m;
-}
-
-TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
-  const Analytic sim;
-  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.01);
-  MeasurementSet set;
-  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  add(set, "hopper", "hopper_discharge", {{"orifice_diameter", 0.05}}, "mass_flow_rate", 0.02);
-  for (double sn : {2000.0, 4000.0, 6000.0}) add(set, fmt::format("shear_{:.0f}", sn), "direct_shear", {{"normal_stress", sn}}, "peak_shear_stress", 50);
-  set = synthesise(set, truth, sim, 5);
-  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
-  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
-  EXPECT_EQ(d.recommended, "liquid_bridge") << d.words.front();
-  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
-  bool offset_words = false;
-  for (const Pattern& p : d.base.before.patterns) offset_words = offset_words || p.words.find("yield locus") != std::string::npos;
-  EXPECT_TRUE(offset_words);
-  EXPECT_TRUE(d.rivals.empty()) << "a yield locus at three stresses tells an offset (bridges) from a steeper slope";
-}
-
-TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
-  // Truth: liquid bridges. Measured: a heap angle and a bulk density only. Friction cannot move
-  // both as the bridges did, but any effect that moves them in another direction, with friction,
-  // fits two numbers exactly: the runner-up is as good, and the diagnosis must say so.
-  const Analytic sim;
-  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.03);
-  MeasurementSet set;
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  set = synthesise(set, truth, sim, 5);
-  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
-  for (const std::string& w : d.words) std::printf("%s\n", w.c_str());
-  for (const CandidateResult& c : d.candidates) std::printf("  %s\n", c.words.c_str());
-  ASSERT_FALSE(d.recommended.empty()) << d.words.front();
-  ASSERT_GE(d.candidates.size(), 2u);
-  ASSERT_TRUE(d.candidates[1].confirmed);
-  EXPECT_LT(d.candidates[1].bic - d.candidates[0].bic, CalibrationOptions{}.rival_margin);
-  ASSERT_EQ(d.rivals.size(), 1u);
-  EXPECT_EQ(d.rivals.front(), d.candidates[1].name);
-  bool words = false;
-  for (const std::string& w : d.words) words = words || w.find("These data do not tell " + d.recommended + " from " + d.rivals.front()) == 0;
-  EXPECT_TRUE(words);
-  // The experiment it names separates them: simulated with the truth (bridges, which neither
-  // candidate is), its outcome lies at least 2 sigma nearer one prediction than the other, so the
-  // measurement decides between the two (here it also rejects both: the diagnosis is run again
-  // with it).
-  ASSERT_FALSE(d.separators.at(d.rivals.front()).empty());
-  const Separator& best = d.separators.at(d.rivals.front()).front();
-  EXPECT_GE(best.separation, 3.0) << best.words;
-  bool named = false;
-  for (const std::string& w : d.words) named = named || w.find("To tell " + d.recommended + " from " + d.rivals.front() + ", measure " + best.id) == 0;
-  EXPECT_TRUE(named);
-  TestOptions o;
-  o.seed = 4242;
-  const double truth_value = sim(truth, best.setup, o).observables.at(best.observable);
-  const double off_a = std::abs(truth_value - best.predicted_a) / best.sigma, off_b = std::abs(truth_value - best.predicted_b) / best.sigma;
-  std::printf("named: %s; truth %.4g (%.1f and %.1f sigma from the two)\n", best.words.c_str(), truth_value, off_a, off_b);
-  EXPECT_GE(std::max(off_a, off_b) - std::min(off_a, off_b), 2.0) << "the measurement decides between the two";
-}
-
-TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
-  const Analytic sim;
-  const MaterialModel start = dry_spheres();
-  MaterialModel truth = start;
-  set_parameter(truth, "friction", 0.7), set_parameter(truth, "restitution", 0.35);
-  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 17);
-  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
-  EXPECT_LT(d.base.after.chi2_per_n(), 1.5);
-  EXPECT_EQ(d.recommended, "");
-  EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
-}
-
-/// Dry spheres with friction 0.3 and a guessed steel restitution of 0.5, and what `sim` measures
-/// of friction 0.5 and a steel restitution of 0.8: two drops on steel, a heap and a density.
-std::pair<MaterialModel, MeasurementSet> guessed_wall(const Simulator& sim) {
-  MaterialModel start = dry_spheres();
-  set_parameter(start, "friction", 0.3), set_parameter(start, "steel.restitution", 0.5);
-  MaterialModel truth = start;
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "steel.restitution", 0.8);
-  MeasurementSet set;
-  add(set, "drop_low", "drop_rebound", {{"drop_height", 0.1}}, "restitution", 0.02);
-  add(set, "drop_high", "drop_rebound", {{"drop_height", 0.5}}, "restitution", 0.02);
-  for (Experiment& e : set.experiments) e.setup.words["plate"] = "steel";
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  return {start, synthesise(set, truth, sim, 3)};
-}
-
-// A drop test misses because the particles' restitution on the steel plate is off, while the
-// flow tests fit: the diagnosis points at the wall parameter, not at missing physics.
-TEST(Diagnose, AWallParameterTheFitLeftOutIsNamedAsAParameter) {
-  const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions& o) {
-    std::mt19937_64 random(o.seed * 7919 + std::hash<std::string>{}(s.test));
-    std::normal_distribution<double> n(0.0, 1.0);
-    const double mu = get_parameter(m, "friction");
-    const double mr = m.contact.rolling.model == "none" ? 0.0 : get_parameter(m, "rolling_friction");
-    SimulatedOutcome out;
-    if (s.test == "drop_rebound") out.observables["restitution"] = get_parameter(m, s.words.at("plate") + ".restitution") + 0.002 * n(random);
-    if (s.test == "angle_of_repose_cylinder") out.observables["angle_deg"] = 18 + 20 * mu + 40 * mr + 0.3 * n(random);
-    if (s.test == "bulk_density") out.observables["bulk_density"] = 1650 - 150 * mu - 300 * mr + 3 * n(random);
-    return out;
-  };
-  const auto [start, set] = guessed_wall(sim);
-  CalibrationOptions options = analytic_options(sim);
-  options.walls_first = false;  // (on, the drops settle the restitution first: the next test)
-  const Diagnosis d = diagnose(start, set, {{"friction", 0.1, 0.9}}, options);
-  for (const std::string& w : d.words) std::cout << w << "\n";
-  for (const CandidateResult& c : d.candidates) std::cout << "  " << c.words << "\n";
-  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
-  EXPECT_EQ(d.recommended, "steel.restitution") << fmt::format("{}", fmt::join(d.words, "\n"));
-  ASSERT_FALSE(d.words.empty());
-  EXPECT_EQ(d.words.front().rfind("Not missing physics: steel.restitution", 0), 0u) << d.words.front();
-  const auto it = std::find_if(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.name == "steel.restitution"; });
-  ASSERT_NE(it, d.candidates.end());
-  EXPECT_NEAR(get_parameter(it->fit.fitted, "steel.restitution"), 0.8, 0.03);
-  // An effect is not recommended to absorb it: no effect candidate beats the parameter.
-  EXPECT_EQ(d.candidates.front().kind, "parameter");
-}
-
 // The first stage of a calibration: the drops on the steel plate settle the particle-steel
 // restitution before the bulk fit, so the guessed wall value neither misfits the drops nor is
 // left to the diagnosis; a measured wall restitution is an input and is not fitted.
@@ -724,99 +455,6 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
   const CalibrationResult kept = calibrate(measured, set, {{"friction", 0.1, 0.9}}, analytic_options(sim));
   EXPECT_DOUBLE_EQ(get_parameter(kept.fitted, "steel.restitution"), 0.5);
   EXPECT_TRUE(kept.fitted.fitted_first.empty());
-}
-
-// --budget: from what a pass over the experiments costs, the plan gives up rounds, design
-// points, packings and candidates in that order until it fits, and says so.
-TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
-  Comparison first;
-  for (int e = 0; e < 7; ++e) {
-    ExperimentRun run;
-    run.replicas = 3, run.wall_seconds = 3 * 10.0;  // 10 s a simulation: 70 s a pass
-    first.runs.push_back(run);
-  }
-  CalibrationOptions options;
-  options.parallel = 2;  // 35 s a pass
-  options.budget_seconds = 1e6;
-  const BudgetPlan roomy = plan_within_budget(options, first, 2, 4, 4);
-  EXPECT_TRUE(roomy.given_up.empty());
-  // Defaults, 2 parameters: 2 x 14 + 3 passes; 8 candidates x 3; 2 confirmations x (2 x 22 + 3): 149 passes.
-  EXPECT_NEAR(roomy.seconds, 149 * 35.0, 1e-9);
-  options.budget_seconds = 1800;
-  const BudgetPlan tight = plan_within_budget(options, first, 2, 4, 4);
-  EXPECT_LE(tight.seconds, 1800);
-  ASSERT_FALSE(tight.given_up.empty());
-  EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
-  EXPECT_EQ(tight.options.rounds, 1);
-  // The wall parameters' screen goes only after the design points and the packings (a guessed
-  // wall pair misfits like missing physics): 51 passes fit 1800 s with the walls still screened.
-  EXPECT_TRUE(tight.options.wall_candidates);
-  EXPECT_EQ(tight.options.replicas, 2);
-  EXPECT_EQ(tight.options.design_factor, 0.5);
-  EXPECT_NEAR(tight.seconds, 51 * 35.0, 1e-9);
-  options.budget_seconds = 60;
-  const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
-  EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
-  EXPECT_EQ(impossible.options.confirm_candidates, 1);
-  // A diagnosis with a budget plans after its first comparison and says so first.
-  const Simulator costly = [](const MaterialModel& m, const TestSetup& s, const TestOptions& o) {
-    SimulatedOutcome out = Analytic{}(m, s, o);
-    out.wall_seconds = 10;
-    return out;
-  };
-  CalibrationOptions budgeted = analytic_options(costly);
-  budgeted.budget_seconds = 1200;
-  const Diagnosis d = diagnose(dry_spheres(), synthesise(flow_tests(), read_material_model(kMaterials + "/gravel.yaml"), costly, 11), {}, budgeted);
-  ASSERT_FALSE(d.words.empty());
-  EXPECT_EQ(d.words.front().rfind("Planned for the budget of 20 min", 0), 0u) << d.words.front();
-  EXPECT_NE(d.words.front().find("given up"), std::string::npos) << d.words.front();
-}
-
-// Progress over the whole command: every line counts one more of the diagnosis' simulations,
-// the count planned in all is never below those done, and by the end the plan (made again as the
-// diagnosis learns which candidates it confirms) equals what ran.
-TEST(Budget, ProgressCountsTheWholeDiagnosis) {
-  const Analytic sim;
-  const MaterialModel start = dry_spheres();
-  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
-  CalibrationOptions options = analytic_options(sim);
-  std::vector<std::pair<int, int>> counts;  // (done, planned in all)
-  options.progress = [&](const std::string& line) {
-    const auto at = line.find("; diagnose: simulation ");
-    if (at == std::string::npos) return;
-    int done = 0, planned = 0;
-    ASSERT_EQ(std::sscanf(line.c_str() + at, "; diagnose: simulation %d of about %d", &done, &planned), 2) << line;
-    counts.emplace_back(done, planned);
-  };
-  diagnose(start, synthesise(flow_tests(), truth, sim, 11), {}, options);
-  ASSERT_GT(counts.size(), 100u);
-  for (size_t k = 0; k < counts.size(); ++k) {
-    EXPECT_EQ(counts[k].first, static_cast<int>(k) + 1);
-    EXPECT_GE(counts[k].second, counts[k].first);
-  }
-  EXPECT_EQ(counts.back().first, counts.back().second);
-}
-
-TEST(Ledger, AppendsVersions) {
-  const std::string path = (std::filesystem::temp_directory_path() / "demdesign_ledger_test" / "ledger.yaml").string();
-  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
-  const MaterialModel m = dry_spheres();
-  Comparison c;
-  Term t;
-  t.experiment = "aor", t.observable = "angle_deg", t.residual = -3.5;
-  c.terms.push_back(t), c.chi2 = 12.25, c.n = 1;
-  append_ledger(path, "gravel", {ledger_entry(m, c, "start", {"friction"})});
-  c.terms[0].residual = 0.5, c.chi2 = 0.25;
-  const auto all = append_ledger(path, "gravel", {ledger_entry(m, c, "+ epsd", {"friction"})});
-  ASSERT_EQ(all.size(), 2u);
-  const auto read = read_ledger(path);
-  ASSERT_EQ(read.size(), 2u);
-  EXPECT_EQ(read[1].version, 2);
-  EXPECT_EQ(read[1].label, "+ epsd");
-  EXPECT_DOUBLE_EQ(read[0].residuals.at("aor/angle_deg"), -3.5);
-  EXPECT_DOUBLE_EQ(read[1].chi2_per_n(), 0.25);
-  EXPECT_DOUBLE_EQ(read[0].parameters.at("friction"), 0.65);
 }
 
 }  // namespace

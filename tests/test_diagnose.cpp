@@ -1,0 +1,274 @@
+// diagnose on analytic stand-ins (analytic_lab.h: known answers, no DEM): which hidden effect is
+// named, rivals, a wall parameter, the budget plan and progress, and the ledger of versions.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "analytic_lab.h"
+#include "calibration.h"
+#include "calibration_report.h"
+#include "material_model.h"
+#include "measurements.h"
+
+namespace dem::materials {
+namespace {
+
+using namespace analytic;
+
+struct HiddenCase {
+  const char* effect;
+  MeasurementSet set;
+  MaterialModel truth;
+};
+
+TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);  // the starting model fails visibly
+  ASSERT_FALSE(d.candidates.empty());
+  EXPECT_EQ(d.candidates.front().name, "epsd") << d.words.front();
+  EXPECT_EQ(d.recommended, "epsd") << d.words.front();
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
+  EXPECT_GT(d.candidates.front().explained, 0.5);
+  // The report: self-contained HTML with the diagnosis, contour maps and the ledger.
+  const std::string dir = (std::filesystem::temp_directory_path() / "demdesign_calibration_report").string();
+  std::filesystem::remove_all(dir);
+  report::CalibrationReportInput in;
+  in.title = "diagnose gravel";
+  in.diagnosis = &d;
+  in.ledger = append_ledger(dir + "/ledger.yaml", "gravel", {ledger_entry(start, d.base.before, "start", {"friction"}),
+                                                             ledger_entry(d.candidates.front().fit.fitted, d.candidates.front().fit.after, "+ rolling", {"friction"})});
+  const std::string html = report::write_calibration_report(in, dir);
+  std::ifstream file(html);
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Most likely missing: epsd"), std::string::npos);
+  EXPECT_NE(text.find("Error ledger"), std::string::npos);
+  EXPECT_EQ(text.find("http"), std::string::npos);
+  // Per experiment, the observable that drives its misfit.
+  EXPECT_NE(text.find("what drives its misfit"), std::string::npos);
+  const materials::Term* worst = nullptr;
+  for (const materials::Term& t : d.base.before.terms)
+    if (t.experiment == d.base.before.runs.front().id && (!worst || std::abs(t.residual) > std::abs(worst->residual))) worst = &t;
+  ASSERT_NE(worst, nullptr);
+  EXPECT_NE(text.find(fmt::format("<td>{}</td><td>{} {:+.2f} &sigma;</td>", worst->experiment, worst->observable, worst->residual)), std::string::npos);
+  if (std::filesystem::exists(dir + "/plots/base_contour0.png")) {
+    EXPECT_NE(text.find("data:image/png;base64"), std::string::npos);
+  }
+}
+
+/// The dry spheres with liquid bridges of this liquid content, at friction 0.5.
+MaterialModel wet_spheres(double liquid_content) {
+  MaterialModel m = dry_spheres();
+  for (const EffectCandidate& c : missing_effects(m))
+    if (c.name == "liquid_bridge") c.add(m);
+  set_parameter(m, "liquid_content", liquid_content), set_parameter(m, "friction", 0.5);
+  return m;
+}
+
+TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.01);
+  MeasurementSet set;
+  add(set, "drop", "drop_rebound", {{"drop_height", 0.3}}, "restitution", 0.02);
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  add(set, "hopper", "hopper_discharge", {{"orifice_diameter", 0.05}}, "mass_flow_rate", 0.02);
+  for (double sn : {2000.0, 4000.0, 6000.0}) add(set, fmt::format("shear_{:.0f}", sn), "direct_shear", {{"normal_stress", sn}}, "peak_shear_stress", 50);
+  set = synthesise(set, truth, sim, 5);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
+  EXPECT_EQ(d.recommended, "liquid_bridge") << d.words.front();
+  EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
+  bool offset_words = false;
+  for (const Pattern& p : d.base.before.patterns) offset_words = offset_words || p.words.find("yield locus") != std::string::npos;
+  EXPECT_TRUE(offset_words);
+  EXPECT_TRUE(d.rivals.empty()) << "a yield locus at three stresses tells an offset (bridges) from a steeper slope";
+}
+
+TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
+  // Truth: liquid bridges. Measured: a heap angle and a bulk density only. Friction cannot move
+  // both as the bridges did, but any effect that moves them in another direction, with friction,
+  // fits two numbers exactly: the runner-up is as good, and the diagnosis must say so.
+  const Analytic sim;
+  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.03);
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  set = synthesise(set, truth, sim, 5);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  for (const std::string& w : d.words) std::printf("%s\n", w.c_str());
+  for (const CandidateResult& c : d.candidates) std::printf("  %s\n", c.words.c_str());
+  ASSERT_FALSE(d.recommended.empty()) << d.words.front();
+  ASSERT_GE(d.candidates.size(), 2u);
+  ASSERT_TRUE(d.candidates[1].confirmed);
+  EXPECT_LT(d.candidates[1].bic - d.candidates[0].bic, CalibrationOptions{}.rival_margin);
+  ASSERT_EQ(d.rivals.size(), 1u);
+  EXPECT_EQ(d.rivals.front(), d.candidates[1].name);
+  bool words = false;
+  for (const std::string& w : d.words) words = words || w.find("These data do not tell " + d.recommended + " from " + d.rivals.front()) == 0;
+  EXPECT_TRUE(words);
+  // The experiment it names separates them: simulated with the truth (bridges, which neither
+  // candidate is), its outcome lies at least 2 sigma nearer one prediction than the other, so the
+  // measurement decides between the two (here it also rejects both: the diagnosis is run again
+  // with it).
+  ASSERT_FALSE(d.separators.at(d.rivals.front()).empty());
+  const Separator& best = d.separators.at(d.rivals.front()).front();
+  EXPECT_GE(best.separation, 3.0) << best.words;
+  bool named = false;
+  for (const std::string& w : d.words) named = named || w.find("To tell " + d.recommended + " from " + d.rivals.front() + ", measure " + best.id) == 0;
+  EXPECT_TRUE(named);
+  TestOptions o;
+  o.seed = 4242;
+  const double truth_value = sim(truth, best.setup, o).observables.at(best.observable);
+  const double off_a = std::abs(truth_value - best.predicted_a) / best.sigma, off_b = std::abs(truth_value - best.predicted_b) / best.sigma;
+  std::printf("named: %s; truth %.4g (%.1f and %.1f sigma from the two)\n", best.words.c_str(), truth_value, off_a, off_b);
+  EXPECT_GE(std::max(off_a, off_b) - std::min(off_a, off_b), 2.0) << "the measurement decides between the two";
+}
+
+TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = start;
+  set_parameter(truth, "friction", 0.7), set_parameter(truth, "restitution", 0.35);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 17);
+  const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
+  EXPECT_LT(d.base.after.chi2_per_n(), 1.5);
+  EXPECT_EQ(d.recommended, "");
+  EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
+}
+
+// A drop test misses because the particles' restitution on the steel plate is off, while the
+// flow tests fit: the diagnosis points at the wall parameter, not at missing physics.
+TEST(Diagnose, AWallParameterTheFitLeftOutIsNamedAsAParameter) {
+  const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions& o) {
+    std::mt19937_64 random(o.seed * 7919 + std::hash<std::string>{}(s.test));
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double mu = get_parameter(m, "friction");
+    const double mr = m.contact.rolling.model == "none" ? 0.0 : get_parameter(m, "rolling_friction");
+    SimulatedOutcome out;
+    if (s.test == "drop_rebound") out.observables["restitution"] = get_parameter(m, s.words.at("plate") + ".restitution") + 0.002 * n(random);
+    if (s.test == "angle_of_repose_cylinder") out.observables["angle_deg"] = 18 + 20 * mu + 40 * mr + 0.3 * n(random);
+    if (s.test == "bulk_density") out.observables["bulk_density"] = 1650 - 150 * mu - 300 * mr + 3 * n(random);
+    return out;
+  };
+  const auto [start, set] = guessed_wall(sim);
+  CalibrationOptions options = analytic_options(sim);
+  options.walls_first = false;  // (on, the drops settle the restitution first: the next test)
+  const Diagnosis d = diagnose(start, set, {{"friction", 0.1, 0.9}}, options);
+  for (const std::string& w : d.words) std::cout << w << "\n";
+  for (const CandidateResult& c : d.candidates) std::cout << "  " << c.words << "\n";
+  EXPECT_GT(d.base.after.chi2_per_n(), 5.0);
+  EXPECT_EQ(d.recommended, "steel.restitution") << fmt::format("{}", fmt::join(d.words, "\n"));
+  ASSERT_FALSE(d.words.empty());
+  EXPECT_EQ(d.words.front().rfind("Not missing physics: steel.restitution", 0), 0u) << d.words.front();
+  const auto it = std::find_if(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.name == "steel.restitution"; });
+  ASSERT_NE(it, d.candidates.end());
+  EXPECT_NEAR(get_parameter(it->fit.fitted, "steel.restitution"), 0.8, 0.03);
+  // An effect is not recommended to absorb it: no effect candidate beats the parameter.
+  EXPECT_EQ(d.candidates.front().kind, "parameter");
+}
+
+// --budget: from what a pass over the experiments costs, the plan gives up rounds, design
+// points, packings and candidates in that order until it fits, and says so.
+TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
+  Comparison first;
+  for (int e = 0; e < 7; ++e) {
+    ExperimentRun run;
+    run.replicas = 3, run.wall_seconds = 3 * 10.0;  // 10 s a simulation: 70 s a pass
+    first.runs.push_back(run);
+  }
+  CalibrationOptions options;
+  options.parallel = 2;  // 35 s a pass
+  options.budget_seconds = 1e6;
+  const BudgetPlan roomy = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_TRUE(roomy.given_up.empty());
+  // Defaults, 2 parameters: 2 x 14 + 3 passes; 8 candidates x 3; 2 confirmations x (2 x 22 + 3): 149 passes.
+  EXPECT_NEAR(roomy.seconds, 149 * 35.0, 1e-9);
+  options.budget_seconds = 1800;
+  const BudgetPlan tight = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_LE(tight.seconds, 1800);
+  ASSERT_FALSE(tight.given_up.empty());
+  EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
+  EXPECT_EQ(tight.options.rounds, 1);
+  // The wall parameters' screen goes only after the design points and the packings (a guessed
+  // wall pair misfits like missing physics): 51 passes fit 1800 s with the walls still screened.
+  EXPECT_TRUE(tight.options.wall_candidates);
+  EXPECT_EQ(tight.options.replicas, 2);
+  EXPECT_EQ(tight.options.design_factor, 0.5);
+  EXPECT_NEAR(tight.seconds, 51 * 35.0, 1e-9);
+  options.budget_seconds = 60;
+  const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
+  EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
+  EXPECT_EQ(impossible.options.confirm_candidates, 1);
+  // A diagnosis with a budget plans after its first comparison and says so first.
+  const Simulator costly = [](const MaterialModel& m, const TestSetup& s, const TestOptions& o) {
+    SimulatedOutcome out = Analytic{}(m, s, o);
+    out.wall_seconds = 10;
+    return out;
+  };
+  CalibrationOptions budgeted = analytic_options(costly);
+  budgeted.budget_seconds = 1200;
+  const Diagnosis d = diagnose(dry_spheres(), synthesise(flow_tests(), read_material_model(kMaterials + "/gravel.yaml"), costly, 11), {}, budgeted);
+  ASSERT_FALSE(d.words.empty());
+  EXPECT_EQ(d.words.front().rfind("Planned for the budget of 20 min", 0), 0u) << d.words.front();
+  EXPECT_NE(d.words.front().find("given up"), std::string::npos) << d.words.front();
+}
+
+// Progress over the whole command: every line counts one more of the diagnosis' simulations,
+// the count planned in all is never below those done, and by the end the plan (made again as the
+// diagnosis learns which candidates it confirms) equals what ran.
+TEST(Budget, ProgressCountsTheWholeDiagnosis) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  CalibrationOptions options = analytic_options(sim);
+  std::vector<std::pair<int, int>> counts;  // (done, planned in all)
+  options.progress = [&](const std::string& line) {
+    const auto at = line.find("; diagnose: simulation ");
+    if (at == std::string::npos) return;
+    int done = 0, planned = 0;
+    ASSERT_EQ(std::sscanf(line.c_str() + at, "; diagnose: simulation %d of about %d", &done, &planned), 2) << line;
+    counts.emplace_back(done, planned);
+  };
+  diagnose(start, synthesise(flow_tests(), truth, sim, 11), {}, options);
+  ASSERT_GT(counts.size(), 100u);
+  for (size_t k = 0; k < counts.size(); ++k) {
+    EXPECT_EQ(counts[k].first, static_cast<int>(k) + 1);
+    EXPECT_GE(counts[k].second, counts[k].first);
+  }
+  EXPECT_EQ(counts.back().first, counts.back().second);
+}
+
+TEST(Ledger, AppendsVersions) {
+  const std::string path = (std::filesystem::temp_directory_path() / "demdesign_ledger_test" / "ledger.yaml").string();
+  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
+  const MaterialModel m = dry_spheres();
+  Comparison c;
+  Term t;
+  t.experiment = "aor", t.observable = "angle_deg", t.residual = -3.5;
+  c.terms.push_back(t), c.chi2 = 12.25, c.n = 1;
+  append_ledger(path, "gravel", {ledger_entry(m, c, "start", {"friction"})});
+  c.terms[0].residual = 0.5, c.chi2 = 0.25;
+  const auto all = append_ledger(path, "gravel", {ledger_entry(m, c, "+ epsd", {"friction"})});
+  ASSERT_EQ(all.size(), 2u);
+  const auto read = read_ledger(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[1].version, 2);
+  EXPECT_EQ(read[1].label, "+ epsd");
+  EXPECT_DOUBLE_EQ(read[0].residuals.at("aor/angle_deg"), -3.5);
+  EXPECT_DOUBLE_EQ(read[1].chi2_per_n(), 0.25);
+  EXPECT_DOUBLE_EQ(read[0].parameters.at("friction"), 0.65);
+}
+
+}  // namespace
+}  // namespace dem::materials
