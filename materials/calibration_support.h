@@ -139,6 +139,16 @@ inline int calibration_passes(const CalibrationOptions& o, int p) { return std::
 /// parameters and screening `effects` effects and `walls` wall parameters (diagnosis.cpp).
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls);
 
+/// Which candidate confirmations fit what is left of a budget [s], each at its cost [s], in rank
+/// order: the first always; a later one when it fits, or when it is tied (the signature screen
+/// cannot tell it from the leader), then beyond the budget. `left` is what remains after those
+/// kept (negative when the tied ones exceed it).
+struct ConfirmationPlan {
+  std::vector<size_t> kept, dropped, beyond;  ///< indices into the costs; beyond: kept past the budget
+  double left = 0;
+};
+ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left);
+
 /// Simulations run at once: `parallel` in this process; under a batch runner (MPI ranks) the
 /// count is the runner's, and one is assumed.
 inline int workers(const CalibrationOptions& o, size_t jobs) {

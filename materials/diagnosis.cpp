@@ -261,17 +261,30 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     // With a budget, the confirmations are fitted into what is left of it, at the cost per
     // simulation this diagnosis has measured so far: a candidate's simulations (cohesion, a wetter
     // bed) may cost several times the first comparison's, on which the plan was made. The leader
-    // is always confirmed.
+    // is always confirmed, and so is every candidate the screen cannot tell from it: confirming
+    // one of two the screen cannot separate would name it on a coin toss. The result says by how
+    // much that exceeds the budget.
     if (given.budget_seconds > 0 && command.outermost() && count.done() > 0 && confirming.size() > 1) {
       const double per_simulation = count.elapsed() / count.done();
       double left = given.budget_seconds - count.elapsed();
-      std::vector<size_t> kept;
-      std::vector<std::string> dropped;
-      double each = 0;
+      std::vector<double> costs;
+      std::vector<bool> tied;
       for (const size_t rank : confirming) {
-        const double cost = experiments * detail::calibration_passes(options, d.candidates[rank].k) * per_simulation;
-        if (kept.empty() || cost <= left) kept.push_back(rank), left -= cost;
-        else dropped.push_back(d.candidates[rank].name), each = cost;
+        costs.push_back(experiments * detail::calibration_passes(options, d.candidates[rank].k) * per_simulation);
+        tied.push_back(std::find(undecided.begin(), undecided.end(), d.candidates[rank].name) != undecided.end());
+      }
+      const detail::ConfirmationPlan plan = detail::fit_confirmations(costs, tied, left);
+      std::vector<size_t> kept;
+      std::vector<std::string> dropped, beyond;
+      double each = 0;
+      for (const size_t k : plan.kept) kept.push_back(confirming[k]);
+      for (const size_t k : plan.beyond) beyond.push_back(d.candidates[confirming[k]].name);
+      for (const size_t k : plan.dropped) dropped.push_back(d.candidates[confirming[k]].name), each = costs[k];
+      if (!beyond.empty()) {
+        d.words.push_back(fmt::format("The budget of {} is exceeded by about {}: the signature screen cannot tell {} from {}, so each is "
+                                      "recalibrated.", detail::duration_text(given.budget_seconds), detail::duration_text(-plan.left),
+                                      d.candidates.front().name, join(beyond, ", ")));
+        if (options.progress) options.progress("diagnose: " + d.words.back());
       }
       if (!dropped.empty()) {
         confirming = kept;
@@ -388,6 +401,22 @@ int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls)
   }
   return passes;
 }
+
+ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left) {
+  ConfirmationPlan plan;
+  for (size_t k = 0; k < costs.size(); ++k) {
+    const bool fits = plan.kept.empty() || costs[k] <= left;
+    if (!fits && !tied[k]) {
+      plan.dropped.push_back(k);
+      continue;
+    }
+    if (!fits) plan.beyond.push_back(k);
+    plan.kept.push_back(k), left -= costs[k];
+  }
+  plan.left = left;
+  return plan;
+}
+
 }  // namespace detail
 
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls) {

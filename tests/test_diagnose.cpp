@@ -11,6 +11,7 @@
 
 #include "analytic_lab.h"
 #include "calibration.h"
+#include "calibration_support.h"
 #include "calibration_report.h"
 #include "material_model.h"
 #include "measurements.h"
@@ -221,6 +222,21 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   ASSERT_FALSE(d.words.empty());
   EXPECT_EQ(d.words.front().rfind("Planned for the budget of 20 min", 0), 0u) << d.words.front();
   EXPECT_NE(d.words.front().find("given up"), std::string::npos) << d.words.front();
+}
+
+TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
+  // 700 s left, 600 s a confirmation: the leader fits; the second is tied with it (the screen
+  // cannot tell them apart) and is confirmed beyond the budget; the third is not tied and waits.
+  const detail::ConfirmationPlan plan = detail::fit_confirmations({600, 600, 600}, {false, true, false}, 700);
+  EXPECT_EQ(plan.kept, (std::vector<size_t>{0, 1}));
+  EXPECT_EQ(plan.beyond, (std::vector<size_t>{1}));
+  EXPECT_EQ(plan.dropped, (std::vector<size_t>{2}));
+  EXPECT_DOUBLE_EQ(plan.left, -500);
+  // With room for two, nothing goes beyond; a leader that alone exceeds the budget is kept.
+  const detail::ConfirmationPlan roomy = detail::fit_confirmations({600, 600, 600}, {false, false, false}, 1300);
+  EXPECT_EQ(roomy.kept, (std::vector<size_t>{0, 1}));
+  EXPECT_TRUE(roomy.beyond.empty());
+  EXPECT_EQ(detail::fit_confirmations({600}, {false}, 100).kept, (std::vector<size_t>{0}));
 }
 
 // Progress over the whole command: every line counts one more of the diagnosis' simulations,
