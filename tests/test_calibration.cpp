@@ -225,7 +225,7 @@ TEST(MaterialModel, CandidatesAddTheirEffects) {
   MaterialModel m = read_material_model(kMaterials + "/glass_beads.yaml");
   EXPECT_EQ(m.contact.rolling.model, "none");
   const auto candidates = missing_effects(m);
-  ASSERT_EQ(candidates.size(), 5u);
+  ASSERT_EQ(candidates.size(), 6u);  // epsd, cdt, liquid_bridge, jkr, sjkr, clump_shape
   for (const auto& c : candidates) {
     MaterialModel with = m;
     c.add(with);

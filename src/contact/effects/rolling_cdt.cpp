@@ -34,6 +34,23 @@ DEM_KERNEL void cdt_kernel(const EffectContext& ctx, ContactBatch& b) {
   }
 }
 
+// A candidate beside epsd: the same lever, without the spring. A single contact tells them apart
+// (an oblique rebound spins up against a constant torque, not against a spring that stores and
+// returns it), so data made with one law may misfit under the other at every mu_r.
+constexpr FittedParam kFitted[] = {{"rolling_friction", 0.15, 0.0, 0.5}};
+constexpr std::string_view kMoves[] = {"angle_of_repose_cylinder/angle_deg", "rotating_drum/dynamic_angle_deg",
+                                       "direct_shear/peak_shear_stress", "direct_shear/steady_shear_stress",
+                                       "bulk_density/bulk_density", "drop_rebound/tangential_restitution"};
+constexpr CandidateSpec kCandidate{
+    .title = "rolling resistance as a constant torque",
+    .signature = "heaps and drum beds stand steeper than spheres allow, and an oblique rebound leaves with less spin than "
+                 "a rolling spring would return: resistance to rolling without elastic recovery (LIGGGHTS `rolling_friction cdt`)",
+    .fitted = kFitted,
+    .also_set = {},
+    .moves = kMoves,
+    .scale = nullptr,
+};
+
 }  // namespace
 
 extern const EffectSpec rolling_cdt{
@@ -50,6 +67,7 @@ extern const EffectSpec rolling_cdt{
     .derive = nullptr,
     .requires_normal = "",
     .reads_spin = true,
+    .candidate = &kCandidate,
 };
 
 }  // namespace dem::effects
