@@ -16,7 +16,9 @@
 // facets move, for the same physics. Facets are at most d50/2 long, so the wall velocity leaves
 // the facet plane by at most 1.5 %. Periodic: the tube reaches two diameters beyond the period.
 // The fill is a jittered cubic lattice (spacing 1.05 largest bounding diameters) in the lowest
-// part of the drum; it collapses during the spin-up revolution.
+// part of the drum; it collapses during the spin-up revolution. Clumps too long for the lattice
+// to hold the fill are poured by a packing inlet in the drum's inscribed square instead, and the
+// spin-up starts when they are in and have fallen.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -113,21 +115,44 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
         set.positions.push_back(Vec3(x + 0.02 * spacing * (jitter.uniform() - 0.5), y + 0.02 * spacing * (jitter.uniform() - 0.5), z));
       }
   }
-  if (static_cast<std::int64_t>(set.positions.size()) < count)
-    read.fail("fill_fraction", fmt::format("{:g}: the drum cannot be filled from a lattice with {} particles; use a smaller fill", fill, count));
-  spec.particles.push_back(set);
+  // Clumps whose bounding spheres leave the lattice too few sites (a two-sphere clump's lattice
+  // cell is several times its volume) are poured instead: a packing inlet over the square the
+  // drum's cross-section inscribes inserts as many as it takes, again as they fall, until the
+  // count is in (LIGGGHTS insert/pack).
+  const bool poured_fill = static_cast<std::int64_t>(set.positions.size()) < count;
+  if (poured_fill) {
+    const double half = inner / std::sqrt(2.0), half_y = 0.5 * depth - (periodic ? 0.0 : 0.5 * spacing);
+    InletSpec inlet;
+    inlet.name = "fill", inlet.material = set.material, inlet.diameter = set.diameter, inlet.clump = set.clump;
+    inlet.count = count;
+    inlet.region_min = Vec3(-half, -half_y, -half), inlet.region_max = Vec3(half, half_y, half);
+    spec.inlets.push_back(inlet);
+  } else {
+    spec.particles.push_back(set);
+  }
 
   SimulatedOutcome out;
   Runner run(spec);
-  const std::int64_t particles = static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
+  const std::int64_t particles = poured_fill ? count : static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
   progress(options, fmt::format("rotating_drum: {} particles, {:.3g} m drum at {:g} rpm", particles, diameter, rpm));
+  // A poured fill: until the count is in, then the time to fall across the drum.
+  double filled = 0;
+  if (poured_fill) {
+    const double fall = std::sqrt(2 * diameter / 9.81), cap = 40 * fall;
+    if (!run.advance_until([&] { return run.state.inlets[0].inserted >= count; }, cap, 0.25 * fall))
+      read.fail("fill_fraction", fmt::format("{:g}: {} of {} particles poured into the drum in {:.2g} s; use a smaller fill", fill,
+                                             run.state.inlets[0].inserted, count, cap));
+    run.advance_until([] { return false; }, run.state.time + fall, fall);
+    filled = run.state.time;
+    out.notes.push_back(fmt::format("poured in {:.2g} s (clumps leave a lattice too few sites)", filled));
+  }
   // Spin-up, then 24 samples over one revolution.
-  run.advance_until([] { return false; }, revolution, revolution);
+  run.advance_until([] { return false; }, filled + revolution, revolution);
   const int samples = 24;
   double angle_sum = 0, carried_sum = 0;
   int used = 0;
   for (int k = 1; k <= samples; ++k) {
-    run.advance_until([] { return false; }, revolution * (1 + double(k) / samples), revolution);
+    run.advance_until([] { return false; }, filled + revolution * (1 + double(k) / samples), revolution);
     const double angle = surface_angle(run.state, d50, 0.5 * depth, periodic);
     if (angle >= 0) angle_sum += angle, ++used;
     // How fast the wall layer moves along the wall, as a share of the wall speed.

@@ -240,6 +240,26 @@ TEST(RotatingDrum, DynamicAngleInRangeSteeperWithRollingResistanceAndSlipOnASmoo
   EXPECT_TRUE(raised) << "the thin slice is made three cells deep and the report says so";
 }
 
+TEST(RotatingDrum, ClumpsTooLongForTheLatticeArePouredAndTheBedIsSampled) {
+  // Two-sphere clumps of aspect ratio 2: a lattice of their bounding spheres holds about half of
+  // a 35 % fill, so a packing inlet pours them; all go in and the bed forms a surface line.
+  MaterialModel m = beads(0.5, 0.1, 0.3, 0.005);
+  m.particle.youngs_modulus = 2e5;
+  set_parameter(m, "clump_aspect_ratio", 2.0);
+  TestOptions options;
+  options.size_factor = 0.5;
+  const SimulatedOutcome out = run_virtual_test(
+      m, setup_of("rotating_drum", {{"drum_diameter", 0.20}, {"drum_depth", 0.04}, {"fill_fraction", 0.35}, {"rpm", 60}}, {{"ends", "periodic"}, {"wall", "steel"}}),
+      options);
+  print("rotating_drum clumps of aspect 2", out);
+  const bool poured = std::any_of(out.notes.begin(), out.notes.end(), [](const std::string& n) { return n.starts_with("poured in"); });
+  EXPECT_TRUE(poured) << "the lattice holds these clumps: the test no longer reaches the poured fill";
+  const double angle = out.observables.at("dynamic_angle_deg");
+  EXPECT_GT(angle, 20);
+  EXPECT_LT(angle, 55);
+  EXPECT_FALSE(flagged(out, "slipping"));
+}
+
 // Hopper: W = C rho_b sqrt(g) (D0 - k d)^2.5 (Beverloo, Leniger & van de Velde 1961) with C in
 // 0.45-0.75 and k in 1-3 for frictional spheres (published 0.55-0.65, 1.3-2.9; Nedderman 1992),
 // bulk density measured by the bulk_density test; an orifice of 2.5 diameters arches (blocked).
