@@ -236,7 +236,9 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
   const double area = cell.length * cell.width;
   const double packing = 0.6;  // [-] solid fraction expected after consolidation
   cell.count = std::max<std::int64_t>(20, std::llround(packing * area * height / sizes.mean_volume));
-  const double fill_height = cell.count * sizes.mean_volume / (0.22 * area) + bounding * sizes.largest;
+  // Placed at 22 % solid (random placement without overlap jams near 30 %); clumps, whose
+  // bounding spheres jam earlier, at 22 % over the square of their bounding factor.
+  const double fill_height = cell.count * sizes.mean_volume / (0.22 / (bounding * bounding) * area) + bounding * sizes.largest;
   cell.fill_low = 1.05 * d50;
   cell.fill_high = cell.fill_low + fill_height;
   cell.top_start = cell.fill_high + 1.05 * d50;

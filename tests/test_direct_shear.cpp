@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numbers>
 
 #include "lab_direct_shear.h"
+#include "material_model.h"
 
 namespace dem::materials {
 namespace {
@@ -98,6 +100,23 @@ TEST(DirectShear, LiquidBridgesRaiseTheIntercept) {
   const double wet = experiment(true, 300).observables.at("peak_shear_stress");
   std::printf("  peak shear stress at 300 Pa: dry %.0f Pa, wet %.0f Pa\n", dry, wet);
   EXPECT_GT(wet, dry * 1.1);
+}
+
+TEST(DirectShear, ClumpsArePlacedAndInterlock) {
+  // Two-sphere clumps of aspect ratio 2 (their bounding spheres jam earlier than spheres when
+  // placed at random): every clump is placed, the servo holds the stress, and the elongated
+  // grains resist shear more than the spheres (Azema & Radjai 2012, Phys. Rev. E 85:031303:
+  // the friction angle grows with elongation).
+  MaterialModel m = beads(false);
+  set_parameter(m, "clump_aspect_ratio", 2.0);
+  TestOptions options;
+  options.threads = 1;
+  const SimulatedOutcome clumps = run_direct_shear(m, setup(1000, 1000), options);
+  const double spheres = experiment(false, 1000).observables.at("peak_shear_stress");
+  std::printf("  peak shear stress at 1000 Pa: spheres %.0f Pa, clumps of aspect 2 %.0f Pa (%lld clumps, %.1f s wall)\n", spheres,
+              clumps.observables.at("peak_shear_stress"), static_cast<long long>(clumps.particles), clumps.wall_seconds);
+  EXPECT_NEAR(clumps.observables.at("plate_normal_stress"), 1000, 0.05 * 1000);
+  EXPECT_GT(clumps.observables.at("peak_shear_stress"), spheres);
 }
 
 TEST(DirectShear, MissingSetupKeyNamesIt) {
