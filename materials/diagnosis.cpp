@@ -233,6 +233,13 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     if (options.on_partial) options.on_partial(d, fmt::format("signatures: {} of {} candidates", d.candidates.size(), effects.size()));
   }
   std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) { return a.explained > b.explained; });
+  if (options.progress && !d.candidates.empty()) {
+    std::vector<std::string> ranked;
+    for (const CandidateResult& c : d.candidates)
+      ranked.push_back(fmt::format("{} {:.0f} % ({:.0f} % at the start, {:.0f} % stronger)", c.name, 100 * c.explained, 100 * c.explained_start,
+                                   100 * c.explained_stronger));
+    options.progress("diagnose: share of the residual each signature explains: " + join(ranked, "; "));
+  }
 
   if (fits) {
     d.words.push_back(fmt::format("No effect recommended: the model as it is fits within the noise after calibration (chi^2/n = {:.2f} <= {:.2g}).",
