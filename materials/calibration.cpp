@@ -97,16 +97,12 @@ Surrogate fit_surrogate(const std::vector<FitParameter>& box, const std::vector<
   // has coefficients would otherwise fit the simulation noise and a response that is not
   // quadratic (a heap that stops forming) with wild curvature between the points.
   std::vector<std::vector<int>> forms(3);
-  for (int k = 0; k < b; ++k) {
-    const bool linear = k <= p;
-    bool square = false;
-    for (int i = 0, c = p + 1; i < p; ++i)
-      for (int j = i; j < p; ++j, ++c)
-        if (c == k) square = i == j;
-    if (linear) forms[0].push_back(k);
-    if (linear || square) forms[1].push_back(k);
-    forms[2].push_back(k);
-  }
+  for (int k = 0; k <= p; ++k) forms[0].push_back(k), forms[1].push_back(k), forms[2].push_back(k);
+  for (int i = 0, k = p + 1; i < p; ++i)  // the quadratic terms in basis() order
+    for (int j = i; j < p; ++j, ++k) {
+      if (i == j) forms[1].push_back(k);
+      forms[2].push_back(k);
+    }
   s.coefficients = Eigen::MatrixXd::Zero(values.cols(), b);
   s.form.assign(values.cols(), "quadratic");
   const char* names[] = {"linear", "separable", "quadratic"};
