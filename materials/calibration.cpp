@@ -260,7 +260,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
   // The start, with replicas: its simulation noise stands for the noise everywhere.
   if (before) result.before = *before;
-  else result.before = compare(given_model, measured, options), result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+  else result.before = compare(given_model, measured, options), result.simulations += result.before.simulations();
   std::string budget_words;
   if (options.budget_seconds > 0) {
     const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0);
@@ -399,10 +399,10 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     design_round(round);
   }
 
-  // Confirmation with real simulations (replicas; noise floor from the start where one replica).
+  // Confirmation with real simulations (replicas, and more packings where the verdict depends on them).
   const auto confirm = [&] {
     const Comparison c = compare(with_values(model, parameters, x_best), measured, options);
-    result.simulations += options.replicas * static_cast<int>(measured.experiments.size());
+    result.simulations += c.simulations();
     Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
     v.setConstant(kNaN);
     for (const Term& t : c.terms)

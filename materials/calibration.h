@@ -76,6 +76,12 @@ struct CalibrationOptions {
   Simulator simulator;          ///< empty: run_virtual_test
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
   int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
+  /// Packings a comparison may give an experiment where its verdict depends on them: when chi^2/n
+  /// lies between fits_within_noise and 4 x it, each experiment with a term beyond 2 sigma whose
+  /// packings scatter gets one more packing at a time, up to this many (compare()). A mean of two
+  /// packings that happen to agree can sit far from the model's own mean (a hopper near its
+  /// arching limit scatters by 20 %). At most `replicas`: none are added.
+  int most_replicas = 6;
   double size_factor = 1.0;     ///< passed to the virtual tests
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default (1 when parallel > 1)
   /// Simulations of a batch run at once in this process when no `batch` runner is set, each on
@@ -147,6 +153,7 @@ struct ExperimentRun {
   std::map<std::string, double> mean;                  ///< observable -> mean over replicas
   std::map<std::string, double> sigma;                 ///< observable -> standard error of the mean (with one replica: the run's extraction error, else 0)
   std::map<std::string, std::vector<double>> values;   ///< observable -> per replica
+  std::map<std::string, std::vector<double>> extraction;  ///< observable -> each replica's own extraction error (when the test gives one)
   std::map<std::string, double> flag_fraction;         ///< outcome flag -> fraction of replicas
   std::vector<std::string> notes;
   int replicas = 0;
@@ -190,6 +197,12 @@ struct Comparison {
   std::vector<Pattern> patterns;
   std::vector<std::string> notes;  ///< e.g. observations not simulated
   double chi2_per_n() const { return n > 0 ? chi2 / n : 0.0; }
+  /// Simulations run for it (every replica of every experiment).
+  int simulations() const {
+    int s = 0;
+    for (const ExperimentRun& r : runs) s += r.replicas;
+    return s;
+  }
   /// The residual of `experiment/observable`; NaN when absent.
   double residual(const std::string& experiment, const std::string& observable) const;
 };
@@ -203,7 +216,8 @@ ExperimentRun simulate_experiment(const MaterialModel& model, const Experiment& 
 Comparison compare_runs(const MeasurementSet& measured, const std::vector<ExperimentRun>& runs, const CalibrationOptions& options,
                         const std::map<std::string, double>& sigma_floor = {});
 
-/// Simulates every experiment with options.replicas replicas and compares.
+/// Simulates every experiment with options.replicas replicas and compares; where the verdict
+/// depends on it, adds packings up to options.most_replicas (see there).
 Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options);
 
 /// Residual patterns per (test, observable): regression on the varied set-up quantity.

@@ -241,4 +241,8 @@ std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, cons
                                                 const CalibrationOptions& options, int replicas, Progress* progress,
                                                 const std::string& prefix);
 
+/// One more packing of each experiment (seed after the run's last), added to its run.
+void add_packing(const MaterialModel& model, const std::vector<const Experiment*>& experiments, const std::vector<ExperimentRun*>& runs,
+                 const CalibrationOptions& options, Progress* progress);
+
 }  // namespace dem::materials::detail

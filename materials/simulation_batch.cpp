@@ -71,22 +71,18 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
   return b;
 }
 
-/// The run of one experiment from the outcomes of its replicas (in seed order).
-ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector<const SimulatedOutcome*>& replicas) {
-  ExperimentRun run;
-  run.id = experiment.id;
-  run.test = experiment.setup.test;
-  run.replicas = static_cast<int>(replicas.size());
-  std::map<std::string, int> flags;
-  std::map<std::string, std::vector<double>> extraction;  // observable -> each replica's own standard error
-  for (size_t r = 0; r < replicas.size(); ++r) {
-    const SimulatedOutcome& out = *replicas[r];
-    for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
-    for (const auto& [key, u] : out.uncertainty) extraction[key].push_back(u);
-    for (const std::string& f : out.flags) ++flags[f];
-    if (r == 0) run.notes = out.notes, run.particles = out.particles;
-    run.wall_seconds += out.wall_seconds;
-  }
+/// Appends one replica's outcome to a run (values, extraction errors, flags, cost).
+void append_replica(ExperimentRun& run, const SimulatedOutcome& out, std::map<std::string, int>& flags) {
+  for (const auto& [key, v] : out.observables) run.values[key].push_back(v);
+  for (const auto& [key, u] : out.uncertainty) run.extraction[key].push_back(u);
+  for (const std::string& f : out.flags) ++flags[f];
+  if (run.replicas == 0) run.notes = out.notes, run.particles = out.particles;
+  run.wall_seconds += out.wall_seconds;
+  ++run.replicas;
+}
+
+/// Mean, standard error and flag fractions of a run from its replicas.
+void summarise(ExperimentRun& run, const std::map<std::string, int>& flags) {
   for (const auto& [key, list] : run.values) {
     const double n = static_cast<double>(list.size());
     const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
@@ -96,15 +92,32 @@ ExperimentRun summarise_replicas(const Experiment& experiment, const std::vector
     run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
     // Two replicas that happen to agree must not make the mean look surer than each run's own
     // extraction says: the standard error is at least that of the runs' errors, averaged.
-    const auto e = extraction.find(key);
-    if (e != extraction.end() && e->second.size() == list.size()) {
+    const auto e = run.extraction.find(key);
+    if (e != run.extraction.end() && e->second.size() == list.size()) {
       double uu = 0;
       for (double u : e->second) uu += u * u;
       run.sigma[key] = std::max(run.sigma[key], std::sqrt(uu / n / n));
     }
   }
+  run.flag_fraction.clear();
   for (const auto& [f, count] : flags) run.flag_fraction[f] = static_cast<double>(count) / run.replicas;
-  return run;
+}
+
+/// The flags of a run counted back from their fractions.
+std::map<std::string, int> flag_counts(const ExperimentRun& run) {
+  std::map<std::string, int> out;
+  for (const auto& [f, fraction] : run.flag_fraction) out[f] = static_cast<int>(std::lround(fraction * run.replicas));
+  return out;
+}
+
+/// Runs a batch and throws the first error in batch order.
+std::vector<BatchOutcome> run_batch_or_throw(const std::vector<Job>& jobs, const CalibrationOptions& options,
+                                             const std::function<void(size_t, const BatchOutcome&)>& done) {
+  std::vector<BatchOutcome> outcomes =
+      detail::run_batch(jobs, options, done, [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
+  for (const BatchOutcome& b : outcomes)
+    if (b.error != BatchOutcome::Error::none) detail::rethrow(b);
+  return outcomes;
 }
 
 }  // namespace
@@ -171,24 +184,38 @@ std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& mod
   std::vector<Job> jobs;
   for (const Experiment& e : experiments)
     for (int r = 0; r < replicas; ++r) jobs.push_back({&model, &e.setup, options.seed + static_cast<std::uint64_t>(r)});
-  const std::vector<BatchOutcome> outcomes = run_batch(
-      jobs, options,
-      [&](size_t k, const BatchOutcome& b) {
-        const size_t e = k / static_cast<size_t>(replicas);
-        if (b.error == BatchOutcome::Error::none && progress)
-          progress->step(experiments[e], fmt::format("{}{}, replica {} of {}{}", prefix, experiments[e].id, k % replicas + 1, replicas, b.stored ? ", stored" : ""),
-                         b.stored ? 0.0 : b.outcome.wall_seconds);
-      },
-      [](const BatchOutcome& b) { return b.error != BatchOutcome::Error::none; });
-  for (const BatchOutcome& b : outcomes)
-    if (b.error != BatchOutcome::Error::none) rethrow(b);
+  const std::vector<BatchOutcome> outcomes = run_batch_or_throw(jobs, options, [&](size_t k, const BatchOutcome& b) {
+    const size_t e = k / static_cast<size_t>(replicas);
+    if (b.error == BatchOutcome::Error::none && progress)
+      progress->step(experiments[e], fmt::format("{}{}, replica {} of {}{}", prefix, experiments[e].id, k % replicas + 1, replicas, b.stored ? ", stored" : ""),
+                     b.stored ? 0.0 : b.outcome.wall_seconds);
+  });
   std::vector<ExperimentRun> runs;
   for (size_t e = 0; e < experiments.size(); ++e) {
-    std::vector<const SimulatedOutcome*> list;
-    for (int r = 0; r < replicas; ++r) list.push_back(&outcomes[e * replicas + r].outcome);
-    runs.push_back(summarise_replicas(experiments[e], list));
+    ExperimentRun run;
+    run.id = experiments[e].id, run.test = experiments[e].setup.test;
+    std::map<std::string, int> flags;
+    for (int r = 0; r < replicas; ++r) append_replica(run, outcomes[e * replicas + r].outcome, flags);
+    summarise(run, flags);
+    runs.push_back(std::move(run));
   }
   return runs;
+}
+
+void detail::add_packing(const MaterialModel& model, const std::vector<const Experiment*>& experiments, const std::vector<ExperimentRun*>& runs,
+                         const CalibrationOptions& options, Progress* progress) {
+  std::vector<Job> jobs;
+  for (size_t k = 0; k < experiments.size(); ++k) jobs.push_back({&model, &experiments[k]->setup, options.seed + static_cast<std::uint64_t>(runs[k]->replicas)});
+  const std::vector<BatchOutcome> outcomes = run_batch_or_throw(jobs, options, [&](size_t k, const BatchOutcome& b) {
+    if (b.error == BatchOutcome::Error::none && progress)
+      progress->step(*experiments[k], fmt::format("{}, replica {} added{}", experiments[k]->id, runs[k]->replicas + 1, b.stored ? ", stored" : ""),
+                     b.stored ? 0.0 : b.outcome.wall_seconds);
+  });
+  for (size_t k = 0; k < runs.size(); ++k) {
+    std::map<std::string, int> flags = flag_counts(*runs[k]);
+    append_replica(*runs[k], outcomes[k].outcome, flags);
+    summarise(*runs[k], flags);
+  }
 }
 
 }  // namespace dem::materials
