@@ -576,6 +576,35 @@ def fmt(v):
     return f"{mantissa}e{int(exponent)}"
 
 
+TEMPLATE_SEEDS = {15485867, 32452843, 49979687, 67867967}  # contact.in's particle templates: LIGGGHTS wants every seed distinct
+
+
+def placement_seeds(first, count):
+    """`count` placement seeds for LIGGGHTS (which wants primes above 10000, distinct from the
+    templates' seeds): `first` and the primes after it."""
+    def prime(n):
+        return n > 1 and all(n % d for d in range(2, int(math.isqrt(n)) + 1))
+    if first in TEMPLATE_SEEDS:
+        raise SystemExit(f"--seed {first}: contact.in's particle templates use it; LIGGGHTS wants every seed distinct")
+    seeds, n = [first], first
+    while len(seeds) < count:
+        n += 1
+        if prime(n) and n not in TEMPLATE_SEEDS:
+            seeds.append(n)
+    return seeds
+
+
+def mean_and_sigma(values, instrument):
+    """Mean of the packings' values and the sigma a lab would state for it: the instrument noise and
+    the standard error of the mean over the packings, combined (two significant digits)."""
+    n = len(values)
+    mean = sum(values) / n
+    se2 = sum((v - mean) ** 2 for v in values) / (n - 1) / n if n > 1 else 0.0
+    sigma = math.sqrt(instrument ** 2 + se2)
+    digits = 1 - int(math.floor(math.log10(sigma))) if sigma > 0 else 0
+    return mean, round(sigma, digits)
+
+
 def rounded(v, sigma):
     """The value to the precision its sigma deserves (two significant digits of sigma, and more)."""
     if v == 0 or sigma <= 0:
@@ -647,11 +676,14 @@ def main():
     ap.add_argument("--noise-seed", type=int, default=7, help="seed of the Gaussian noise (default 7)")
     ap.add_argument("--no-noise", action="store_true", help="write the simulated values as they are")
     ap.add_argument("--only", action="append", help="run only this experiment id (repeatable); the file is not written")
-    ap.add_argument("--seed", type=int, default=15485863, help="seed of LIGGGHTS' random particle placement (a prime > 10000)")
+    ap.add_argument("--seed", type=int, default=15485863, help="seed of LIGGGHTS' random particle placement of the first packing (a prime > 10000); the next packings take the primes after it")
+    ap.add_argument("--packings", type=int, default=3, help="packings (placement seeds) per experiment, averaged as a lab averages repeats (default 3; the one-particle drop runs once)")
     ap.add_argument("--liggghts", default="liggghts", help="the LIGGGHTS executable (default: liggghts)")
     ap.add_argument("--nice", type=int, default=10, help="run LIGGGHTS under nice -n N (default 10; -1: not at all)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary folder with the raw LIGGGHTS output")
     args = ap.parse_args()
+    if args.packings < 1:
+        raise SystemExit(f"--packings {args.packings}: at least 1")
     if args.nice is not None and args.nice < 0:
         args.nice = None
     if shutil.which(args.liggghts) is None:
@@ -675,36 +707,51 @@ def main():
     rng = random.Random(args.noise_seed)
     results = {}
     total = 0.0
+    seeds = placement_seeds(args.seed, args.packings)
     try:
         for e in experiments:
-            folder = os.path.join(work, e["id"])
-            os.makedirs(folder)
-            print(f"{e['id']}: {e['test']} ...", file=sys.stderr, flush=True)
-            try:
-                obs, notes, elapsed, particles = TESTS[e["test"]](args, mat, e["setup"], folder)
-            except Failure as err:
-                raise SystemExit(f"{e['id']}: {err} (raw output kept in {folder})") from None
-            total += elapsed
-            flags = [n.split(" ", 1)[1] for n in notes if n.startswith("flag ")]
+            # A lab repeats a test and states the mean with its standard error; so does this file.
+            # One particle falls the same way whatever the placement seed: the drop runs once.
+            count = 1 if e["test"] == "drop_rebound" else args.packings
+            packings = []
+            for k in range(count):
+                folder = os.path.join(work, e["id"], f"packing_{k + 1}")
+                os.makedirs(folder)
+                print(f"{e['id']}: {e['test']}, packing {k + 1} of {count} ...", file=sys.stderr, flush=True)
+                try:
+                    obs, notes, elapsed, particles = TESTS[e["test"]](argparse.Namespace(**dict(vars(args), seed=seeds[k])), mat, e["setup"], folder)
+                except Failure as err:
+                    raise SystemExit(f"{e['id']}: {err} (raw output kept in {folder})") from None
+                total += elapsed
+                packings.append((obs, notes))
+                shown = ", ".join(f"{key} {v:.5g}" for key, v in obs.items())
+                flagged = [n for n in notes if n.startswith("flag ")]
+                print(f"{e['id']}: packing {k + 1}: {shown}{' [' + ', '.join(flagged) + ']' if flagged else ''} ({elapsed:.1f} s"
+                      f"{f', {particles} particles' if particles else ''}; {'; '.join(n for n in notes if not n.startswith('flag '))})",
+                      file=sys.stderr, flush=True)
+            flag_count = {}
+            for _, notes in packings:
+                for n in notes:
+                    if n.startswith("flag "):
+                        flag_count[n.split(" ", 1)[1]] = flag_count.get(n.split(" ", 1)[1], 0) + 1
+            flags = [f for f, c in flag_count.items() if 2 * c > count]  # an outcome of most packings
+            raw = {key: [obs[key] for obs, _ in packings] for key in packings[0][0]}
             observed = {}
             outcome = None
             if e["test"] in OUTCOMES and OUTCOMES[e["test"]][1] in flags:
                 outcome = OUTCOMES[e["test"]][1]
             for key, sigma in e["observe"].items():
-                if key not in obs:
-                    raise SystemExit(f"{e['id']}: {e['test']} has no observable '{key}'; it has {', '.join(obs)}")
+                if key not in raw:
+                    raise SystemExit(f"{e['id']}: {e['test']} has no observable '{key}'; it has {', '.join(raw)}")
                 if outcome and key == OUTCOMES[e["test"]][0]:
                     continue  # the outcome replaces the value
-                value = obs[key] + (0.0 if args.no_noise else rng.gauss(0.0, sigma))
-                observed[key] = (rounded(value, sigma), sigma)
+                mean, stated = mean_and_sigma(raw[key], sigma)
+                value = mean + (0.0 if args.no_noise else rng.gauss(0.0, sigma))
+                observed[key] = (rounded(value, stated), stated)
             if e["test"] == "rotating_drum" and "slipping" in flags:
                 outcome = "slipping"
-            results[e["id"]] = {"observed": observed, "outcome": outcome, "raw": obs,
-                                "notes": [n for n in notes if n != f"flag {outcome}"]}
-            shown = ", ".join(f"{k} {v:.5g}" for k, v in obs.items())
-            count = f", {particles} particles" if particles else ""
-            print(f"{e['id']}: {shown}{' [' + outcome + ']' if outcome else ''} ({elapsed:.1f} s{count}; "
-                  f"{'; '.join(n for n in notes if not n.startswith('flag '))})", file=sys.stderr, flush=True)
+            notes = [n for n in packings[0][1] if not n.startswith("flag ")]
+            results[e["id"]] = {"observed": observed, "outcome": outcome, "raw": raw, "notes": notes}
     finally:
         if args.keep:
             print(f"raw LIGGGHTS output kept in {work}", file=sys.stderr)
@@ -719,15 +766,15 @@ def main():
     header = (f"# Simulated with {version}, not measured: variant {mat.variant}, {mat.describe()}; "
               f"made {today} by calibration/liggghts/make_measurements.py; {noise}")
     comments = [
-        f"Material {os.path.basename(args.material)}, experiments {os.path.basename(args.experiments)}, placement seed {args.seed}.",
-        "Each value is the extraction rule of demdesign's virtual test applied to a LIGGGHTS run of the same",
-        "protocol (calibration/liggghts/README.md says where the LIGGGHTS set-ups differ). Simulated, before noise:",
+        f"Material {os.path.basename(args.material)}, experiments {os.path.basename(args.experiments)}, placement seeds {', '.join(map(str, seeds))}.",
+        "Each value is the extraction rule of demdesign's virtual test applied to LIGGGHTS runs of the same",
+        "protocol (calibration/liggghts/README.md says where the LIGGGHTS set-ups differ), averaged over the packings;",
+        "each sigma is the stated instrument noise and the packings' standard error combined. Simulated, per packing, before noise:",
     ]
     for e in experiments:
-        raw = results[e["id"]]["raw"]
         r = results[e["id"]]
-        comments.append(f"  {e['id']}: " + ", ".join(f"{k} {v:.5g}" for k, v in raw.items())
-                        + (f" [{r['outcome']}]" if r["outcome"] else "") + (f" ({'; '.join(r['notes'])})" if r["notes"] else ""))
+        comments.append(f"  {e['id']}: " + ", ".join(f"{k} {' / '.join(f'{v:.5g}' for v in values)}" for k, values in r["raw"].items())
+                        + (f" [{r['outcome']}]" if r["outcome"] else "") + (f" (packing 1: {'; '.join(r['notes'])})" if r["notes"] else ""))
     write_yaml(args.out, mat, experiments, results, header, comments)
     print(f"wrote {args.out}", file=sys.stderr)
 
