@@ -263,7 +263,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   else result.before = compare(given_model, measured, options), result.simulations += result.before.simulations();
   std::string budget_words;
   if (options.budget_seconds > 0) {
-    const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0);
+    const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0, seconds_since(t0));
     options = plan.options;
     options.budget_seconds = 0;
     budget_words = fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),

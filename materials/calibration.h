@@ -350,14 +350,15 @@ struct Diagnosis {
 /// The settings of a calibration or diagnosis that fit options.budget_seconds, from the cost of a
 /// pass over the experiments measured by `first` (a comparison of the starting model), with `p`
 /// fitted parameters, `effects` effect candidates and `walls` wall-parameter candidates to
-/// screen (both 0: a calibration). `given_up` says what was reduced, and `seconds` the planned
-/// wall time of what remains.
+/// screen (both 0: a calibration). `spent` [s] is what the command has taken so far (the first
+/// comparison): the rest is planned into what is left of the budget. `given_up` says what was
+/// reduced, and `seconds` the planned wall time of what remains.
 struct BudgetPlan {
   CalibrationOptions options;
   std::vector<std::string> given_up;
   double seconds = 0;
 };
-BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls);
+BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent = 0);
 
 /// BIC = chi^2 + k ln n.
 double bic(double chi2, int k, int n);

@@ -82,8 +82,9 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   // With a budget: the starting model is compared first (a simulation of each experiment is then
   // timed) and the rest planned to fit; the calibration uses that comparison as its start.
   if (options.budget_seconds > 0) {
+    const detail::Clock::time_point t0 = detail::Clock::now();
     const Comparison first = compare(model, measured, options);
-    const BudgetPlan plan = plan_within_budget(options, first, fitted, lacking, walls);
+    const BudgetPlan plan = plan_within_budget(options, first, fitted, lacking, walls, detail::seconds_since(t0));
     options = plan.options;
     if (command.outermost()) count.plan_remaining(experiments * detail::diagnosis_passes(options, fitted, lacking, walls));
     options.budget_seconds = 0;  // planned once, for the whole diagnosis
@@ -426,7 +427,8 @@ ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::
 
 }  // namespace detail
 
-BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls) {
+BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
+  const double left = options.budget_seconds - spent;
   const int candidates = effects + walls;
   BudgetPlan plan{options, {}, 0};
   // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
@@ -454,14 +456,14 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   };
   plan.seconds = seconds(plan.options);
   for (const Step& step : ladder) {
-    if (plan.seconds <= options.budget_seconds) break;
+    if (plan.seconds <= left) break;
     if (step.diagnosis_only && candidates == 0) continue;
     CalibrationOptions reduced = plan.options;
     step.apply(reduced);
     const double s = seconds(reduced);
     if (s < plan.seconds) plan.options = reduced, plan.seconds = s, plan.given_up.emplace_back(step.words);
   }
-  if (plan.seconds > options.budget_seconds)
+  if (plan.seconds > left)
     plan.given_up.push_back(fmt::format("still about {} at the least: the budget of {} cannot be met with these experiments (use --size-factor, or "
                                         "fewer experiments)",
                                         detail::duration_text(plan.seconds), detail::duration_text(options.budget_seconds)));

@@ -206,6 +206,11 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   EXPECT_EQ(tight.options.replicas, 2);
   EXPECT_EQ(tight.options.design_factor, 0.5);
   EXPECT_NEAR(tight.seconds, 51 * 35.0, 1e-9);
+  // What the first comparison took comes off the budget: with 100 s spent, 51 passes (1785 s) no
+  // longer fit the 1700 s left, and the wall screen goes (8 passes).
+  const BudgetPlan later = plan_within_budget(options, first, 2, 4, 4, 100.0);
+  EXPECT_FALSE(later.options.wall_candidates);
+  EXPECT_NEAR(later.seconds, 43 * 35.0, 1e-9);
   options.budget_seconds = 60;
   const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
   EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
