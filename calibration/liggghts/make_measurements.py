@@ -17,6 +17,7 @@ it and prints where).
 """
 
 import argparse
+import collections
 import datetime
 import glob
 import json
@@ -729,11 +730,7 @@ def main():
                 print(f"{e['id']}: packing {k + 1}: {shown}{' [' + ', '.join(flagged) + ']' if flagged else ''} ({elapsed:.1f} s"
                       f"{f', {particles} particles' if particles else ''}; {'; '.join(n for n in notes if not n.startswith('flag '))})",
                       file=sys.stderr, flush=True)
-            flag_count = {}
-            for _, notes in packings:
-                for n in notes:
-                    if n.startswith("flag "):
-                        flag_count[n.split(" ", 1)[1]] = flag_count.get(n.split(" ", 1)[1], 0) + 1
+            flag_count = collections.Counter(n[len("flag "):] for _, notes in packings for n in notes if n.startswith("flag "))
             flags = [f for f, c in flag_count.items() if 2 * c > count]  # an outcome of most packings
             raw = {key: [obs[key] for obs, _ in packings] for key in packings[0][0]}
             observed = {}
