@@ -359,6 +359,10 @@ struct BudgetPlan {
   double seconds = 0;
 };
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent = 0);
+/// The same for what a diagnosis has left after calibrating the model as it is (the signature
+/// screen and the confirmations), at `pass` [s] a pass over the experiments as measured so far,
+/// into `left` [s] of the budget `budget` [s].
+BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget);
 
 /// BIC = chi^2 + k ln n.
 double bic(double chi2, int k, int n);

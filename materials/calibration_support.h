@@ -138,6 +138,9 @@ inline int calibration_passes(const CalibrationOptions& o, int p) { return std::
 /// Passes over the experiments that a diagnosis makes after its first comparison, fitting `p`
 /// parameters and screening `effects` effects and `walls` wall parameters (diagnosis.cpp).
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls);
+/// The part of diagnosis_passes after the calibration of the model as it is: the signature screen
+/// and the confirmations.
+int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls);
 
 /// Which candidate confirmations fit what is left of a budget [s], each at its cost [s], in rank
 /// order: the first always; a later one when it fits, or when it is tied (the signature screen

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -100,6 +101,41 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
   const int n = base.n;
   d.base_bic = bic(base.chi2, static_cast<int>(parameters.size()), n);
   const bool fits = base.chi2_per_n() <= options.fits_within_noise;
+  // No candidate can be recommended when the model already fits within the noise, nor when even
+  // an effect that took up all of the misfit (chi^2 -> 0) with one parameter more would not lower
+  // BIC by the margin (Delta BIC <= chi^2 - ln n): the screen and the confirmations are then not
+  // run, unless candidates were named with options.effects.
+  const double most_gain = base.chi2 - std::log(static_cast<double>(std::max(n, 1)));
+  if ((fits || most_gain <= options.bic_margin) && options.effects.empty()) {
+    if (command.outermost()) count.plan_remaining(0);
+    if (fits)
+      d.words.push_back(fmt::format("No effect recommended: the model as it is fits within the noise after calibration (chi^2/n = {:.2f} <= {:.2g}); "
+                                    "no candidate was screened (name some with --effects to screen them anyway).",
+                                    base.chi2_per_n(), options.fits_within_noise));
+    else
+      d.words.push_back(fmt::format("No effect recommended: the model misfits (chi^2/n = {:.2f}), but over {} terms even an effect that took up "
+                                    "all of chi^2 = {:.1f} with one parameter more would lower BIC by at most {:.1f}, not more than the margin "
+                                    "{:.0f}; no candidate was screened. More experiments, or more packings where they scatter, let the data decide.",
+                                    base.chi2_per_n(), n, base.chi2, most_gain, options.bic_margin));
+    if (options.progress) options.progress("diagnose: " + d.words.back());
+    return d;
+  }
+  // With a budget, the screen and the confirmations are planned again into what is left of it, at
+  // the cost per simulation measured so far: the calibration's design points (friction near the
+  // top of its range, slower flows) cost more than the first comparison, on which the first plan
+  // was made.
+  if (given.budget_seconds > 0 && command.outermost() && count.done() > 0) {
+    const double pass = experiments * count.elapsed() / count.done();
+    const BudgetPlan rest = plan_screen_within_budget(options, pass, fitted, lacking, walls, given.budget_seconds - count.elapsed(), given.budget_seconds);
+    if (!rest.given_up.empty()) {
+      options = rest.options;
+      d.words.push_back(fmt::format("Planned again after calibrating the model as it is ({} spent, at {:.1f} s a simulation): about {} for the "
+                                    "screen and the confirmations; given up: {}.",
+                                    detail::duration_text(count.elapsed()), count.elapsed() / count.done(), detail::duration_text(rest.seconds),
+                                    join(rest.given_up, "; ")));
+      if (options.progress) options.progress("diagnose: " + d.words.back());
+    }
+  }
 
   // Sigma of each term (measurement and simulation noise) and the residual vector.
   const int nt = static_cast<int>(base.terms.size());
@@ -400,14 +436,16 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
 // ---- budget -------------------------------------------------------------------------------
 
 namespace detail {
+int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {
+  if (effects + walls == 0) return 0;
+  const int screened = effects + (o.wall_candidates ? walls : 0);
+  return screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1)  // two strengths
+         + o.confirm_candidates * detail::calibration_passes(o, p + 1);
+}
+
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
-  int passes = detail::calibration_passes(o, p);  // the calibration and its confirming comparison
-  if (effects + walls > 0) {
-    const int screened = effects + (o.wall_candidates ? walls : 0);
-    passes += screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);  // two strengths
-    passes += o.confirm_candidates * detail::calibration_passes(o, p + 1);
-  }
-  return passes;
+  // The calibration and its confirming comparison, then the screen and the confirmations.
+  return detail::calibration_passes(o, p) + screen_and_confirmation_passes(o, p, effects, walls);
 }
 
 ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left) {
@@ -427,16 +465,13 @@ ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::
 
 }  // namespace detail
 
-BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
-  const double left = options.budget_seconds - spent;
-  const int candidates = effects + walls;
+namespace {
+
+/// The ladder of reductions applied in turn until `passes` passes of `pass` seconds fit `left`.
+BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double left, double budget, int candidates,
+                         const std::function<int(const CalibrationOptions&)>& passes) {
   BudgetPlan plan{options, {}, 0};
-  // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
-  // `parallel` simulations at once.
-  double pass = 0;
-  for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
-  pass /= std::max(1, options.parallel);
-  const auto seconds = [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls) * pass; };
+  const auto seconds = [&](const CalibrationOptions& o) { return passes(o) * pass; };
   struct Step {
     const char* words;
     void (*apply)(CalibrationOptions&);
@@ -466,8 +501,25 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   if (plan.seconds > left)
     plan.given_up.push_back(fmt::format("still about {} at the least: the budget of {} cannot be met with these experiments (use --size-factor, or "
                                         "fewer experiments)",
-                                        detail::duration_text(plan.seconds), detail::duration_text(options.budget_seconds)));
+                                        detail::duration_text(plan.seconds), detail::duration_text(budget)));
   return plan;
+}
+
+}  // namespace
+
+BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
+  // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
+  // `parallel` simulations at once.
+  double pass = 0;
+  for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
+  pass /= std::max(1, options.parallel);
+  return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls,
+                       [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls); });
+}
+
+BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget) {
+  return fit_to_budget(options, pass, left, budget, effects + walls,
+                       [&](const CalibrationOptions& o) { return detail::screen_and_confirmation_passes(o, p, effects, walls); });
 }
 
 // ---- ledger -------------------------------------------------------------------------------

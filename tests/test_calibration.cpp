@@ -487,9 +487,14 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
   EXPECT_NEAR(fit.value[0], 0.5, 3 * fit.sigma[0]);
   EXPECT_GT(fit.before.chi2_per_n(), 20.0);  // the guessed wall, before
   EXPECT_LE(fit.after.chi2_per_n(), 1.5);
-  // The diagnosis does not offer the settled wall parameter again.
-  const Diagnosis d = diagnose(start, set, {{"friction", 0.1, 0.9}}, analytic_options(sim));
+  // The diagnosis does not offer the settled wall parameter again, even when asked to screen it.
+  CalibrationOptions screen_all = analytic_options(sim);
+  screen_all.effects = candidate_names();
+  screen_all.effects.insert(screen_all.effects.end(), {"steel.restitution", "steel.friction"});
+  const Diagnosis d = diagnose(start, set, {{"friction", 0.1, 0.9}}, screen_all);
   EXPECT_TRUE(d.recommended.empty()) << d.recommended;
+  ASSERT_FALSE(d.candidates.empty());
+  EXPECT_TRUE(std::any_of(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.name == "steel.friction"; }));
   for (const CandidateResult& c : d.candidates) EXPECT_NE(c.name, "steel.restitution");
   // Measured, it is an input: kept as given.
   MaterialModel measured = start;

@@ -134,6 +134,9 @@ TEST(CampaignMpi, DiagnosisSharedAmongRanksEqualsSerial) {
   int serial_calls = 0, shared_calls = 0;
   CalibrationOptions a = options(Analytic{&serial_calls}, false), b = options(Analytic{&shared_calls}, true);
   a.rounds = b.rounds = 1;
+  // Every candidate screened and the leaders confirmed, however well the model fits already.
+  a.effects = b.effects = candidate_names();
+  a.fits_within_noise = b.fits_within_noise = 0;
   const Diagnosis alone = diagnose(model, measurements(), params, a);
   const Diagnosis shared = diagnose(model, measurements(), params, b);
   expect_same(alone.base, shared.base);
@@ -146,6 +149,7 @@ TEST(CampaignMpi, DiagnosisSharedAmongRanksEqualsSerial) {
     EXPECT_EQ(alone.candidates[k].confirmed, shared.candidates[k].confirmed) << alone.candidates[k].name;
     EXPECT_EQ(alone.candidates[k].bic, shared.candidates[k].bic) << alone.candidates[k].name;
   }
+  EXPECT_TRUE(std::any_of(alone.candidates.begin(), alone.candidates.end(), [](const CandidateResult& c) { return c.confirmed; }));
   EXPECT_EQ(alone.recommended, shared.recommended);
   EXPECT_EQ(total_over_ranks(shared_calls), serial_calls);
 }

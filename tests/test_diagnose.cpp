@@ -145,6 +145,43 @@ TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
   EXPECT_LT(d.base.after.chi2_per_n(), 1.5);
   EXPECT_EQ(d.recommended, "");
   EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
+  // A model that fits gets no signature screen: nothing it found could be recommended.
+  EXPECT_TRUE(d.candidates.empty());
+  EXPECT_NE(d.words.front().find("no candidate was screened"), std::string::npos) << d.words.front();
+  // Named candidates are screened all the same.
+  CalibrationOptions named = analytic_options(sim);
+  named.effects = {"epsd"};
+  const Diagnosis screened = diagnose(start, set, {}, named);
+  ASSERT_EQ(screened.candidates.size(), 1u);
+  EXPECT_EQ(screened.candidates.front().name, "epsd");
+  EXPECT_EQ(screened.recommended, "");
+}
+
+// A misfit that no candidate could turn into a recommendation (an effect that took up all of
+// chi^2 with one parameter more would lower BIC by at most chi^2 - ln n) is not screened.
+TEST(Diagnose, NoScreenWhenNoCandidateCouldPassTheMargin) {
+  const Analytic sim;
+  const MaterialModel start = dry_spheres();
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
+  int simulations = 0;
+  CalibrationOptions options = analytic_options(sim);
+  const Simulator counting = [&](const MaterialModel& m, const TestSetup& s, const TestOptions& o) { return ++simulations, sim(m, s, o); };
+  options.simulator = counting;
+  const Diagnosis plain = diagnose(start, set, {}, options);
+  const int with_screen = simulations;
+  ASSERT_GT(plain.base.after.chi2_per_n(), 5.0);
+  const double most_gain = plain.base.after.chi2 - std::log(plain.base.after.n);
+  options.bic_margin = most_gain + 1;  // just out of reach
+  simulations = 0;
+  const Diagnosis d = diagnose(start, set, {}, options);
+  EXPECT_TRUE(d.candidates.empty());
+  EXPECT_EQ(d.recommended, "");
+  EXPECT_NE(d.words.front().find(fmt::format("at most {:.1f}", most_gain)), std::string::npos) << d.words.front();
+  EXPECT_LT(simulations, with_screen / 2) << "the screen and the confirmations ran";
+  options.bic_margin = most_gain - 1;  // within reach: screened
+  EXPECT_FALSE(diagnose(start, set, {}, options).candidates.empty());
 }
 
 // A drop test misses because the particles' restitution on the steel plate is off, while the
@@ -211,6 +248,17 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   const BudgetPlan later = plan_within_budget(options, first, 2, 4, 4, 100.0);
   EXPECT_FALSE(later.options.wall_candidates);
   EXPECT_NEAR(later.seconds, 43 * 35.0, 1e-9);
+  // After the calibration of the model as it is, the screen and the confirmations are planned
+  // again at the cost measured so far: at 35 s a pass, 8 candidates x 3 + 2 x (2 x 22 + 3) = 118
+  // passes do not fit 1800 s; one round, design factor 1 (2 x (12 + 3)), signatures with one
+  // packing (8 x 2): 46 passes.
+  const BudgetPlan rest = plan_screen_within_budget(CalibrationOptions{}, 35.0, 2, 4, 4, 1800, 1800);
+  EXPECT_NEAR(plan_screen_within_budget(CalibrationOptions{}, 35.0, 2, 4, 4, 1e6, 1e6).seconds, 118 * 35.0, 1e-9);
+  EXPECT_EQ(rest.options.rounds, 1);
+  EXPECT_EQ(rest.options.signature_replicas, 1);
+  EXPECT_TRUE(rest.options.wall_candidates);
+  EXPECT_NEAR(rest.seconds, 46 * 35.0, 1e-9);
+  EXPECT_EQ(rest.given_up.size(), 3u);
   options.budget_seconds = 60;
   const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
   EXPECT_NE(impossible.given_up.back().find("cannot be met"), std::string::npos);
