@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -49,6 +50,7 @@ struct RunArgs {
   bool quiet = false;
   bool resume = false;
   long variant = -1;  ///< run this variant of the case's sweep (the sweep runner's children)
+  std::string rank_grid;  ///< "NXxNYxNZ": the grid of boxes under mpirun (empty: chosen)
   bool report = true;
 };
 
@@ -180,10 +182,18 @@ int run_case(const RunArgs& args) {
   if (threads > 0) omp_set_num_threads(threads);
   dem::State state = dem::initial_state(model);
   dem::Workspace work;
-  // Under mpirun the case is split into slabs, one per rank (app/mpi_domain.h); rank 0 writes.
+  // Under mpirun the case is split into a grid of boxes, one per rank (app/mpi_domain.h); rank 0 writes.
   const dem::app::mpi::World& world = dem::app::mpi::world();
   std::string domain_note;
-  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note) : nullptr;
+  std::array<int, 3> grid{0, 0, 0};
+  if (!args.rank_grid.empty()) {
+    char x1 = 0, x2 = 0;
+    std::istringstream in(args.rank_grid);
+    if (!(in >> grid[0] >> x1 >> grid[1] >> x2 >> grid[2]) || x1 != 'x' || x2 != 'x' || !in.eof() || grid[0] < 1 || grid[1] < 1 || grid[2] < 1)
+      throw dem::CaseError(fmt::format("--rank-grid '{}': expected three box counts as NXxNYxNZ, for example 2x2x1", args.rank_grid));
+  }
+  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid) : nullptr;
+  if (world.active() && !domain && grid[0] > 0 && world.size > 1) throw dem::CaseError(fmt::format("--rank-grid {}: {}", args.rank_grid, domain_note));
   if (world.active() && !domain) {  // cannot be split: rank 0 runs it alone, the others wait
     if (world.rank != 0) return 0;
     std::cout << fmt::format("note: {} MPI ranks, but this case runs on rank 0 alone: {}\n", world.size, domain_note);
@@ -309,6 +319,7 @@ int main(int argc, char** argv) {
     cmd->add_flag("--quiet", args.quiet, "no progress lines");
     cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
     cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
+    cmd->add_option("--rank-grid", args.rank_grid, "under mpirun: the grid of boxes, NXxNYxNZ (default: chosen from the domain's shape)");
     cmd->add_flag("--resume", args.resume, "continue from OUT/checkpoint.bin (written every output.checkpoint_every, and on SIGINT/SIGTERM)");
   };
   app.add_option("case", args.case_path, "case file (YAML) to run");

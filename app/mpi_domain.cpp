@@ -41,15 +41,75 @@ std::vector<int> offsets_of(const std::vector<int>& counts) {
   return out;
 }
 
+/// The 26 neighbour offsets of a box in the rank grid, in a fixed order (the message tags).
+struct Offset {
+  int d[3];
+  /// Lexicographically positive (z first): this rank receives that neighbour's particles as
+  /// ghosts and lists the pairs across their common faces, edges and corners; the neighbour
+  /// receives none of this rank's. Every pair across ranks is thus listed once.
+  bool upper() const { return d[2] > 0 || (d[2] == 0 && (d[1] > 0 || (d[1] == 0 && d[0] > 0))); }
+};
+std::vector<Offset> all_offsets() {
+  std::vector<Offset> out;
+  for (int z = -1; z <= 1; ++z)
+    for (int y = -1; y <= 1; ++y)
+      for (int x = -1; x <= 1; ++x)
+        if (x || y || z) out.push_back({{x, y, z}});
+  return out;
+}
+int index_of(const int d[3]) {  // into all_offsets()
+  const int k = (d[0] + 1) + 3 * (d[1] + 1) + 9 * (d[2] + 1);
+  return k < 13 ? k : k - 1;
+}
+
+/// Whether every box of the grid `n` is at least `narrowest` [m] wide along each cut axis
+/// (`periodic`: every box; otherwise the outer boxes reach to infinity).
+bool grid_fits(const std::array<int, 3>& n, const double extent[3], const bool periodic[3], double narrowest) {
+  for (int a = 0; a < 3; ++a) {
+    const int needed = periodic[a] ? n[a] : std::max(n[a] - 2, 0);
+    if (n[a] > 1 && extent[a] < needed * narrowest) return false;
+  }
+  return true;
+}
+
+/// A rank grid for `ranks` over boxes of `extent` [m] (per axis, a score: the axis of gravity
+/// counts half), each cut axis at least `narrowest` [m] a box (`periodic`: every box; otherwise
+/// the outer boxes reach to infinity): the factorisation whose busiest box shares the least face
+/// area with its neighbours, and of equal ones the one with fewer cut axes (fewer neighbours,
+/// fewer messages); {0, 0, 0} when none fits.
+std::array<int, 3> choose_grid(int ranks, const double extent[3], const bool periodic[3], double narrowest) {
+  std::array<int, 3> best{0, 0, 0};
+  double least = kInfinity;
+  int fewest = 4;
+  for (int nx = 1; nx <= ranks; ++nx) {
+    if (ranks % nx) continue;
+    for (int ny = 1; ny <= ranks / nx; ++ny) {
+      if ((ranks / nx) % ny) continue;
+      const std::array<int, 3> n{nx, ny, ranks / nx / ny};
+      if (!grid_fits(n, extent, periodic, narrowest)) continue;
+      double box[3], area = 0;
+      int cut = 0;
+      for (int a = 0; a < 3; ++a) box[a] = std::max(extent[a], narrowest) / n[a];
+      for (int a = 0; a < 3; ++a) {
+        if (n[a] == 1) continue;
+        const int faces = periodic[a] || n[a] > 2 ? 2 : 1;  // of an interior box
+        area += faces * box[(a + 1) % 3] * box[(a + 2) % 3], ++cut;
+      }
+      if (area < least * (1 - 1e-9) || (area <= least * (1 + 1e-9) && cut < fewest)) least = area, fewest = cut, best = n;
+    }
+  }
+  return best;
+}
+
 class MpiDomain final : public Domain {
  public:
-  MpiDomain(const Model& model, const State& initial) : local_(model) {
+  MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested) : local_(model) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (model.has_attached)
       throw CaseError(fmt::format("{}: the split into subdomains does not take spheres glued to walls (a shear cell)", model.source));
     // A clump belongs to the rank of its centre; its spheres reach `sticking_out_` beyond it,
-    // so the ghost layer and the slabs are that much deeper.
+    // so the ghost layer and the boxes are that much deeper.
     for (size_t p = 0; p < initial.size(); ++p)
       if (initial.body[p] >= 0)
         sticking_out_ = std::max(sticking_out_, std::sqrt(initial.offset_x[p] * initial.offset_x[p] + initial.offset_y[p] * initial.offset_y[p] +
@@ -60,52 +120,82 @@ class MpiDomain final : public Domain {
     double radius_max = model.radius_max;
     for (double r : initial.radius) radius_max = std::max(radius_max, r);
     reach_ = 2.0 * radius_max + model.interaction_range + model.skin + sticking_out_;
-    slab_min_ = reach_ + sticking_out_;
-    // The axis on which the particles (and the domain box) spread furthest.
-    double extent[3] = {0, 0, 0};
+    box_min_ = reach_ + sticking_out_;
+    // How far the particles (and the domain box) spread along each axis.
+    double extent[3] = {0, 0, 0}, score[3];
+    bool periodic[3];
     for (int a = 0; a < 3; ++a) {
       const std::vector<double>& c = column(initial, a);
       if (!c.empty()) extent[a] = *std::max_element(c.begin(), c.end()) - *std::min_element(c.begin(), c.end());
       if (model.has_domain) extent[a] = std::max(extent[a], model.domain_max[a] - model.domain_min[a]);
-      if (model.period[a] > 0) extent[a] = model.period[a];
+      periodic[a] = model.period[a] > 0;
+      if (periodic[a]) extent[a] = model.period[a];
+      score[a] = extent[a];
     }
-    // Particles travel along gravity (they settle, fall down chutes): slabs across it would see
+    // Particles travel along gravity (they settle, fall down chutes): cuts across it would see
     // most particles migrate and the balance shift all the time, so that axis counts half.
     const double g[3] = {std::abs(model.gravity[0]), std::abs(model.gravity[1]), std::abs(model.gravity[2])};
     const int down = static_cast<int>(std::max_element(g, g + 3) - g);
-    double score[3] = {extent[0], extent[1], extent[2]};
     if (g[down] > 0) score[down] *= 0.5;
-    axis_ = static_cast<int>(std::max_element(score, score + 3) - score);
-    periodic_ = model.period[axis_] > 0;
-    period_ = model.period[axis_];
-    low_ = model.domain_min[axis_];
-    if (periodic_) local_.period[axis_] = 0.0;  // the ranks carry the period across their faces
-    const double needed = (periodic_ ? size_ : std::max(size_ - 2, 0)) * slab_min_;
-    if (extent[axis_] < needed)
-      throw CaseError(fmt::format("{}: {} ranks need a domain at least {:.4g} m long along {} (each slab one pair reach, {:.4g} m, "
-                                  "wide); it is {:.4g} m, so fewer ranks would split it",
-                                  model.source, size_, needed, "xyz"[axis_], slab_min_, extent[axis_]));
-    down_ = rank_ > 0 ? rank_ - 1 : periodic_ ? size_ - 1 : MPI_PROC_NULL;
-    up_ = rank_ < size_ - 1 ? rank_ + 1 : periodic_ ? 0 : MPI_PROC_NULL;
-    // First cuts from the initial particles (the same on every rank), or evenly over the box.
-    std::vector<double> coords;
-    for (size_t p = 0; p < initial.size(); ++p) coords.push_back(wrapped(owner_coordinate(initial, p)));
-    std::sort(coords.begin(), coords.end());
-    cuts_.assign(size_ - 1, 0.0);
-    double lo = periodic_ ? low_ : model.has_domain ? model.domain_min[axis_] : coords.empty() ? 0.0 : coords.front();
-    double hi = periodic_ ? low_ + period_ : model.has_domain ? model.domain_max[axis_] : coords.empty() ? 1.0 : coords.back();
-    for (int k = 1; k < size_; ++k) {
-      if (coords.size() >= static_cast<size_t>(size_))
-        cuts_[k - 1] = coords[coords.size() * k / size_];
-      else
-        cuts_[k - 1] = lo + (hi - lo) * k / size_;
+    std::array<int, 3> grid = choose_grid(size_, score, periodic, box_min_);
+    if (requested[0] > 0) {
+      if (requested[0] * requested[1] * requested[2] != size_)
+        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} has {} boxes, not the {} ranks running", model.source, requested[0], requested[1],
+                                    requested[2], requested[0] * requested[1] * requested[2], size_));
+      if (!grid_fits(requested, extent, periodic, box_min_))
+        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} makes boxes narrower than one pair reach ({:.4g} m) in a domain of {:.4g} x "
+                                    "{:.4g} x {:.4g} m",
+                                    model.source, requested[0], requested[1], requested[2], box_min_, extent[0], extent[1], extent[2]));
+      grid = requested;
     }
-    keep_slabs_wide();
+    if (grid[0] == 0)
+      throw CaseError(fmt::format("{}: {} ranks cannot share a domain of {:.4g} x {:.4g} x {:.4g} m (each box at least one pair reach, {:.4g} m, "
+                                  "wide along every axis it is cut across), so fewer ranks would split it",
+                                  model.source, size_, extent[0], extent[1], extent[2], box_min_));
+    int rest = rank_;
+    for (int a = 0; a < 3; ++a) {
+      dims_[a] = grid[a];
+      coord_[a] = rest % dims_[a], rest /= dims_[a];
+      periodic_[a] = periodic[a] && dims_[a] > 1;
+      period_[a] = model.period[a];
+      low_[a] = model.domain_min[a];
+      if (periodic_[a]) local_.period[a] = 0.0;  // the ranks carry the period across their faces
+    }
+    // The neighbours: the offsets whose box exists (an axis not cut has none; a non-periodic
+    // axis none beyond its outer boxes), with the shift a particle sent there takes.
+    for (const Offset& o : all_offsets()) {
+      Neighbour n{o, 0, {0, 0, 0}};
+      int at[3];
+      bool exists = true;
+      for (int a = 0; a < 3 && exists; ++a) {
+        at[a] = coord_[a] + o.d[a];
+        if (o.d[a] != 0 && dims_[a] == 1) exists = false;
+        else if (at[a] < 0 || at[a] >= dims_[a]) {
+          if (!periodic_[a]) exists = false;
+          n.shift[a] = at[a] < 0 ? period_[a] : -period_[a];  // what I send there is seen one period on
+          at[a] = (at[a] + dims_[a]) % dims_[a];
+        }
+      }
+      if (!exists) continue;
+      n.rank = rank_of(at);
+      (o.upper() ? from_ : to_).push_back(n);
+    }
+    // First cuts from the initial particles (the same on every rank), or evenly over the box.
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> coords;
+      for (size_t p = 0; p < initial.size(); ++p) coords.push_back(wrapped(owner_coordinate(initial, p, a), a));
+      std::sort(coords.begin(), coords.end());
+      cuts_[a].assign(dims_[a] - 1, 0.0);
+      const double lo = periodic_[a] ? low_[a] : model.has_domain ? model.domain_min[a] : coords.empty() ? 0.0 : coords.front();
+      const double hi = periodic_[a] ? low_[a] + period_[a] : model.has_domain ? model.domain_max[a] : coords.empty() ? 1.0 : coords.back();
+      for (int k = 1; k < dims_[a]; ++k)
+        cuts_[a][k - 1] = coords.size() >= static_cast<size_t>(dims_[a]) ? coords[coords.size() * k / dims_[a]] : lo + (hi - lo) * k / dims_[a];
+      keep_boxes_wide(a);
+    }
   }
 
   const Model& local_model() const override { return local_; }
   bool root() const override { return rank_ == 0; }
-  int axis() const { return axis_; }
 
   bool any(bool mine) override {
     Timed timed{step_seconds_};
@@ -122,7 +212,7 @@ class MpiDomain final : public Domain {
 
   bool owns(double x, double y, double z) const override {
     const double at[3] = {x, y, z};
-    return owner(at[axis_]) == rank_;
+    return owner(at) == rank_;
   }
 
   std::vector<std::array<double, 4>> particles_in(const State& s, const double lo[3], const double hi[3]) override {
@@ -143,15 +233,16 @@ class MpiDomain final : public Domain {
     Timed timed{rebuild_seconds_};
     pairs.append(pending_pairs_), walls.append(pending_walls_);
     pending_pairs_ = {}, pending_walls_ = {};
-    wrap_slab_axis(s);
-    rebalance(s);
+    wrap_periodic_axes(s);
+    rebalance(s, pairs, walls);
     const int width = model.history_width;
     const size_t n = s.size(), record = s.record_size();
     // Where each body goes (-1: stays), then free spheres and bodies with their spheres.
     std::vector<int> body_to(s.bodies.size(), -1);
-    const std::vector<double>& centre = body_column(s, axis_);
-    for (size_t b = 0; b < s.bodies.size(); ++b)
-      if (owner(centre[b]) != rank_) body_to[b] = owner(centre[b]);
+    for (size_t b = 0; b < s.bodies.size(); ++b) {
+      const double at[3] = {s.bodies.x[b], s.bodies.y[b], s.bodies.z[b]};
+      if (owner(at) != rank_) body_to[b] = owner(at);
+    }
     std::unordered_map<std::int64_t, int> leaving;  // sphere id -> new owner
     std::vector<std::uint8_t> keep(n, 1);
     std::vector<std::vector<double>> spheres(size_), clumps(size_);
@@ -159,7 +250,8 @@ class MpiDomain final : public Domain {
     std::vector<std::vector<std::int32_t>> members(s.bodies.size());
     for (size_t p = 0; p < n; ++p) {
       const std::int32_t b = s.body[p];
-      const int to = b >= 0 ? body_to[b] : owner(column(s, axis_)[p]);
+      const double at[3] = {s.x[p], s.y[p], s.z[p]};
+      const int to = b >= 0 ? body_to[b] : owner(at);
       if (to < 0 || to == rank_) continue;
       keep[p] = 0;
       leaving[s.id[p]] = to;
@@ -237,72 +329,92 @@ class MpiDomain final : public Domain {
 
   void make_ghosts(const Model&, State& s) override {
     Timed timed{rebuild_seconds_};
-    // The owned particles within one reach above the lower face go down as ghosts; rank 0 of a
-    // periodic axis sends its to the top rank, one period up.
-    send_slots_.clear();
-    const std::vector<double>& c = column(s, axis_);
-    const double face = slab_low();
-    if (down_ != MPI_PROC_NULL)
-      for (size_t p = 0; p < s.owned(); ++p)
-        if (c[p] < face + reach_) send_slots_.push_back(static_cast<std::int32_t>(p));
-    shift_ = rank_ == 0 && periodic_ ? period_ : 0.0;
-    std::vector<double> out;
+    // To each lower neighbour, the owned particles within one reach of the faces, edges or
+    // corner this box shares with it, shifted by a period where the grid wraps.
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = box_low(a), hi[a] = box_high(a);
     const int record = static_cast<int>(s.record_size());
-    out.reserve(send_slots_.size() * record);
-    for (const std::int32_t p : send_slots_) {
-      const size_t at = out.size();
-      s.pack(p, out);
-      out[at + axis_] += shift_;
+    const size_t owned = s.owned();
+    std::vector<std::vector<double>> out(to_.size());
+    for (size_t k = 0; k < to_.size(); ++k) {
+      Neighbour& n = to_[k];
+      n.slots.clear();
+      for (size_t p = 0; p < owned; ++p) {
+        const double at[3] = {s.x[p], s.y[p], s.z[p]};
+        bool near = true;
+        for (int a = 0; a < 3 && near; ++a)
+          near = n.offset.d[a] == 0 || (n.offset.d[a] < 0 ? at[a] < lo[a] + reach_ : at[a] > hi[a] - reach_);
+        if (near) n.slots.push_back(static_cast<std::int32_t>(p));
+      }
+      out[k].reserve(n.slots.size() * record);
+      for (const std::int32_t p : n.slots) {
+        const size_t at = out[k].size();
+        s.pack(p, out[k]);
+        for (int a = 0; a < 3; ++a) out[k][at + a] += n.shift[a];
+      }
     }
-    int count = static_cast<int>(send_slots_.size()), incoming = 0;
-    check(MPI_Sendrecv(&count, 1, MPI_INT, down_, 1, &incoming, 1, MPI_INT, up_, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Sendrecv");
-    std::vector<double> in(static_cast<size_t>(incoming) * record);
-    check(MPI_Sendrecv(out.data(), static_cast<int>(out.size()), MPI_DOUBLE, down_, 2, in.data(), static_cast<int>(in.size()),
-                       MPI_DOUBLE, up_, 2, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
-          "MPI_Sendrecv");
-    for (int k = 0; k < incoming; ++k) {
-      s.unpack(in.data() + static_cast<size_t>(k) * record);
-      s.body.back() = -1, s.attached.back() = -1;  // a copy: its body, if any, lives on its owner
+    std::vector<int> sent(to_.size()), counts(from_.size());
+    for (size_t k = 0; k < to_.size(); ++k) sent[k] = static_cast<int>(to_[k].slots.size());
+    exchange_counts(sent, counts, 1);
+    std::vector<std::vector<double>> in(from_.size());
+    for (size_t k = 0; k < from_.size(); ++k) in[k].resize(static_cast<size_t>(counts[k]) * record);
+    exchange(out, in, 2, false);
+    size_t ghosts = 0;
+    for (size_t k = 0; k < from_.size(); ++k) {
+      from_[k].count = counts[k];
+      for (int q = 0; q < counts[k]; ++q) {
+        s.unpack(in[k].data() + static_cast<size_t>(q) * record);
+        s.body.back() = -1, s.attached.back() = -1;  // a copy: its body, if any, lives on its owner
+      }
+      ghosts += static_cast<size_t>(counts[k]);
     }
-    s.ghosts = static_cast<size_t>(incoming);
+    s.ghosts = ghosts;
     ++rebuilds_;
-    ghosts_ += incoming;
-    bytes_ += 8.0 * static_cast<double>(out.size());
+    ghosts_ += static_cast<std::int64_t>(ghosts);
+    for (const auto& o : out) bytes_ += 8.0 * static_cast<double>(o.size());
   }
 
   void refresh_ghosts(State& s) override {
     Timed timed{step_seconds_};
     ++refreshes_;
-    buffer_.clear();
-    for (const std::int32_t p : send_slots_) {
-      buffer_.insert(buffer_.end(), {s.x[p], s.y[p], s.z[p], s.vx[p], s.vy[p], s.vz[p], s.wx[p], s.wy[p], s.wz[p]});
-      buffer_[buffer_.size() - 9 + axis_] += shift_;
+    out_.resize(to_.size()), in_.resize(from_.size());
+    for (size_t k = 0; k < to_.size(); ++k) {
+      std::vector<double>& o = out_[k];
+      o.clear();
+      const double* shift = to_[k].shift;
+      for (const std::int32_t p : to_[k].slots)
+        o.insert(o.end(), {s.x[p] + shift[0], s.y[p] + shift[1], s.z[p] + shift[2], s.vx[p], s.vy[p], s.vz[p], s.wx[p], s.wy[p], s.wz[p]});
+      bytes_ += 8.0 * static_cast<double>(o.size());
     }
-    incoming_.resize(9 * s.ghosts);
-    check(MPI_Sendrecv(buffer_.data(), static_cast<int>(buffer_.size()), MPI_DOUBLE, down_, 3, incoming_.data(),
-                       static_cast<int>(incoming_.size()), MPI_DOUBLE, up_, 3, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
-          "MPI_Sendrecv");
-    bytes_ += 8.0 * static_cast<double>(buffer_.size());
-    const double* in = incoming_.data();
-    for (size_t p = s.owned(); p < s.size(); ++p, in += 9) {
-      s.x[p] = in[0], s.y[p] = in[1], s.z[p] = in[2], s.vx[p] = in[3], s.vy[p] = in[4], s.vz[p] = in[5];
-      s.wx[p] = in[6], s.wy[p] = in[7], s.wz[p] = in[8];
-    }
+    for (size_t k = 0; k < from_.size(); ++k) in_[k].resize(9 * static_cast<size_t>(from_[k].count));
+    exchange(out_, in_, 3, false);
+    size_t p = s.owned();
+    for (const std::vector<double>& block : in_)
+      for (const double* in = block.data(); in < block.data() + block.size(); in += 9, ++p) {
+        s.x[p] = in[0], s.y[p] = in[1], s.z[p] = in[2], s.vx[p] = in[3], s.vy[p] = in[4], s.vz[p] = in[5];
+        s.wx[p] = in[6], s.wy[p] = in[7], s.wz[p] = in[8];
+      }
   }
 
   void return_ghost_loads(State& s) override {
     Timed timed{step_seconds_};
-    buffer_.clear();
-    for (size_t p = s.owned(); p < s.size(); ++p) buffer_.insert(buffer_.end(), {s.fx[p], s.fy[p], s.fz[p], s.tx[p], s.ty[p], s.tz[p]});
-    incoming_.resize(6 * send_slots_.size());
-    check(MPI_Sendrecv(buffer_.data(), static_cast<int>(buffer_.size()), MPI_DOUBLE, up_, 4, incoming_.data(),
-                       static_cast<int>(incoming_.size()), MPI_DOUBLE, down_, 4, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
-          "MPI_Sendrecv");
-    bytes_ += 8.0 * static_cast<double>(buffer_.size());
-    const double* in = incoming_.data();
-    for (const std::int32_t p : send_slots_) {
-      s.fx[p] += in[0], s.fy[p] += in[1], s.fz[p] += in[2], s.tx[p] += in[3], s.ty[p] += in[4], s.tz[p] += in[5];
-      in += 6;
+    // Back along the ghosts' way: each upper neighbour gets the loads on its particles.
+    out_.resize(from_.size()), in_.resize(to_.size());
+    size_t p = s.owned();
+    for (size_t k = 0; k < from_.size(); ++k) {
+      std::vector<double>& o = out_[k];
+      o.clear();
+      for (int q = 0; q < from_[k].count; ++q, ++p) o.insert(o.end(), {s.fx[p], s.fy[p], s.fz[p], s.tx[p], s.ty[p], s.tz[p]});
+      bytes_ += 8.0 * static_cast<double>(o.size());
+    }
+    for (size_t k = 0; k < to_.size(); ++k) in_[k].resize(6 * to_[k].slots.size());
+    exchange(out_, in_, 4, true);
+    for (size_t k = 0; k < to_.size(); ++k) {
+      const double* in = in_[k].data();
+      for (const std::int32_t q : to_[k].slots) {
+        s.fx[q] += in[0], s.fy[q] += in[1], s.fz[q] += in[2], s.tx[q] += in[3], s.ty[q] += in[4], s.tz[q] += in[5];
+        in += 6;
+      }
     }
   }
 
@@ -318,8 +430,11 @@ class MpiDomain final : public Domain {
   void distribute(State& s) override {
     const int width = local_.history_width;
     std::vector<std::uint8_t> keep(s.size(), 0);
-    wrap_slab_axis(s);
-    for (size_t p = 0; p < s.size(); ++p) keep[p] = owner(owner_coordinate(s, p)) == rank_;
+    wrap_periodic_axes(s);
+    for (size_t p = 0; p < s.size(); ++p) {
+      const double at[3] = {owner_coordinate(s, p, 0), owner_coordinate(s, p, 1), owner_coordinate(s, p, 2)};
+      keep[p] = owner(at) == rank_;
+    }
     // Histories of a checkpoint: kept (by ids) for the first rebuild, where a pair with a
     // particle of another rank finds its partner among the ghosts.
     for (size_t k = 0; k < s.pairs.size() && width > 0; ++k)
@@ -412,84 +527,165 @@ class MpiDomain final : public Domain {
 
   std::string statistics() const override {
     const double steps = static_cast<double>(std::max<std::int64_t>(rebuilds_ + refreshes_, 1));
-    return fmt::format("{} steps ({} with a rebuild), mean {:.0f} ghosts, {} particles migrated, {} rebalances; communication "
+    return fmt::format("{} steps ({} with a rebuild), mean {:.0f} ghosts from {} neighbours, {} particles migrated, {} rebalances; communication "
                        "{:.3g} s in steps ({:.3g} ms a step), {:.3g} s at rebuilds, {:.3g} s gathering results; {:.3g} kB sent a step",
-                       rebuilds_ + refreshes_, rebuilds_, static_cast<double>(ghosts_) / std::max<std::int64_t>(rebuilds_, 1), migrated_,
-                       rebalances_, step_seconds_, 1e3 * step_seconds_ / steps, rebuild_seconds_, gather_seconds_, 1e-3 * bytes_ / steps);
+                       rebuilds_ + refreshes_, rebuilds_, static_cast<double>(ghosts_) / std::max<std::int64_t>(rebuilds_, 1), from_.size(),
+                       migrated_, rebalances_, step_seconds_, 1e3 * step_seconds_ / steps, rebuild_seconds_, gather_seconds_, 1e-3 * bytes_ / steps);
   }
 
   std::string describe() const {
     std::string cuts;
-    for (double c : cuts_) cuts += fmt::format("{}{:.4g}", cuts.empty() ? "" : ", ", c);
-    return fmt::format("{} ranks, slabs along {}{} (cuts at {} m), ghost reach {:.3g} m", size_, "xyz"[axis_],
-                       periodic_ ? " across the period" : "", cuts, reach_);
+    for (int a = 0; a < 3; ++a) {
+      if (cuts_[a].empty()) continue;
+      std::string at;
+      for (double c : cuts_[a]) at += fmt::format("{}{:.4g}", at.empty() ? "" : ", ", c);
+      cuts += fmt::format("{}{} at {} m{}", cuts.empty() ? "" : "; ", "xyz"[a], at, periodic_[a] ? " across the period" : "");
+    }
+    return fmt::format("{} ranks as a {} x {} x {} grid of boxes (cuts: {}), ghost reach {:.3g} m", size_, dims_[0], dims_[1], dims_[2], cuts, reach_);
   }
 
  private:
+  /// A box next to this one: its rank, where it lies, the shift [m] of what is sent to it, and
+  /// what is sent (to a lower neighbour: owned slots, in message order) or received (from an
+  /// upper one: the ghost count, the ghosts in the order of from_).
+  struct Neighbour {
+    Offset offset;
+    int rank = MPI_PROC_NULL;
+    double shift[3] = {0, 0, 0};
+    std::vector<std::int32_t> slots;
+    int count = 0;
+  };
+
   static std::vector<double>& column(State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
   static const std::vector<double>& column(const State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
-
   static std::vector<double>& body_column(State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
   static const std::vector<double>& body_column(const State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
-  /// Where a sphere belongs along the slab axis: its own centre, or its clump's.
-  double owner_coordinate(const State& s, size_t p) const {
-    return s.body[p] >= 0 ? body_column(s, axis_)[s.body[p]] : column(s, axis_)[p];
-  }
-  /// Free spheres and clump centres back into the period along a periodic slab axis (a clump's
-  /// spheres move with its centre).
-  void wrap_slab_axis(State& s) const {
-    if (!periodic_) return;
-    std::vector<double>& c = column(s, axis_);
-    std::vector<double>& centre = body_column(s, axis_);
-    std::vector<double> shift(centre.size());
-    for (size_t b = 0; b < centre.size(); ++b) shift[b] = wrapped(centre[b]) - centre[b], centre[b] += shift[b];
-    for (size_t p = 0; p < s.size(); ++p) c[p] = s.body[p] >= 0 ? c[p] + shift[s.body[p]] : wrapped(c[p]);
-  }
-  double wrapped(double c) const { return periodic_ ? c - period_ * std::floor((c - low_) / period_) : c; }
-  int owner(double c) const {
-    return static_cast<int>(std::upper_bound(cuts_.begin(), cuts_.end(), wrapped(c)) - cuts_.begin());
-  }
-  double slab_low() const { return rank_ > 0 ? cuts_[rank_ - 1] : periodic_ ? low_ : -kInfinity; }
 
-  /// Interior slabs (all slabs of a periodic axis) at least one reach wide.
-  void keep_slabs_wide() {
-    const int cuts = static_cast<int>(cuts_.size());
-    if (cuts == 0) return;
-    if (periodic_) cuts_[0] = std::max(cuts_[0], low_ + slab_min_);
-    for (int k = 1; k < cuts; ++k) cuts_[k] = std::max(cuts_[k], cuts_[k - 1] + slab_min_);
-    if (periodic_) cuts_[cuts - 1] = std::min(cuts_[cuts - 1], low_ + period_ - slab_min_);
-    for (int k = cuts - 2; k >= 0; --k) cuts_[k] = std::min(cuts_[k], cuts_[k + 1] - slab_min_);
-  }
-
-  /// New cuts at the quantiles of the particle count when the fullest rank holds more than
-  /// kImbalance times the mean (collective).
-  void rebalance(const State& s) {
-    const size_t n = s.size();
-    double stats[3] = {static_cast<double>(n), kInfinity, kInfinity};  // count, -min, max
-    double lo = kInfinity, hi = -kInfinity;
-    for (size_t p = 0; p < n; ++p) lo = std::min(lo, wrapped(owner_coordinate(s, p))), hi = std::max(hi, wrapped(owner_coordinate(s, p)));
-    stats[1] = -lo, stats[2] = hi;
-    double most[3];
-    check(MPI_Allreduce(stats, most, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-    const double total = sum(static_cast<double>(n));
-    if (total < size_ || most[0] <= kImbalance * total / size_) return;
-    if (periodic_) lo = low_, hi = low_ + period_;
-    else lo = -most[1], hi = most[2];
-    if (!(hi > lo)) return;
-    std::vector<double> histogram(kHistogramBins, 0.0), all(kHistogramBins);
-    const double width = (hi - lo) / kHistogramBins;
-    for (size_t p = 0; p < n; ++p) histogram[std::clamp(static_cast<int>((wrapped(owner_coordinate(s, p)) - lo) / width), 0, kHistogramBins - 1)] += 1;
-    check(MPI_Allreduce(histogram.data(), all.data(), kHistogramBins, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
-    double below = 0;
-    int bin = 0;
-    for (int k = 1; k < size_; ++k) {
-      const double target = total * k / size_;
-      while (bin < kHistogramBins && below + all[bin] < target) below += all[bin++];
-      const double within = bin < kHistogramBins && all[bin] > 0 ? (target - below) / all[bin] : 0.0;
-      cuts_[k - 1] = lo + (bin + within) * width;
+  int rank_of(const int at[3]) const { return at[0] + dims_[0] * (at[1] + dims_[1] * at[2]); }
+  /// Where a sphere belongs along axis a: its own centre, or its clump's.
+  double owner_coordinate(const State& s, size_t p, int a) const { return s.body[p] >= 0 ? body_column(s, a)[s.body[p]] : column(s, a)[p]; }
+  /// Free spheres and clump centres back into the period along every periodic axis the grid cuts
+  /// (a clump's spheres move with its centre).
+  void wrap_periodic_axes(State& s) const {
+    for (int a = 0; a < 3; ++a) {
+      if (!periodic_[a]) continue;
+      std::vector<double>& c = column(s, a);
+      std::vector<double>& centre = body_column(s, a);
+      std::vector<double> shift(centre.size());
+      for (size_t b = 0; b < centre.size(); ++b) shift[b] = wrapped(centre[b], a) - centre[b], centre[b] += shift[b];
+      for (size_t p = 0; p < s.size(); ++p) c[p] = s.body[p] >= 0 ? c[p] + shift[s.body[p]] : wrapped(c[p], a);
     }
-    keep_slabs_wide();
+  }
+  double wrapped(double c, int a) const { return periodic_[a] ? c - period_[a] * std::floor((c - low_[a]) / period_[a]) : c; }
+  int slot_along(double c, int a) const { return static_cast<int>(std::upper_bound(cuts_[a].begin(), cuts_[a].end(), wrapped(c, a)) - cuts_[a].begin()); }
+  int owner(const double at[3]) const {
+    const int slot[3] = {slot_along(at[0], 0), slot_along(at[1], 1), slot_along(at[2], 2)};
+    return rank_of(slot);
+  }
+  double box_low(int a) const { return coord_[a] > 0 ? cuts_[a][coord_[a] - 1] : periodic_[a] ? low_[a] : -kInfinity; }
+  double box_high(int a) const {
+    return coord_[a] < dims_[a] - 1 ? cuts_[a][coord_[a]] : periodic_[a] ? low_[a] + period_[a] : kInfinity;
+  }
+
+  /// Interior boxes along axis a (all boxes of a periodic axis) at least one reach wide.
+  void keep_boxes_wide(int a) {
+    std::vector<double>& cuts = cuts_[a];
+    const int n = static_cast<int>(cuts.size());
+    if (n == 0) return;
+    if (periodic_[a]) cuts[0] = std::max(cuts[0], low_[a] + box_min_);
+    for (int k = 1; k < n; ++k) cuts[k] = std::max(cuts[k], cuts[k - 1] + box_min_);
+    if (periodic_[a]) cuts[n - 1] = std::min(cuts[n - 1], low_[a] + period_[a] - box_min_);
+    for (int k = n - 2; k >= 0; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - box_min_);
+  }
+
+  /// New cuts when the most loaded rank carries more than kImbalance times the mean work
+  /// (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
+  /// history: in a dense bed the contacts, not the particles, cost the time); each cut axis gets
+  /// its cuts at the quantiles of the work along it.
+  void rebalance(const State& s, const HistoryRows& pairs, const HistoryRows& walls) {
+    const size_t n = s.size();
+    std::unordered_map<std::int64_t, double> contacts;
+    for (size_t q = 0; q < pairs.size(); ++q) contacts[pairs.a[q]] += 1, contacts[pairs.b[q]] += 1;
+    for (size_t q = 0; q < walls.size(); ++q) contacts[walls.a[q]] += 1;
+    std::vector<double> work(n, 1.0);
+    double mine = 0;
+    for (size_t p = 0; p < n; ++p) {
+      const auto it = contacts.find(s.id[p]);
+      if (it != contacts.end()) work[p] += it->second;
+      mine += work[p];
+    }
+    double stats[7] = {mine};  // work, then -low and high along each axis
+    for (int a = 0; a < 3; ++a) {
+      double lo = kInfinity, hi = -kInfinity;
+      for (size_t p = 0; p < n; ++p) lo = std::min(lo, wrapped(owner_coordinate(s, p, a), a)), hi = std::max(hi, wrapped(owner_coordinate(s, p, a), a));
+      stats[1 + 2 * a] = -lo, stats[2 + 2 * a] = hi;
+    }
+    double most[7];
+    check(MPI_Allreduce(stats, most, 7, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
+    const double total = sum(mine);
+    if (total < size_ || most[0] <= kImbalance * total / size_) return;
+    for (int a = 0; a < 3; ++a) {
+      if (dims_[a] == 1) continue;
+      const double lo = periodic_[a] ? low_[a] : -most[1 + 2 * a], hi = periodic_[a] ? low_[a] + period_[a] : most[2 + 2 * a];
+      if (!(hi > lo)) continue;
+      std::vector<double> histogram(kHistogramBins, 0.0), all(kHistogramBins);
+      const double width = (hi - lo) / kHistogramBins;
+      for (size_t p = 0; p < n; ++p)
+        histogram[std::clamp(static_cast<int>((wrapped(owner_coordinate(s, p, a), a) - lo) / width), 0, kHistogramBins - 1)] += work[p];
+      check(MPI_Allreduce(histogram.data(), all.data(), kHistogramBins, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+      double below = 0;
+      int bin = 0;
+      for (int k = 1; k < dims_[a]; ++k) {
+        const double target = total * k / dims_[a];
+        while (bin < kHistogramBins && below + all[bin] < target) below += all[bin++];
+        const double within = bin < kHistogramBins && all[bin] > 0 ? (target - below) / all[bin] : 0.0;
+        cuts_[a][k - 1] = lo + (bin + within) * width;
+      }
+      keep_boxes_wide(a);
+    }
     ++rebalances_;
+  }
+
+  /// One message to each lower neighbour (`out`, by to_) and one from each upper one (`in`, sized
+  /// by the caller, by from_); `back` reverses the roles (loads returned to the ghosts' owners).
+  /// The tag names the offset as the receiver sees the sender, so two messages between the same
+  /// two ranks (two boxes across a period) do not mix.
+  void exchange(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in, int kind, bool back) {
+    const std::vector<Neighbour>& senders_to = back ? from_ : to_;
+    const std::vector<Neighbour>& receivers_from = back ? to_ : from_;
+    requests_.clear();
+    for (size_t k = 0; k < receivers_from.size(); ++k) {
+      requests_.emplace_back();
+      check(MPI_Irecv(in[k].data(), static_cast<int>(in[k].size()), MPI_DOUBLE, receivers_from[k].rank, tag(kind, receivers_from[k].offset.d, false),
+                      MPI_COMM_WORLD, &requests_.back()),
+            "MPI_Irecv");
+    }
+    for (size_t k = 0; k < senders_to.size(); ++k) {
+      requests_.emplace_back();
+      check(MPI_Isend(out[k].data(), static_cast<int>(out[k].size()), MPI_DOUBLE, senders_to[k].rank, tag(kind, senders_to[k].offset.d, true),
+                      MPI_COMM_WORLD, &requests_.back()),
+            "MPI_Isend");
+    }
+    check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+  }
+  void exchange_counts(const std::vector<int>& sent, std::vector<int>& counts, int kind) {
+    requests_.clear();
+    for (size_t k = 0; k < from_.size(); ++k) {
+      requests_.emplace_back();
+      check(MPI_Irecv(&counts[k], 1, MPI_INT, from_[k].rank, tag(kind, from_[k].offset.d, false), MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
+    }
+    for (size_t k = 0; k < to_.size(); ++k) {
+      requests_.emplace_back();
+      check(MPI_Isend(&sent[k], 1, MPI_INT, to_[k].rank, tag(kind, to_[k].offset.d, true), MPI_COMM_WORLD, &requests_.back()), "MPI_Isend");
+    }
+    check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+  }
+  /// A message's tag: its kind and the offset of the receiver's box from the sender's (`sending`:
+  /// `d` is the offset of the receiver as the sender sees it; otherwise of the sender as the
+  /// receiver sees it, so negated).
+  static int tag(int kind, const int d[3], bool sending) {
+    const int seen[3] = {sending ? d[0] : -d[0], sending ? d[1] : -d[1], sending ? d[2] : -d[2]};
+    return 32 * kind + index_of(seen);
   }
 
   std::vector<double> all_gather(const std::vector<double>& mine) {
@@ -517,18 +713,18 @@ class MpiDomain final : public Domain {
 
   Model local_;
   int rank_ = 0, size_ = 1;
-  int axis_ = 0;
-  bool periodic_ = false;
-  double period_ = 0, low_ = 0;  // [m] along the slab axis
+  int dims_[3] = {1, 1, 1}, coord_[3] = {0, 0, 0};  // the rank grid and this rank's place in it
+  bool periodic_[3] = {false, false, false};        // periodic and cut by the grid
+  double period_[3] = {0, 0, 0}, low_[3] = {0, 0, 0};  // [m]
   double reach_ = 0;             // [m] ghost layer depth: a pair's largest listing distance (+ sticking_out_)
   double sticking_out_ = 0;      // [m] how far a clump's sphere centre lies from the clump's centre
-  double slab_min_ = 0;          // [m] narrowest slab: reach_ + sticking_out_
-  std::vector<double> cuts_;     // [m] between slab r and r + 1
-  int down_ = -1, up_ = -1;      // neighbour ranks (MPI_PROC_NULL: none)
-  std::vector<std::int32_t> send_slots_;  ///< owned slots sent down as ghosts, in message order
-  double shift_ = 0;                       // [m] added along the axis to what is sent down
+  double box_min_ = 0;           // [m] narrowest box along a cut axis: reach_ + sticking_out_
+  std::vector<double> cuts_[3];  // [m] between box k and k + 1 along each axis
+  std::vector<Neighbour> to_, from_;  // lower neighbours (get my ghosts, return their loads), upper ones
   HistoryRows pending_pairs_, pending_walls_;
-  std::vector<double> buffer_, incoming_;
+  std::vector<double> buffer_;
+  std::vector<std::vector<double>> out_, in_;
+  std::vector<MPI_Request> requests_;
   std::int64_t migrated_ = 0, rebalances_ = 0, rebuilds_ = 0, refreshes_ = 0, ghosts_ = 0;
   double step_seconds_ = 0, rebuild_seconds_ = 0, gather_seconds_ = 0;  // [s] in MPI and packing
   double bytes_ = 0;  // [B] sent by this rank
@@ -536,12 +732,12 @@ class MpiDomain final : public Domain {
 
 }  // namespace
 
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note) {
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size < 2) return nullptr;
   try {
-    auto domain = std::make_unique<MpiDomain>(model, initial);
+    auto domain = std::make_unique<MpiDomain>(model, initial, grid);
     if (note) *note = domain->describe();
     return domain;
   } catch (const CaseError& e) {
@@ -552,7 +748,7 @@ std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, st
 
 #else
 
-std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*) { return nullptr; }
+std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*, const std::array<int, 3>&) { return nullptr; }
 
 #endif
 

@@ -1,25 +1,32 @@
 // Spatial domain decomposition over MPI ranks (the engine's side is src/core/domain.h): one case
-// split into slabs along one axis, `mpirun -np N demdesign CASE.yaml`.
+// split into a 3-D grid of boxes, `mpirun -np N demdesign CASE.yaml`.
 //
-// Slabs: along the axis on which the particles spread furthest (a periodic axis counts with its
-// period, the axis of gravity at half its extent: particles travel along it). The cuts between slabs sit at quantiles of the particle count (load balance by
-// particle count), recomputed at a rebuild when the largest rank holds more than 10 % above the
-// mean; every slab stays at least one ghost reach wide, so a rank's ghosts come from the next rank
-// up only. The outer slabs of a non-periodic axis reach to infinity; along a periodic axis the top
-// rank's upper neighbour is rank 0, whose particles it sees shifted by one period.
+// The grid: of the factorisations nx x ny x nz of the rank count, the one whose boxes share the
+// least face area with their neighbours, over the extent the particles and the domain box span
+// (a periodic axis counts with its period, the axis of gravity at half its extent: particles
+// travel along it), with every box at least one ghost reach wide along each axis it is cut across.
+// The cuts along each axis sit at quantiles of the work (a particle weighs one plus its
+// contacts), recomputed at a rebuild when the most loaded rank carries more than 10 % above the
+// mean. The outer boxes of a non-periodic axis reach to infinity; along a periodic axis the last
+// box's upper neighbour is the first, seen one period on.
 //
-// Exchanges per step: ghost positions and velocities down (9 doubles a ghost), ghost loads back
-// up (6 doubles a ghost), one logical OR (rebuild?), one sum of the plane walls' loads. At a
-// rebuild: one all-to-all of migrating particles with their contact histories, one exchange of
-// ghost records, one histogram sum for the balance. Meshes are held whole by every rank (their
-// triangles are shared, read-only); wear records and loads are summed when results are written.
+// Ghosts: of its up to 26 neighbours, a rank receives the particles of the 13 that lie above it
+// (z first, then y, then x), within one reach of the faces, edges or corner they share, and lists
+// the pairs with them; the forces on those ghosts go back to their owners. A pair across ranks is
+// thus listed once. Exchanges per step: ghost positions and velocities (9 doubles a ghost), ghost
+// loads back (6 doubles a ghost), one message to or from each neighbour, one logical OR
+// (rebuild?), one sum of the plane walls' loads. At a rebuild: one all-to-all of migrating
+// particles with their contact histories, one exchange of ghost records, per cut axis one
+// histogram sum for the balance. Meshes are held whole by every rank (their triangles are shared,
+// read-only); wear records and loads are summed when results are written.
 //
 // Clumps belong to the rank of their centre and move with all their spheres; the ghost layer and
-// the narrowest slab are deeper by how far a clump's spheres stick out. Not decomposed: spheres
+// the narrowest box are deeper by how far a clump's spheres stick out. Not decomposed: spheres
 // glued to walls (a shear cell; such a case runs on rank 0 alone). Rank 0 gathers the whole
 // state for every row of scalars, frame and checkpoint.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "core/domain.h"
@@ -28,8 +35,9 @@ namespace dem::app::mpi {
 
 /// The domain over all ranks of the running MPI session for `model`, whose initial particles are
 /// `initial` (the same on every rank); `note` tells how it was cut. Null without MPI, on one
-/// rank, and when the case cannot be split (clumps, glued spheres, a slab axis too short for the
-/// ranks): then `note` says why, and the case runs on rank 0 alone.
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note);
+/// rank, and when the case cannot be split (glued spheres, a domain too small for the ranks' boxes):
+/// then `note` says why, and the case runs on rank 0 alone. `grid` (nx, ny, nz; zeros: chosen)
+/// asks for a rank grid, whose boxes must have the ranks' count and one reach's width.
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid = {0, 0, 0});
 
 }  // namespace dem::app::mpi

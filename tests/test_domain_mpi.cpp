@@ -1,10 +1,11 @@
 // Domain decomposition (src/core/domain.h, app/mpi_domain.h), run as
-// `mpirun -np 2 domain_mpi_tests` (tests/CMakeLists.txt). Every rank runs each case twice: whole,
-// in this process alone, and split into slabs shared with the other rank. Particles and momentum
+// `mpirun -np 2 domain_mpi_tests` and with 4 ranks (tests/CMakeLists.txt). Every rank runs each
+// case twice: whole, in this process alone, and split into boxes shared with the other ranks. Particles and momentum
 // must be conserved exactly (to rounding), and the decomposed runs must match the single-rank runs
 // within their run-to-run spread: a split run is not bitwise the same (contacts across a face are
 // summed in another order), so its trajectories part from the single run's after a while, as two
 // runs of one case on different machines would.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -33,12 +34,12 @@ struct Outcome {
   std::string note;           ///< how the domain was cut
 };
 
-Outcome simulate(const CaseSpec& spec, bool decomposed, double duration) {
+Outcome simulate(const CaseSpec& spec, bool decomposed, double duration, const std::array<int, 3>& grid = {0, 0, 0}) {
   const Model model = compile(spec);
   Outcome out;
   State state = initial_state(model);
   Workspace work;
-  std::unique_ptr<Domain> domain = decomposed ? mpi::make_domain(model, state, &out.note) : nullptr;
+  std::unique_ptr<Domain> domain = decomposed ? mpi::make_domain(model, state, &out.note, grid) : nullptr;
   RunOptions options;
   options.write_files = false;
   options.progress = false;
@@ -57,8 +58,8 @@ bool root() { return mpi::world().rank == 0; }
 struct Runs {
   Outcome whole, split;
 };
-Runs whole_and_split(const CaseSpec& spec, double duration) {
-  Runs runs{simulate(spec, false, duration), simulate(spec, true, duration)};
+Runs whole_and_split(const CaseSpec& spec, double duration, const std::array<int, 3>& grid = {0, 0, 0}) {
+  Runs runs{simulate(spec, false, duration), simulate(spec, true, duration, grid)};
   if (root()) std::printf("  %s\n", runs.split.note.c_str());
   return runs;
 }
@@ -84,9 +85,9 @@ std::array<double, 4> momentum(const State& s) {  // [kg m/s] x, y, z and the su
 }
 
 // A frictional, dissipative gas in a box periodic along all three axes, no walls, no gravity:
-// nothing but contacts acts, so the total momentum stays what it was. The slabs run along x, the
-// long axis, with the top rank's upper neighbour rank 0 one period on: particles cross both the
-// cut and the periodic face, ghosts are sent across both.
+// nothing but contacts acts, so the total momentum stays what it was. The box is long along x, so
+// the ranks cut x alone, with the last box's upper neighbour the first one period on: particles
+// cross both the cuts and the periodic face, ghosts are sent across both.
 const char* kPeriodicGas = R"(
 title: periodic frictional gas
 simulation:
@@ -110,7 +111,9 @@ TEST(DomainMpi, PeriodicGasConservesParticlesAndMomentumExactly) {
   const Runs runs = whole_and_split(spec, 0.05);
   if (!root()) return;
   const Outcome &whole = runs.whole, &split = runs.split;
-  EXPECT_NE(split.note.find("slabs along x across the period"), std::string::npos) << split.note;
+  const int ranks = mpi::world().size;
+  EXPECT_NE(split.note.find(fmt::format("{} x 1 x 1 grid", ranks)), std::string::npos) << split.note;
+  EXPECT_NE(split.note.find("across the period"), std::string::npos) << split.note;
   ASSERT_EQ(split.whole.size(), 1800u) << "particles";
   ASSERT_EQ(whole.whole.size(), 1800u);
   const std::array<double, 4> a = momentum(whole.whole), b = momentum(split.whole);
@@ -127,9 +130,41 @@ TEST(DomainMpi, PeriodicGasConservesParticlesAndMomentumExactly) {
   EXPECT_NEAR(kb, ka, 0.05 * ka);
 }
 
+// The same gas in a flatter box on a grid cut along two axes (2 x 2 x 1 on four ranks, 1 x 2 x 1
+// on two): each rank takes ghosts from the neighbours across faces, edges and corners, and on a
+// periodic axis of two boxes its neighbours below and above are the same rank, one period apart.
+// Particles and momentum must be kept exactly all the same.
+TEST(DomainMpi, PeriodicGasOnAGridOfBoxesConservesExactly) {
+  std::string text = kPeriodicGas;
+  const auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  replace("max: [0.12, 0.03, 0.03]}\nmaterials", "max: [0.06, 0.06, 0.03]}\nmaterials");
+  for (int k = 0; k < 2; ++k) replace("max: [0.12, 0.03, 0.03]}, velocity", "max: [0.06, 0.06, 0.03]}, velocity");
+  const CaseSpec spec = parse_case_text(text, "periodic_gas_grid.yaml");
+  const Model model = compile(spec);
+  const std::array<double, 4> before = momentum(initial_state(model));
+  const int ranks = mpi::world().size;
+  const std::array<int, 3> grid = ranks == 4 ? std::array<int, 3>{2, 2, 1} : std::array<int, 3>{1, ranks, 1};
+  const Runs runs = whole_and_split(spec, 0.05, grid);
+  if (!root()) return;
+  const Outcome &whole = runs.whole, &split = runs.split;
+  EXPECT_NE(split.note.find(fmt::format("{} x {} x {} grid", grid[0], grid[1], grid[2])), std::string::npos) << split.note;
+  ASSERT_EQ(split.whole.size(), 1800u) << "particles";
+  const std::array<double, 4> b = momentum(split.whole);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(b[k], before[k], 1e-11 * before[3]) << "momentum component " << k << " of the split run";
+  const double ka = whole.rows.back().kinetic_translation, kb = split.rows.back().kinetic_translation;
+  std::printf("  kinetic energy %.5g J single, %.5g J split; contacts %zu / %zu\n", ka, kb, whole.rows.back().contacts, split.rows.back().contacts);
+  EXPECT_LT(ka, 0.9 * whole.rows.front().kinetic_translation);
+  EXPECT_NEAR(kb, ka, 0.05 * ka);
+  // Early on, before the runs part, the split run has the single run's contacts: every pair
+  // across a face, edge or corner listed once, none lost, none twice.
+  ASSERT_GT(split.rows.size(), 1u);
+  ASSERT_GT(whole.rows[1].contacts, 20u);
+  EXPECT_EQ(split.rows[1].contacts, whole.rows[1].contacts) << "at " << whole.rows[1].time << " s";
+}
+
 TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
   // The shipped settling bed (rolling resistance, liquid bridges), 2,000 beads poured from a tall
-  // region: the slabs run along z (twice as tall as wide, so even at half weight), most beads fall
+  // region: two ranks cut z (twice as tall as wide, so even at half weight), most beads fall
   // from the upper rank to the lower, the cuts move with them (balance by particle count). At
   // rest the floor carries the weight.
   CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/settling_bed.yaml");
@@ -167,7 +202,7 @@ TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
 
 TEST(DomainMpi, InclinedPlateFlowMatchesTheSingleRankRun) {
   // The shipped inlet-plate-outlet case: an inlet pours gravel onto a plate inclined at 40
-  // degrees, the outlet bin takes what leaves it. The slabs run along x, the flow direction, so
+  // degrees, the outlet bin takes what leaves it. Two ranks cut x, the flow direction, so
   // every bead is inserted on rank 0 and migrates to rank 1 with its contacts.
   const CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/inlet_outlet.yaml");
   const double duration = 0.6;
@@ -259,7 +294,7 @@ TEST(DomainMpi, ClumpPourMatchesTheSingleRankRun) {
 TEST(DomainMpi, SiloDischargeThroughAMeshMatchesTheSingleRankRun) {
   // A small silo (triangle mesh, slide gate opening at 0.3 s): 2,500 beads, discharge for 0.6 s.
   // Mesh contacts (with their histories, per particle) migrate with the particles; the wall
-  // loads and wear records of the ranks are summed. The slabs run along x, through the orifice.
+  // loads and wear records of the ranks are summed. Two ranks cut x, through the orifice.
   YAML::Node node = YAML::LoadFile(DEMDESIGN_SOURCE_DIR "/cases/silo_discharge.yaml");
   node.remove("sweep");
   node["equipment"]["silo"]["diameter"] = 0.1;

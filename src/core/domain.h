@@ -1,18 +1,19 @@
 // Spatial domain decomposition, the engine's side: what a step asks of the ranks that share one
 // simulation. The engine knows no MPI; app/mpi_domain.* implements this over MPI.
 //
-// Each rank owns the particles in its slab of the domain (slab axis and bounds are the
-// implementation's) and holds, after its own particles, ghost copies of the particles of the
-// next rank up that lie within one pair reach (interaction range + skin + the largest diameter)
-// of its upper face (State::ghosts). A pair across a face is thus listed on exactly one rank, the
-// lower one, which evaluates it once and returns the force on the ghost to its owner
-// (Newton's third law holds exactly, as in one process). Ghost-ghost pairs are not listed.
+// Each rank owns the particles in its box of the domain (the grid of boxes is the
+// implementation's) and holds, after its own particles, ghost copies of the particles of its
+// upper neighbours (the boxes across a face, edge or corner that the implementation ranks above
+// it) that lie within one pair reach (interaction range + skin + the largest diameter) of the
+// faces, edges or corner they share (State::ghosts). A pair across ranks is thus listed on exactly
+// one rank, which evaluates it once and returns the force on the ghost to its owner (Newton's
+// third law holds exactly, as in one process). Ghost-ghost pairs are not listed.
 //
 // The step with a domain (step.cpp, neighbors.cpp, forces.cpp):
 //   kick + drift of owned particles
 //   rebuild decided together (any rank's skin used up rebuilds every rank), and then, in
 //   rebuild_contacts: ghosts dropped, lost particles removed, migrate() (owned particles that
-//   left the slab move to their new owner with every contact history they had), owned slots
+//   left the box move to their new owner with every contact history they had), owned slots
 //   sorted, make_ghosts(), lists built, histories carried by particle id;
 //   otherwise refresh_ghosts() (positions and velocities of the ghosts from their owners)
 //   contact forces, then return_ghost_loads(), sum_wall_loads(), gravity and the closing kick.
@@ -39,12 +40,12 @@ class Domain {
   virtual ~Domain() = default;
   /// True on every rank when `mine` is true on any (collective).
   virtual bool any(bool mine) = 0;
-  /// Whether a point lies in this rank's slab (new particles of an inlet are kept by the owner).
+  /// Whether a point lies in this rank's box (new particles of an inlet are kept by the owner).
   virtual bool owns(double x, double y, double z) const = 0;
   /// Centres and radii (x, y, z, r) of every rank's owned particles inside the box [lo, hi], for
   /// an inlet's overlap checks (collective).
   virtual std::vector<std::array<double, 4>> particles_in(const State& state, const double lo[3], const double hi[3]) = 0;
-  /// Sends owned particles that left this rank's slab to their owners with their contact
+  /// Sends owned particles that left this rank's box to their owners with their contact
   /// histories (taken from `pairs` and `walls`) and appends the particles and histories other
   /// ranks sent (collective). Ghosts have been dropped.
   virtual void migrate(const Model& model, State& state, HistoryRows& pairs, HistoryRows& walls) = 0;
@@ -58,8 +59,8 @@ class Domain {
   virtual void sum_wall_loads(State& state) = 0;
 
   // The run's side (run.cpp).
-  /// The model the ranks step: the case's, with the slab axis no longer periodic (the ranks
-  /// carry the period across their faces).
+  /// The model the ranks step: the case's, with the periodic axes the grid cuts no longer
+  /// periodic (the ranks carry the period across their faces).
   virtual const Model& local_model() const = 0;
   /// Whether this rank writes the results (rank 0).
   virtual bool root() const = 0;

@@ -77,7 +77,7 @@ void refresh_body_spheres(const Model& model, State& s, const Workspace& work) {
 }
 
 /// Inlets under domain decomposition: every rank draws the same insertions (same random
-/// state) against every rank's spheres near the region, and keeps those in its own slab.
+/// state) against every rank's spheres near the region, and keeps those in its own box.
 void run_inlets_decomposed(const Model& model, State& state, Workspace& work) {
   Domain& domain = *work.domain;
   for (int k = 0; k < static_cast<int>(model.inlets.size()); ++k) {
