@@ -142,6 +142,19 @@ int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls)
 /// and the confirmations.
 int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls);
 
+/// Which of the candidates, ranked by the residual their signatures explain, are confirmed by
+/// recalibration: the leading confirm_candidates the screen passes (or, when the screen passes
+/// none, the leading ones anyway); every runner-up the screen cannot tell from the leader (within
+/// screen_margin: `undecided`, whatever its rank, so that a budget does not leave it out); and
+/// one whose signature changes shape between its two strengths (`nonlinear`); at most
+/// confirm_candidates + 2. `confirming` holds indices into `ranked`.
+struct ConfirmationChoice {
+  std::vector<size_t> confirming;
+  std::vector<std::string> undecided, nonlinear;
+  bool screen_silent = false;
+};
+ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options);
+
 /// Which candidate confirmations fit what is left of a budget [s], each at its cost [s], in rank
 /// order: the first always; a later one when it fits, or when it is tied (the signature screen
 /// cannot tell it from the leader), then beyond the budget. `left` is what remains after those

@@ -287,21 +287,10 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     // nonlinear effect (cohesion at a start far from the truth) can overshoot and show little
     // projection. When no candidate passes the screen although the model misfits, the leading
     // ones are confirmed anyway: recalibration, not the screen, decides.
-    const bool screen_silent = std::none_of(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
-    // Confirmed: the leaders the screen passes, every candidate it cannot tell from the leader
-    // (within screen_margin), and a candidate whose signature changes shape between its two
-    // strengths (the linear screen cannot be trusted for it); at most confirm_candidates + 2.
-    const double leader = d.candidates.empty() ? 0.0 : d.candidates.front().explained;
-    std::vector<std::string> undecided, nonlinear;
-    const auto chosen = [&](const CandidateResult& cr, int rank) {
-      if (rank < options.confirm_candidates && (cr.explained >= 0.05 || screen_silent)) return true;
-      if (cr.explained >= 0.05 && leader - cr.explained <= options.screen_margin) return undecided.push_back(cr.name), true;
-      if (cr.explained >= 0.05 && cr.agreement < 0.5) return nonlinear.push_back(cr.name), true;
-      return false;
-    };
-    std::vector<size_t> confirming;
-    for (size_t rank = 0; rank < d.candidates.size() && static_cast<int>(confirming.size()) < options.confirm_candidates + 2; ++rank)
-      if (chosen(d.candidates[rank], static_cast<int>(rank))) confirming.push_back(rank);
+    const detail::ConfirmationChoice choice = detail::choose_confirmations(d.candidates, options);
+    const bool screen_silent = choice.screen_silent;
+    std::vector<size_t> confirming = choice.confirming;
+    std::vector<std::string> undecided = choice.undecided, nonlinear = choice.nonlinear;
     // With a budget, the confirmations are fitted into what is left of it, at the cost per
     // simulation this diagnosis has measured so far: a candidate's simulations (cohesion, a wetter
     // bed) may cost several times the first comparison's, on which the plan was made. The leader
@@ -446,6 +435,23 @@ int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effec
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
   // The calibration and its confirming comparison, then the screen and the confirmations.
   return detail::calibration_passes(o, p) + screen_and_confirmation_passes(o, p, effects, walls);
+}
+
+ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options) {
+  ConfirmationChoice out;
+  out.screen_silent = std::none_of(ranked.begin(), ranked.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
+  const double leader = ranked.empty() ? 0.0 : ranked.front().explained;
+  const auto chosen = [&](const CandidateResult& cr, int rank) {
+    const bool tied = rank > 0 && cr.explained >= 0.05 && leader - cr.explained <= options.screen_margin;
+    if (tied) out.undecided.push_back(cr.name);
+    if (rank < options.confirm_candidates && (cr.explained >= 0.05 || out.screen_silent)) return true;
+    if (tied) return true;
+    if (cr.explained >= 0.05 && cr.agreement < 0.5) return out.nonlinear.push_back(cr.name), true;
+    return false;
+  };
+  for (size_t rank = 0; rank < ranked.size() && static_cast<int>(out.confirming.size()) < options.confirm_candidates + 2; ++rank)
+    if (chosen(ranked[rank], static_cast<int>(rank))) out.confirming.push_back(rank);
+  return out;
 }
 
 ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left) {

@@ -278,6 +278,17 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
 }
 
 TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
+  // sjkr 73 %, jkr 69 % (within the 10 % margin: tied, although jkr is also among the two leaders
+  // confirmed anyway), liquid bridges 57 % (not tied); the budget below may drop only the last.
+  std::vector<CandidateResult> ranked(4);
+  const char* names[] = {"sjkr", "jkr", "liquid_bridge", "epsd"};
+  const double explained[] = {0.73, 0.69, 0.57, 0.19};
+  for (size_t k = 0; k < ranked.size(); ++k) ranked[k].name = names[k], ranked[k].explained = explained[k], ranked[k].agreement = 0.9;
+  const detail::ConfirmationChoice choice = detail::choose_confirmations(ranked, CalibrationOptions{});
+  EXPECT_EQ(choice.confirming, (std::vector<size_t>{0, 1}));
+  EXPECT_EQ(choice.undecided, (std::vector<std::string>{"jkr"}));
+  EXPECT_TRUE(choice.nonlinear.empty());
+
   // 700 s left, 600 s a confirmation: the leader fits; the second is tied with it (the screen
   // cannot tell them apart) and is confirmed beyond the budget; the third is not tied and waits.
   const detail::ConfirmationPlan plan = detail::fit_confirmations({600, 600, 600}, {false, true, false}, 700);
