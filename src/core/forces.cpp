@@ -69,6 +69,8 @@ struct Batch {
   // What each contact adds (load_terms): force on i [N], torques on i and on j [N m].
   double force[3][kBatch], torque_i[3][kBatch], torque_j[3][kBatch];
   int wall_count = 0;            // plane-wall contacts: the last entries
+  /// The ghost pass: the loads on j are appended here (Workspace::ghost_loads), not added.
+  std::vector<double>* ghost_loads = nullptr;
 };
 
 /// The contact geometry of the batch's particle pairs (its first `pairs` entries) from the
@@ -154,7 +156,7 @@ DEM_KERNEL void load_terms(Batch& batch, int begin, int end) {
 /// Adds the loads of batch entries [begin, end) (load_terms) to the bodies' totals in entry
 /// order: of the particle pairs to both bodies (kPairs), else of the plane walls to their
 /// spheres; and keeps each contact's force on i. Scalar: a body can appear twice in a batch.
-template <bool kPairs>
+template <bool kPairs, bool kGhostLoads = false>
 [[gnu::always_inline]] inline void add_loads(const Batch& batch, State& s, Workspace& work, int begin, int end) {
   // The columns' addresses held in locals: the byte stored to `active` may alias anything, so
   // read through the vectors they would be loaded again after it, a dozen loads a contact.
@@ -172,7 +174,9 @@ template <bool kPairs>
     const double f_x = force[0][c], f_y = force[1][c], f_z = force[2][c];
     fx[i] += f_x, fy[i] += f_y, fz[i] += f_z;
     tx[i] += torque_i[0][c], ty[i] += torque_i[1][c], tz[i] += torque_i[2][c];
-    if constexpr (kPairs) {
+    if constexpr (kPairs && kGhostLoads) {
+      batch.ghost_loads->insert(batch.ghost_loads->end(), {static_cast<double>(batch.other[c]), f_x, f_y, f_z, torque_j[0][c], torque_j[1][c], torque_j[2][c]});
+    } else if constexpr (kPairs) {
       const std::int64_t j = batch.other[c];
       fx[j] -= f_x, fy[j] -= f_y, fz[j] -= f_z;
       tx[j] += torque_j[0][c], ty[j] += torque_j[1][c], tz[j] += torque_j[2][c];
@@ -193,7 +197,8 @@ void flush(const Model& model, Batch& batch, State& s, Workspace& work) {
   (model.spin_inputs ? pair_geometry : pair_geometry_without_spin)(s, model.n_materials(), batch, pairs);
   evaluate_effects(model, b);
   load_terms(batch, 0, b.count);
-  add_loads<true>(batch, s, work, 0, pairs);
+  if (batch.ghost_loads) add_loads<true, true>(batch, s, work, 0, pairs);
+  else add_loads<true>(batch, s, work, 0, pairs);
   add_loads<false>(batch, s, work, pairs, b.count);
   b.count = 0;
   batch.wall_count = 0;
@@ -551,13 +556,38 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
   work.near_refreshes += !near;
   if (!finish_in_pass) {
-    if (!work.ghost_owners.empty()) {  // pairs with ghosts, in slot order (few: the subdomain's upper face)
-      Batch batch;
-      std::int32_t unused = 0;
-      for (const std::int32_t i : work.ghost_owners)
-        (periodic ? list_contacts<true, true, Scan::kAll> : list_contacts<false, true, Scan::kAll>)(
-            model, s, work, batch, work.pair_begin[i], work.pair_begin[i + 1], owned, static_cast<std::int32_t>(n_all), unused);
-      flush(model, batch, s, work);
+    if (!work.ghost_owners.empty()) {
+      // Pairs with ghosts (the subdomain's faces shared with its upper neighbours), in parallel
+      // over their owned spheres: each thread takes a run of them in slot order and adds to its
+      // own spheres; the loads on the ghosts, which several threads touch, are kept per contact
+      // and added after in pass order, so every sum is the serial one whatever the threads.
+      const long owners = static_cast<long>(work.ghost_owners.size());
+      const int threads = owners >= work.ghost_pass_parallel_min ? omp_get_max_threads() : 1;
+      work.ghost_loads.resize(static_cast<size_t>(threads));
+#pragma omp parallel num_threads(threads)
+      {
+        std::vector<double>& out = work.ghost_loads[static_cast<size_t>(omp_get_thread_num())];
+        out.clear();
+        Batch batch;
+        batch.ghost_loads = &out;
+        std::int32_t unused = 0;
+#pragma omp for schedule(static)  // contiguous runs in thread order
+        for (long e = 0; e < owners; ++e) {
+          const std::int32_t i = work.ghost_owners[static_cast<size_t>(e)];
+          (periodic ? list_contacts<true, true, Scan::kAll> : list_contacts<false, true, Scan::kAll>)(
+              model, s, work, batch, work.pair_begin[i], work.pair_begin[i + 1], owned, static_cast<std::int32_t>(n_all), unused);
+        }
+        flush(model, batch, s, work);
+      }
+      double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+      for (int t = 0; t < threads; ++t) {
+        const std::vector<double>& loads = work.ghost_loads[static_cast<size_t>(t)];
+        for (size_t k = 0; k < loads.size(); k += 7) {
+          const size_t j = static_cast<size_t>(loads[k]);
+          fx[j] -= loads[k + 1], fy[j] -= loads[k + 2], fz[j] -= loads[k + 3];
+          tx[j] += loads[k + 4], ty[j] += loads[k + 5], tz[j] += loads[k + 6];
+        }
+      }
     }
     mesh_contact_forces(model, s, work);
     if (work.domain) work.domain->return_ghost_loads(s);

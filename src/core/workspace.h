@@ -99,6 +99,11 @@ struct Workspace {
   bool block_timed = false;  ///< block_work holds measured seconds
   /// Owned slots with a ghost partner, ascending (domain.h; empty without ghosts).
   std::vector<std::int32_t> ghost_owners;
+  /// Per thread of the ghost pass, the loads on the ghosts of each contact in pass order: slot j,
+  /// force on j [N] (3), torque on j [N m] (3). Added to the ghosts after the pass (forces.cpp).
+  std::vector<std::vector<double>> ghost_loads;
+  /// Owned spheres with ghost partners from which the ghost pass runs on all threads.
+  long ghost_pass_parallel_min = 256;
 
   /// The pairs of the list that can act before the spheres move another margin/2: those whose
   /// gap was under `margin` when the list was last scanned in full (plus every pair with a
