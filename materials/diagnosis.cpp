@@ -351,13 +351,15 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       cr.delta_bic = d.base_bic - cr.bic;
       if (options.on_partial) options.on_partial(d, fmt::format("{} confirmed by recalibration", cr.name));
     }
+    // Why more than the leaders were recalibrated: said after the verdict.
+    std::vector<std::string> why_recalibrated;
     if (!undecided.empty())
-      d.words.push_back(fmt::format("The signature screen cannot tell {} from {} (their signatures explain within {:.0f} % of each other, "
-                                    "at its noise): each was recalibrated.",
-                                    d.candidates.front().name, join(undecided, ", "), 100 * options.screen_margin));
+      why_recalibrated.push_back(fmt::format("The signature screen cannot tell {} from {} (their signatures explain within {:.0f} % of each other, "
+                                             "at its noise): each was recalibrated.",
+                                             d.candidates.front().name, join(undecided, ", "), 100 * options.screen_margin));
     if (!nonlinear.empty())
-      d.words.push_back(fmt::format("The signature of {} changes shape between its two strengths (the linear screen cannot be trusted for "
-                                    "it): recalibrated.", join(nonlinear, ", ")));
+      why_recalibrated.push_back(fmt::format("The signature of {} changes shape between its two strengths (the linear screen cannot be trusted for "
+                                             "it): recalibrated.", join(nonlinear, ", ")));
     std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& a, const CandidateResult& b) {
       if (a.confirmed != b.confirmed) return a.confirmed;
       return a.confirmed ? a.bic < b.bic : a.explained > b.explained;
@@ -407,6 +409,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                     base.chi2_per_n(), options.bic_margin,
                                     best ? fmt::format(" (best: {}, by {:.1f})", best->name, best->delta_bic) : ""));
     }
+    d.words.insert(d.words.end(), why_recalibrated.begin(), why_recalibrated.end());
     if (screen_silent && !d.candidates.empty())
       d.words.push_back("The signatures explained little of the misfit (they are a linear screen from one step to each effect's start "
                         "values); the leading candidates were confirmed by recalibration anyway.");
