@@ -27,12 +27,17 @@ struct HiddenCase {
   MaterialModel truth;
 };
 
+/// The flow tests of gravel that rolls (mu_r = 0.2, friction 0.5, restitution 0.5), measured by `sim`.
+MeasurementSet rolling_gravel(const Simulator& sim) {
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
+  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
+  return synthesise(flow_tests(), truth, sim, 11);
+}
+
 TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   const Analytic sim;
   const MaterialModel start = dry_spheres();
-  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
-  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
+  const MeasurementSet set = rolling_gravel(sim);
   const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
   EXPECT_GT(d.base.after.chi2_per_n(), 5.0);  // the starting model fails visibly
   ASSERT_FALSE(d.candidates.empty());
@@ -162,9 +167,7 @@ TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
 TEST(Diagnose, NoScreenWhenNoCandidateCouldPassTheMargin) {
   const Analytic sim;
   const MaterialModel start = dry_spheres();
-  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");  // rolls: mu_r = 0.2
-  set_parameter(truth, "friction", 0.5), set_parameter(truth, "restitution", 0.5);
-  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 11);
+  const MeasurementSet set = rolling_gravel(sim);
   int simulations = 0;
   CalibrationOptions options = analytic_options(sim);
   const Simulator counting = [&](const MaterialModel& m, const TestSetup& s, const TestOptions& o) { return ++simulations, sim(m, s, o); };
