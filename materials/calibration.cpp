@@ -241,7 +241,7 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 }  // namespace
 
 CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& given, const Comparison* before) {
+                            const CalibrationOptions& given, const Comparison* before, const std::vector<std::vector<double>>& include) {
   const Clock::time_point t0 = Clock::now();
   CalibrationOptions options = given;  // a budget may reduce it
   CalibrationResult result;
@@ -321,8 +321,19 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
   // far inside the box; its optimum from several starts. A point whose simulation fails is
   // skipped; bad input (CaseError) stops the calibration.
+  // The points the first round takes from `include`: inside the box, at most all but one.
+  std::vector<Eigen::VectorXd> included;
+  for (const std::vector<double>& x : include) {
+    if (static_cast<int>(x.size()) != p || static_cast<int>(included.size()) + 1 >= points) continue;
+    bool inside = true;
+    for (int i = 0; i < p; ++i) inside = inside && x[i] >= parameters[i].min && x[i] <= parameters[i].max;
+    if (inside) included.push_back(Eigen::Map<const Eigen::VectorXd>(x.data(), p));
+  }
   const auto design_round = [&](int round) {
-    const Eigen::MatrixXd design = latin_hypercube(box, points, options.seed + 7919u * static_cast<std::uint64_t>(round));
+    const int own = round == 0 ? points - static_cast<int>(included.size()) : points;
+    Eigen::MatrixXd design(points, p);
+    design.topRows(own) = latin_hypercube(box, own, options.seed + 7919u * static_cast<std::uint64_t>(round));
+    for (int k = own; k < points; ++k) design.row(k) = included[k - own].transpose();
     Eigen::MatrixXd values(points, static_cast<Eigen::Index>(names.size()));
     values.setConstant(kNaN);
     std::vector<MaterialModel> models;

@@ -296,9 +296,13 @@ struct CalibrationResult {
 };
 
 /// Fits `parameters` (empty: the model's tunable ranges). `before`: an existing comparison of
-/// `model` (its simulation noise is reused); nullptr: compared first.
+/// `model` (its simulation noise is reused); nullptr: compared first. `include`: points (values
+/// of `parameters`, physical units) the first round's design takes in place of as many of its
+/// own, where they lie inside the box: points already simulated (a diagnosis's signature runs)
+/// then come from the store (options.store) instead of running again.
 CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& options, const Comparison* before = nullptr);
+                            const CalibrationOptions& options, const Comparison* before = nullptr,
+                            const std::vector<std::vector<double>>& include = {});
 
 /// The Fig. 5 map for parameters px, py of a result, for the two observations whose contours
 /// cross most steeply (from different tests when there are).

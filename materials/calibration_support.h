@@ -257,6 +257,23 @@ std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, cons
                                                 const CalibrationOptions& options, int replicas, Progress* progress,
                                                 const std::string& prefix);
 
+/// A candidate's runs at its two signature strengths (diagnose).
+struct SignatureRuns {
+  std::vector<ExperimentRun> start;     ///< at its start values, with `replicas` packings
+  std::vector<ExperimentRun> stronger;  ///< at the stronger step, one packing
+  std::string cannot;                   ///< why the apparatus cannot take it (bad input), or empty
+};
+
+/// Every candidate added to `model` at its two signature strengths, its wall restitution fitted
+/// again first to the drops when options.walls_first (fit_walls_first with `parameters` and the
+/// candidate's own), every experiment simulated: all of them one batch, so that two cores stay
+/// busy to the end. A candidate whose set-up is bad input is left out with the reason; any other
+/// error stops the diagnosis (the first in candidate, strength, experiment and replica order).
+/// A progress step, labelled with the candidate, the strength and the experiment, as each finishes.
+std::vector<SignatureRuns> simulate_signatures(const MaterialModel& model, const std::vector<EffectCandidate>& candidates,
+                                               const std::vector<FitParameter>& parameters, const MeasurementSet& measured,
+                                               const CalibrationOptions& options, int replicas, Progress* progress);
+
 /// One more packing of each experiment (seed after the run's last), added to its run.
 void add_packing(const MaterialModel& model, const std::vector<const Experiment*>& experiments, const std::vector<ExperimentRun*>& runs,
                  const CalibrationOptions& options, Progress* progress);

@@ -197,7 +197,11 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     const double ss = s_perp.squaredNorm(), rr = r.squaredNorm();
     return cancelling(s_perp, s) > 0 ? (s_perp.dot(r) * s_perp.dot(r)) / (ss * rr) : 0.0;
   };
-  for (const EffectCandidate& c : effects) {
+  // Every candidate's runs at both strengths, one batch.
+  const std::vector<detail::SignatureRuns> signature_runs =
+      detail::simulate_signatures(d.base.fitted, effects, parameters, measured, options, replicas, &progress);
+  for (size_t index = 0; index < effects.size(); ++index) {
+    const EffectCandidate& c = effects[index];
     CandidateResult cr;
     cr.name = c.name, cr.title = c.title, cr.description = c.description, cr.why = c.why, cr.switch_on = c.switch_on, cr.kind = c.kind;
     for (const auto& [key, range] : c.parameters) cr.adds.push_back({key, range.first, range.second});
@@ -206,32 +210,9 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     double strength_needed = 0;  // of the added parameter, from the linear screen at either strength
     // A candidate the apparatus cannot take (clumps too large to fill a drum from a lattice) is
     // left out with the reason, not the whole diagnosis.
-    std::string cannot;
+    const std::string& cannot = signature_runs[index].cannot;
     for (int strength = 0; strength < 2 && cannot.empty(); ++strength) {
-      MaterialModel with = d.base.fitted;
-      c.add(with);
-      for (const auto& [key, v] : c.start) {
-        const auto stronger = c.stronger.find(key);
-        set_parameter(with, key, strength == 1 && stronger != c.stronger.end() ? stronger->second : v);
-      }
-      // The wall restitution fitted first to the drops is fitted again with the candidate on (a
-      // cohesion that also damps the rebound would otherwise show a drop misfit the staged
-      // calibration of that model does not have): the signature is that of the staged model.
-      std::vector<ExperimentRun> runs;
-      try {
-        if (options.walls_first) {
-          std::vector<FitParameter> all_fitted = parameters;
-          all_fitted.insert(all_fitted.end(), cr.adds.begin(), cr.adds.end());
-          CalibrationOptions quiet = options;
-          quiet.progress = nullptr;
-          with = detail::fit_walls_first(with, measured, all_fitted, quiet).model;
-        }
-        runs = simulate_experiments(with, measured.experiments, options, strength == 0 ? replicas : 1, &progress,
-                                    fmt::format("{} {} ", c.name, strength == 0 ? "start" : "stronger"));
-      } catch (const CaseError& e) {
-        cannot = e.what();
-        break;
-      }
+      const std::vector<ExperimentRun>& runs = strength == 0 ? signature_runs[index].start : signature_runs[index].stronger;
       const Comparison changed = compare_runs(measured, runs, options, floor);
       Eigen::VectorXd s = Eigen::VectorXd::Zero(nt);
       for (int i = 0; i < nt; ++i)
@@ -343,8 +324,15 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       for (const auto& [key, v] : it->start) set_parameter(with, key, v);
       std::vector<FitParameter> params = parameters;
       params.insert(params.end(), cr.adds.begin(), cr.adds.end());
+      // Its signature runs are two points of its design, taken from the store: the fitted
+      // parameters at the base's values, its own at the start and at the stronger step.
+      std::vector<std::vector<double>> signature_points(2, std::vector<double>(d.base.value.begin(), d.base.value.end()));
+      for (const FitParameter& added : cr.adds) {
+        signature_points[0].push_back(it->start.at(added.key));
+        signature_points[1].push_back(it->stronger.count(added.key) ? it->stronger.at(added.key) : it->start.at(added.key));
+      }
       if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
-      cr.fit = calibrate(with, measured, params, options, &at_start.at(cr.name));
+      cr.fit = calibrate(with, measured, params, options, &at_start.at(cr.name), signature_points);
       cr.confirmed = true;
       cr.chi2 = cr.fit.after.chi2;
       cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);

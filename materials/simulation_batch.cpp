@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <optional>
@@ -70,6 +72,36 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
   }
   return b;
 }
+
+/// Wall seconds the last simulation of each set-up took in this process, so that a batch can
+/// start its longest simulations first. Only the order of a batch depends on it, never an outcome.
+class SetupCosts {
+ public:
+  static SetupCosts& shared() {
+    static SetupCosts costs;
+    return costs;
+  }
+  /// [s]; infinity when no simulation of this set-up has run yet.
+  double of(const TestSetup& setup) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = seconds_.find(key(setup));
+    return it == seconds_.end() ? std::numeric_limits<double>::infinity() : it->second;
+  }
+  void note(const TestSetup& setup, double seconds) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    seconds_[key(setup)] = seconds;
+  }
+
+ private:
+  static std::string key(const TestSetup& setup) {
+    std::string out = setup.test;
+    for (const auto& [k, v] : setup.numbers) out += fmt::format(";{}={}", k, v);
+    for (const auto& [k, v] : setup.words) out += fmt::format(";{}={}", k, v);
+    return out;
+  }
+  mutable std::mutex mutex_;
+  std::map<std::string, double> seconds_;
+};
 
 /// Appends one replica's outcome to a run (values, extraction errors, flags, cost).
 void append_replica(ExperimentRun& run, const SimulatedOutcome& out, std::map<std::string, int>& flags) {
@@ -155,20 +187,29 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
     }
     return out;
   }
-  // Workers take the jobs in order; after a fatal outcome none starts another, so every job
-  // before the first fatal one has its outcome, as in the serial loop.
+  // Workers take the jobs longest first, by what each set-up last cost in this process (a set-up
+  // not yet run counts as longest, and jobs of equal cost keep their batch order): the batch
+  // ends when its last simulation does, and a hopper discharge started last would keep one core
+  // busy alone for a minute. After a fatal outcome only jobs before it in batch order still
+  // start, so every job before the first fatal one has its outcome, as in the serial loop.
+  std::vector<double> cost(jobs.size());
+  for (size_t k = 0; k < jobs.size(); ++k) cost[k] = SetupCosts::shared().of(*jobs[k].setup);
+  std::vector<size_t> order(jobs.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
   std::atomic<size_t> next{0};
-  std::atomic<bool> stop{false};
+  std::atomic<size_t> first_fatal{jobs.size()};
   std::mutex reporting;
   const auto work = [&] {
     omp_set_num_threads(std::max(1, options.threads));  // this thread's own OpenMP setting
-    while (!stop) {
-      const size_t k = next++;
-      if (k >= jobs.size()) break;
+    for (size_t i = next++; i < jobs.size(); i = next++) {
+      const size_t k = order[i];
+      if (k > first_fatal) continue;
       out[k] = simulate(k);
+      if (out[k].error == BatchOutcome::Error::none && !out[k].stored) SetupCosts::shared().note(*jobs[k].setup, out[k].outcome.wall_seconds);
       const std::lock_guard<std::mutex> lock(reporting);
       done(k, out[k]);
-      if (fatal(out[k])) stop = true;
+      if (fatal(out[k])) first_fatal = std::min(first_fatal.load(), k);
     }
   };
   std::vector<std::thread> pool;
@@ -176,6 +217,24 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
   for (std::thread& t : pool) t.join();
   return out;
 }
+
+namespace {
+
+/// The runs of `experiments`, each from `replicas` outcomes in experiment and replica order from `first`.
+std::vector<ExperimentRun> runs_of(const std::vector<Experiment>& experiments, const std::vector<BatchOutcome>& outcomes, size_t first, int replicas) {
+  std::vector<ExperimentRun> runs;
+  for (size_t e = 0; e < experiments.size(); ++e) {
+    ExperimentRun run;
+    run.id = experiments[e].id, run.test = experiments[e].setup.test;
+    std::map<std::string, int> flags;
+    for (int r = 0; r < replicas; ++r) append_replica(run, outcomes[first + e * replicas + r].outcome, flags);
+    summarise(run, flags);
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+}  // namespace
 
 std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& model, const std::vector<Experiment>& experiments,
                                                         const CalibrationOptions& options, int replicas, Progress* progress,
@@ -190,16 +249,87 @@ std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& mod
       progress->step(experiments[e], fmt::format("{}{}, replica {} of {}{}", prefix, experiments[e].id, k % replicas + 1, replicas, b.stored ? ", stored" : ""),
                      b.stored ? 0.0 : b.outcome.wall_seconds);
   });
-  std::vector<ExperimentRun> runs;
-  for (size_t e = 0; e < experiments.size(); ++e) {
-    ExperimentRun run;
-    run.id = experiments[e].id, run.test = experiments[e].setup.test;
-    std::map<std::string, int> flags;
-    for (int r = 0; r < replicas; ++r) append_replica(run, outcomes[e * replicas + r].outcome, flags);
-    summarise(run, flags);
-    runs.push_back(std::move(run));
+  return runs_of(experiments, outcomes, 0, replicas);
+}
+
+std::vector<detail::SignatureRuns> detail::simulate_signatures(const MaterialModel& model, const std::vector<EffectCandidate>& candidates,
+                                                               const std::vector<FitParameter>& parameters, const MeasurementSet& measured,
+                                                               const CalibrationOptions& options, int replicas, Progress* progress) {
+  replicas = std::max(1, replicas);
+  const std::vector<Experiment>& experiments = measured.experiments;
+  std::vector<SignatureRuns> out(candidates.size());
+  // The models: two per candidate (its start values, then the stronger step). The wall
+  // restitution fitted first to the drops is fitted again with the candidate on (a cohesion that
+  // also damps the rebound would otherwise show a drop misfit the staged calibration of that model
+  // does not have): the signature is that of the staged model.
+  std::vector<MaterialModel> models(2 * candidates.size());
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    const EffectCandidate& candidate = candidates[c];
+    for (int strength = 0; strength < 2 && out[c].cannot.empty(); ++strength) {
+      MaterialModel& with = models[2 * c + strength];
+      with = model;
+      candidate.add(with);
+      for (const auto& [key, v] : candidate.start) {
+        const auto stronger = candidate.stronger.find(key);
+        set_parameter(with, key, strength == 1 && stronger != candidate.stronger.end() ? stronger->second : v);
+      }
+      if (!options.walls_first) continue;
+      std::vector<FitParameter> all_fitted = parameters;
+      for (const auto& [key, range] : candidate.parameters) all_fitted.push_back({key, range.first, range.second});
+      CalibrationOptions quiet = options;
+      quiet.progress = nullptr;
+      try {
+        with = fit_walls_first(with, measured, all_fitted, quiet).model;
+      } catch (const CaseError& e) {
+        out[c].cannot = e.what();
+      }
+    }
   }
-  return runs;
+  struct Place {
+    size_t candidate, experiment;
+    int strength, replica, of;
+  };
+  std::vector<Job> jobs;
+  std::vector<Place> places;
+  std::vector<size_t> begin(candidates.size(), jobs.size());
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (!out[c].cannot.empty()) continue;
+    begin[c] = jobs.size();
+    for (int strength = 0; strength < 2; ++strength) {
+      const int of = strength == 0 ? replicas : 1;
+      for (size_t e = 0; e < experiments.size(); ++e)
+        for (int r = 0; r < of; ++r) {
+          jobs.push_back({&models[2 * c + strength], &experiments[e].setup, options.seed + static_cast<std::uint64_t>(r)});
+          places.push_back({c, e, strength, r, of});
+        }
+    }
+  }
+  const std::vector<BatchOutcome> outcomes = run_batch(
+      jobs, options,
+      [&](size_t k, const BatchOutcome& b) {
+        if (b.error != BatchOutcome::Error::none || !progress) return;
+        const Place& at = places[k];
+        const Experiment& e = experiments[at.experiment];
+        progress->step(e, fmt::format("{} {} {}, replica {} of {}{}", candidates[at.candidate].name, at.strength == 0 ? "start" : "stronger", e.id,
+                                      at.replica + 1, at.of, b.stored ? ", stored" : ""),
+                       b.stored ? 0.0 : b.outcome.wall_seconds);
+      },
+      [](const BatchOutcome&) { return false; });
+  // Bad input leaves its candidate out; any other error stops, the first in batch order.
+  for (size_t k = 0; k < outcomes.size(); ++k) {
+    const BatchOutcome& b = outcomes[k];
+    if (b.error == BatchOutcome::Error::input) {
+      if (out[places[k].candidate].cannot.empty()) out[places[k].candidate].cannot = b.message;
+    } else if (b.error != BatchOutcome::Error::none) {
+      rethrow(b);
+    }
+  }
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    if (!out[c].cannot.empty()) continue;
+    out[c].start = runs_of(experiments, outcomes, begin[c], replicas);
+    out[c].stronger = runs_of(experiments, outcomes, begin[c] + experiments.size() * static_cast<size_t>(replicas), 1);
+  }
+  return out;
 }
 
 void detail::add_packing(const MaterialModel& model, const std::vector<const Experiment*>& experiments, const std::vector<ExperimentRun*>& runs,

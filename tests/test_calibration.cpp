@@ -7,10 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <mutex>
 #include <random>
+#include <set>
 
 #include "analytic_lab.h"
 #include "calibration.h"
+#include "calibration_support.h"
 #include "material_model.h"
 #include "measurements.h"
 
@@ -270,6 +273,52 @@ TEST(Calibration, CompareFormsNormalisedResidualsWithSimulationNoise) {
       EXPECT_EQ(p.varied, "rpm");
     }
   EXPECT_TRUE(drum);
+}
+
+// Two workers start a batch's longest simulations first (by what each set-up cost when it last
+// ran), and return every outcome in batch order; after a fatal outcome, only the jobs before it in
+// batch order still run.
+TEST(Calibration, ABatchStartsItsLongestSimulationsFirst) {
+  const MaterialModel model = dry_spheres();
+  std::vector<TestSetup> setups(4);
+  const std::vector<double> seconds = {1, 5, 2, 9};  // what each set-up "costs"
+  for (size_t k = 0; k < setups.size(); ++k) setups[k].test = "batch_order", setups[k].numbers["which"] = static_cast<double>(k);
+  std::mutex m;
+  std::vector<int> started;
+  CalibrationOptions options;
+  options.parallel = 2;
+  options.simulator = [&](const MaterialModel&, const TestSetup& setup, const TestOptions&) {
+    const int which = static_cast<int>(setup.numbers.at("which"));
+    {
+      const std::lock_guard<std::mutex> lock(m);
+      started.push_back(which);
+    }
+    if (setup.numbers.count("fatal")) throw CaseError("bad input");
+    SimulatedOutcome out;
+    out.observables["x"] = which;
+    out.wall_seconds = seconds[which];
+    return out;
+  };
+  std::vector<detail::Job> jobs;
+  for (const TestSetup& s : setups) jobs.push_back({&model, &s, 1});
+  const auto none = [](size_t, const BatchOutcome&) {};
+  const auto fatal = [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; };
+  // The first batch knows no costs: batch order.
+  std::vector<BatchOutcome> out = detail::run_batch(jobs, options, none, fatal);
+  for (size_t k = 0; k < jobs.size(); ++k) EXPECT_EQ(out[k].outcome.observables.at("x"), static_cast<double>(k));
+  // The second starts the 9 s and 5 s set-ups, then 2 s, then 1 s; outcomes stay in batch order.
+  started.clear();
+  out = detail::run_batch(jobs, options, none, fatal);
+  ASSERT_EQ(started.size(), 4u);
+  EXPECT_EQ(std::set<int>(started.begin(), started.begin() + 2), (std::set<int>{3, 1}));
+  EXPECT_EQ(std::set<int>(started.begin() + 2, started.end()), (std::set<int>{2, 0}));
+  for (size_t k = 0; k < jobs.size(); ++k) EXPECT_EQ(out[k].outcome.observables.at("x"), static_cast<double>(k));
+  // Job 1 fails with bad input. It is started second, after the 9 s job; job 0, which comes before
+  // it in batch order, still runs although it is started last.
+  setups[1].numbers["fatal"] = 1;
+  out = detail::run_batch(jobs, options, none, fatal);
+  EXPECT_EQ(out[0].error, BatchOutcome::Error::none);
+  EXPECT_EQ(out[1].error, BatchOutcome::Error::input);
 }
 
 TEST(Calibration, AnObservablesOwnExtractionErrorBoundsItsSimulationNoise) {
