@@ -103,6 +103,11 @@ struct CalibrationOptions {
   /// box inside the parameter's limit: each spans half the last box around the best point
   /// simulated so far, and is confirmed in turn. The better confirmed point is the result.
   int refine_rounds = 1;
+  /// No refinement round when both the simulations at the optimum and the surrogate's prediction
+  /// give chi^2 above this: a diagnosis sets it for a runner-up from the best candidate confirmed
+  /// so far (its BIC plus twice rival_margin), as a runner-up that far behind is no rival either
+  /// way. Infinity: refine as above.
+  double refine_below_chi2 = std::numeric_limits<double>::infinity();
   int starts = 8;               ///< NLopt starts (best design points and the centre)
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise

@@ -509,6 +509,15 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
   EXPECT_TRUE(std::any_of(refined.words.begin(), refined.words.end(), [](const std::string& w) { return w.starts_with("One more surrogate round"); }));
   fmt::print("one round: friction {:.4f}, chi^2/n {:.2f}; refined: friction {:.4f}, chi^2/n {:.2f}\n", once.value[0], once.after.chi2_per_n(),
              refined.value[0], refined.after.chi2_per_n());
+  // A runner-up of a diagnosis whose simulations and surrogate both lie beyond the bar (a leader's
+  // BIC plus twice the rival margin) is not refined; just above both, it is.
+  o.refine_below_chi2 = 0.9 * std::min(once.after.chi2, once.surrogate_chi2);
+  const CalibrationResult behind = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  EXPECT_EQ(behind.after.chi2, once.after.chi2);
+  EXPECT_TRUE(std::any_of(behind.words.begin(), behind.words.end(), [](const std::string& w) { return w.starts_with("Not refined"); }));
+  o.refine_below_chi2 = 1.1 * std::min(once.after.chi2, once.surrogate_chi2);
+  const CalibrationResult within = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  EXPECT_EQ(within.after.chi2, refined.after.chi2);
 }
 
 // The first stage of a calibration: the drops on the steel plate settle the particle-steel
