@@ -210,6 +210,18 @@ class MpiDomain final : public Domain {
     return all;
   }
 
+  void sum(std::vector<double>& values) override {
+    Timed timed{step_seconds_};
+    check(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+  }
+
+  double max(double mine) override {
+    Timed timed{step_seconds_};
+    double most = 0;
+    check(MPI_Allreduce(&mine, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
+    return most;
+  }
+
   bool owns(double x, double y, double z) const override {
     const double at[3] = {x, y, z};
     return owner(at) == rank_;

@@ -72,6 +72,11 @@ class Domain {
   virtual State gather(const State& state) = 0;
   /// Sums per-rank counts (particle steps) over the ranks (collective).
   virtual double sum(double mine) = 0;
+  /// Sums each element over the ranks, in place on every rank (collective): the parts of a row
+  /// of scalars (statistics/diagnostics.h).
+  virtual void sum(std::vector<double>& values) = 0;
+  /// The largest of the ranks' values (collective).
+  virtual double max(double mine) = 0;
   /// What the decomposition cost this rank so far (time in communication, bytes, migrations),
   /// one line for the run's log.
   virtual std::string statistics() const = 0;

@@ -277,23 +277,37 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   if (domain) domain->distribute(state);
   prepare(stepped, state, work);
 
-  // The whole state for results: the state itself, or (domain) the root's gathered copy with
-  // its lists rebuilt and, for the scalars, its contact forces evaluated on a second copy.
+  // The whole state for frames and checkpoints: the state itself, or (domain) the root's
+  // gathered copy with its lists rebuilt (and, for the caller at the end, a copy with this
+  // instant's contact forces).
   std::optional<WholeState> whole;
-  const State* results = &state;   // positions, counters, histories
-  const State* measured = &state;  // the same with this instant's forces
+  const State* results = &state;  // positions, counters, histories
   const Workspace* results_work = &work;
-  bool whole_fresh = false;
   auto gather_whole = [&]() {
     if (!domain) return;
     State gathered = domain->gather(state);
     if (!writer) return;
     whole = ready_for_results(model, std::move(gathered));
-    results = &whole->state, measured = &whole->evaluated, results_work = &whole->work;
-    whole_fresh = true;
+    results = &whole->state, results_work = &whole->work;
+  };
+  // A row of scalars (collective under domain decomposition): each rank measures its own
+  // particles and the contacts it lists, the parts are summed over the ranks and the root
+  // finishes the row; no rank gathers the state for it (diagnostics.h).
+  std::int64_t lost_total = state.lost;  // every rank's, as of the last row
+  const auto measure_row = [&] {
+    if (!domain) return measure(model, state, work);
+    ScalarParts parts = measure_parts(stepped, state, work);
+    domain->sum(parts.sums);
+    parts.max_overlap_ratio = domain->max(parts.max_overlap_ratio);
+    Scalars row = finish_scalars(model, state, parts);
+    lost_total = row.lost;
+    return row;
   };
   gather_whole();
-  if (!options.resume && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
+  if (!options.resume) {
+    Scalars row = measure_row();
+    if (writer) summary.scalars.push_back(std::move(row));
+  }
 
   const std::int64_t first_step = state.step;
   std::int64_t last_step = end_step;
@@ -322,6 +336,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
     }
   }
+  // The rows so far, the events and the ParaView script (at checkpoints, on trouble, at the end).
+  const auto write_tables = [&] {
+    write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
+    write_file_atomically(out + "/events.csv", events_csv(events.fired()));
+    if (frames) write_paraview_script(out);
+  };
   stop_signal = 0;
   auto previous_int = std::signal(SIGINT, on_stop_signal);
   auto previous_term = std::signal(SIGTERM, on_stop_signal);
@@ -335,9 +355,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       // Keep what was computed: the rows so far (the last checkpoint stays as it was).
       if (options.write_files && writer) {
         try {
-          write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
-          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
-    if (frames) write_paraview_script(out);
+          write_tables();
         } catch (const std::exception&) {
         }
       }
@@ -374,13 +392,16 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     const bool scalars_due = state.step % every == 0 || last;
     const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
     const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
-    if (domain && (scalars_due || frame_due || checkpoint_due)) gather_whole();
+    if (domain && (frame_due || checkpoint_due || last || stopping)) gather_whole();
     if (check_due) {
+      // Under domain decomposition every rank's energy, summed before any rank may throw; the
+      // root judges it.
+      const double energy_total = domain && energy.active() ? domain->sum(mechanical_energy(stepped, state)) : 0.0;
       std::optional<NumericalError> found;
       try {
         check_numerics(stepped, state, work, model.max_overlap_ratio);
         if (!domain) energy.check(model, state);
-        else if (writer && whole_fresh) whole_fresh = false, energy.check(model, whole->state);
+        else if (writer) energy.check(model, state, energy_total);
       } catch (const NumericalError& e) {
         found = e;
       }
@@ -391,28 +412,36 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
         for (auto e = events.fired().rbegin(); e != events.fired().rend() && e->step > state.step - check_every; ++e)
           fmt::print(log, "  t = {:.6g} s (step {}): {} (particle {})\n", e->time, e->step, e->what, e->particle);
       last_check = state.time;
-      if (writer && results->lost > lost_reported) {
-        const auto& p = results->last_lost;
+      // Under domain decomposition the count is every rank's as of the last row, and the
+      // particle named is the last the root knows of (its own, or of the last gathered state).
+      const std::int64_t lost_now = domain ? lost_total : state.lost;
+      if (writer && lost_now > lost_reported) {
+        const auto& p = state.lost > 0 || !domain ? state.last_lost : results->last_lost;
+        const bool named = state.lost > 0 || (domain && results->lost > 0);
         // The first loss, then each tenfold: a leak is told, not repeated every step.
-        if (lost_reported == 0 || results->lost >= 10 * lost_reported)
-          fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; "
-                          "the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. Likely "
+        if (lost_reported == 0 || lost_now >= 10 * lost_reported) {
+          fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; {}Likely "
                           "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
                           "large that particles pass through a wall\n",
-                     state.time, results->lost, p.id, p.x, p.y, p.z, p.vx, p.vy, p.vz);
-        if (lost_reported == 0 || results->lost >= 10 * lost_reported) lost_reported = results->lost;
+                     state.time, lost_now,
+                     named ? fmt::format("the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. ", p.id,
+                                         p.x, p.y, p.z, p.vx, p.vy, p.vz)
+                           : "");
+          lost_reported = lost_now;
+        }
       }
     }
-    if (scalars_due && writer) summary.scalars.push_back(measure(model, *measured, *results_work));
+    if (scalars_due) {
+      Scalars row = measure_row();
+      if (writer) summary.scalars.push_back(std::move(row));
+    }
     if (frames && frame_due) {
       write_frame(*frames, *results);
       if (options.on_frame) options.on_frame(model, *results, *results_work, out, last);
     }
     if (checkpoint_due && writer) {
       save_checkpoint(checkpoint_path, model, *results);
-      write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
-          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
-    if (frames) write_paraview_script(out);
+      write_tables();
     }
     if (stopping) {
       if (writer)
@@ -456,9 +485,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
                final_state.outlets[k].removed_mass);
   if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
   if (options.write_files) {
-    write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
-          write_file_atomically(out + "/events.csv", events_csv(events.fired()));
-    if (frames) write_paraview_script(out);
+    write_tables();
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
     write_file_atomically(out + "/run_info.yaml",
                           run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"

@@ -45,71 +45,84 @@ std::uint64_t mix(std::uint64_t h, double v) {
 /// flux estimator of continuum averaging: each particle crossing spends h / (v.n) in the slab).
 /// Box: mass, mass-weighted velocity, centroid offset along `across`. Clumps count once, at
 /// their centre of mass.
-static void measure_sensors(const Model& model, const State& s, std::vector<SensorReading>& out) {
-  out.assign(model.sensors.size(), {});
+namespace {
+
+/// Where each part of the scalars lies in ScalarParts::sums.
+struct PartsLayout {
+  static constexpr size_t kParticles = 0, kKineticTranslation = 1, kKineticRotation = 2, kContacts = 3, kOverlapSum = 4, kLost = 5,
+                          kLostMass = 6, kFixed = 7;
+  static constexpr size_t kPerMesh = 7;    // fx, fy, fz, tx, ty, tz, power
+  static constexpr size_t kPerSensor = 8;  // flow, count_flow, vx, vy, vz (weighted sums), carried weight, mass, moment
+  size_t outlets, meshes, sensors;
+  explicit PartsLayout(const Model& model) : outlets(model.outlets.size()), meshes(model.meshes.size()), sensors(model.sensors.size()) {}
+  size_t outlet(size_t k) const { return kFixed + k; }
+  size_t mesh(size_t m) const { return kFixed + outlets + kPerMesh * m; }
+  size_t sensor(size_t k) const { return kFixed + outlets + kPerMesh * meshes + kPerSensor * k; }
+  size_t size() const { return sensor(sensors); }
+};
+
+/// The sensors' sums over the owned particles and bodies (PartsLayout::kPerSensor each).
+void sum_sensors(const Model& model, const State& s, double* sums) {
   if (model.sensors.empty()) return;
-  std::vector<double> moment(model.sensors.size(), 0.0), carried(model.sensors.size(), 0.0);
   auto add = [&](double x, double y, double z, double vx, double vy, double vz, double m) {
     for (size_t k = 0; k < model.sensors.size(); ++k) {
       const SensorSpec& sensor = model.sensors[k];
       if (x < sensor.region_min.x() || x > sensor.region_max.x() || y < sensor.region_min.y() || y > sensor.region_max.y() ||
           z < sensor.region_min.z() || z > sensor.region_max.z())
         continue;
-      SensorReading& r = out[k];
+      double* r = sums + PartsLayout::kPerSensor * k;
       if (sensor.kind == SensorSpec::Kind::plane) {
         const Vec3& n = sensor.normal;
         const double distance = (x - sensor.point.x()) * n.x() + (y - sensor.point.y()) * n.y() + (z - sensor.point.z()) * n.z();
         if (std::abs(distance) <= 0.5 * sensor.thickness) {
           const double along = vx * n.x() + vy * n.y() + vz * n.z(), weight = m * std::abs(along);
-          r.flow += m * along / sensor.thickness;
-          r.count_flow += along / sensor.thickness;
-          r.vx += weight * vx, r.vy += weight * vy, r.vz += weight * vz;
-          carried[k] += weight;
+          r[0] += m * along / sensor.thickness;
+          r[1] += along / sensor.thickness;
+          r[2] += weight * vx, r[3] += weight * vy, r[4] += weight * vz;
+          r[5] += weight;
         }
       } else {
         const Vec3 centre = 0.5 * (sensor.region_min + sensor.region_max);
-        r.mass += m;
-        r.vx += m * vx, r.vy += m * vy, r.vz += m * vz;
-        moment[k] += m * ((x - centre.x()) * sensor.across.x() + (y - centre.y()) * sensor.across.y() + (z - centre.z()) * sensor.across.z());
+        r[6] += m;
+        r[2] += m * vx, r[3] += m * vy, r[4] += m * vz;
+        r[7] += m * ((x - centre.x()) * sensor.across.x() + (y - centre.y()) * sensor.across.y() + (z - centre.z()) * sensor.across.z());
       }
     }
   };
-  for (size_t p = 0; p < s.size(); ++p)
+  for (size_t p = 0; p < s.owned(); ++p)
     if (s.body[p] < 0) add(s.x[p], s.y[p], s.z[p], s.vx[p], s.vy[p], s.vz[p], 1.0 / s.inv_mass[p]);
   const Bodies& b = s.bodies;
   for (size_t k = 0; k < b.size(); ++k) add(b.x[k], b.y[k], b.z[k], b.vx[k], b.vy[k], b.vz[k], b.mass[k]);
-  for (size_t k = 0; k < out.size(); ++k)
-    if (carried[k] > 0) out[k].vx /= carried[k], out[k].vy /= carried[k], out[k].vz /= carried[k];
-  for (size_t k = 0; k < out.size(); ++k)
-    if (out[k].mass > 0) {
-      out[k].vx /= out[k].mass, out[k].vy /= out[k].mass, out[k].vz /= out[k].mass;
-      out[k].offset = moment[k] / out[k].mass;
-    }
 }
 
-Scalars measure(const Model& model, const State& s, const Workspace& work) {
-  Scalars out;
-  out.time = s.time;
-  out.step = s.step;
-  out.particles = s.size();
-  out.dt = model.dt;
-  out.lost = s.lost;
-  out.lost_mass = s.lost_mass;
-  for (size_t p = 0; p < s.size(); ++p) {
+}  // namespace
+
+ScalarParts measure_parts(const Model& model, const State& s, const Workspace& work) {
+  const PartsLayout at(model);
+  ScalarParts out;
+  out.sums.assign(at.size(), 0.0);
+  double* sums = out.sums.data();
+  sums[at.kParticles] = static_cast<double>(s.owned());
+  sums[at.kLost] = static_cast<double>(s.lost);
+  sums[at.kLostMass] = s.lost_mass;
+  double translation = 0, rotation = 0;
+  for (size_t p = 0; p < s.owned(); ++p) {
     if (s.body[p] >= 0) continue;  // counted with its body
     const double m = 1.0 / s.inv_mass[p], inertia = 1.0 / s.inv_inertia[p];
-    out.kinetic_translation += 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
-    out.kinetic_rotation += 0.5 * inertia * (s.wx[p] * s.wx[p] + s.wy[p] * s.wy[p] + s.wz[p] * s.wz[p]);
+    translation += 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
+    rotation += 0.5 * inertia * (s.wx[p] * s.wx[p] + s.wy[p] * s.wy[p] + s.wz[p] * s.wz[p]);
   }
   const Bodies& b = s.bodies;
   for (size_t k = 0; k < b.size(); ++k) {
-    out.kinetic_translation += 0.5 * b.mass[k] * (b.vx[k] * b.vx[k] + b.vy[k] * b.vy[k] + b.vz[k] * b.vz[k]);
-    out.kinetic_rotation += body_rotational_energy(s, k);
+    translation += 0.5 * b.mass[k] * (b.vx[k] * b.vx[k] + b.vy[k] * b.vy[k] + b.vz[k] * b.vz[k]);
+    rotation += body_rotational_energy(s, k);
   }
+  sums[at.kKineticTranslation] = translation, sums[at.kKineticRotation] = rotation;
+  std::size_t contacts = 0;
   double sum = 0;
   auto count = [&](double overlap, double radius) {
     if (overlap <= 0) return;
-    ++out.contacts;
+    ++contacts;
     sum += overlap / radius;
     out.max_overlap_ratio = std::max(out.max_overlap_ratio, overlap / radius);
   };
@@ -118,30 +131,74 @@ Scalars measure(const Model& model, const State& s, const Workspace& work) {
   for (size_t k = 0; k < s.wall_pairs.size(); ++k)
     count(wall_overlap(model, s, s.wall_pairs.i[k], s.wall_pairs.j[k]), s.radius[s.wall_pairs.i[k]]);
   if (s.has_meshes)  // mesh contacts of the last evaluation: overlap = r - distance to the contact point
-    for (size_t p = 0; p < s.size(); ++p)
+    for (size_t p = 0; p < s.owned(); ++p)
       for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
-        const size_t at = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);  // results by candidate
-        const double dx = s.x[p] - work.mesh_slots.cx[at], dy = s.y[p] - work.mesh_slots.cy[at], dz = s.z[p] - work.mesh_slots.cz[at];
+        const size_t c = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);  // results by candidate
+        const double dx = s.x[p] - work.mesh_slots.cx[c], dy = s.y[p] - work.mesh_slots.cy[c], dz = s.z[p] - work.mesh_slots.cz[c];
         count(s.radius[p] - std::sqrt(dx * dx + dy * dy + dz * dz), s.radius[p]);
       }
-  out.mean_overlap_ratio = out.contacts ? sum / static_cast<double>(out.contacts) : 0.0;
+  sums[at.kContacts] = static_cast<double>(contacts), sums[at.kOverlapSum] = sum;
+  for (size_t k = 0; k < s.outlets.size() && k < at.outlets; ++k) sums[at.outlet(k)] = s.outlets[k].removed_mass;
+  const MeshLoads& loads = s.mesh_loads;
+  for (size_t m = 0; m < at.meshes && m < loads.fx.size(); ++m) {
+    double* l = sums + at.mesh(m);
+    l[0] = loads.fx[m], l[1] = loads.fy[m], l[2] = loads.fz[m], l[3] = loads.tx[m], l[4] = loads.ty[m], l[5] = loads.tz[m], l[6] = loads.power[m];
+  }
+  sum_sensors(model, s, sums + at.sensor(0));
+  return out;
+}
+
+void add_parts(ScalarParts& total, const ScalarParts& more) {
+  if (total.sums.size() < more.sums.size()) total.sums.resize(more.sums.size(), 0.0);
+  for (size_t k = 0; k < more.sums.size(); ++k) total.sums[k] += more.sums[k];
+  total.max_overlap_ratio = std::max(total.max_overlap_ratio, more.max_overlap_ratio);
+}
+
+Scalars finish_scalars(const Model& model, const State& s, const ScalarParts& parts) {
+  const PartsLayout at(model);
+  if (parts.sums.size() != at.size()) throw std::logic_error("finish_scalars: the parts do not belong to this model");
+  const double* sums = parts.sums.data();
+  Scalars out;
+  out.time = s.time;
+  out.step = s.step;
+  out.dt = model.dt;
+  out.particles = static_cast<std::size_t>(std::llround(sums[at.kParticles]));
+  out.lost = std::llround(sums[at.kLost]);
+  out.lost_mass = sums[at.kLostMass];
+  out.kinetic_translation = sums[at.kKineticTranslation];
+  out.kinetic_rotation = sums[at.kKineticRotation];
+  out.contacts = static_cast<std::size_t>(std::llround(sums[at.kContacts]));
+  out.max_overlap_ratio = parts.max_overlap_ratio;
+  out.mean_overlap_ratio = out.contacts ? sums[at.kOverlapSum] / static_cast<double>(out.contacts) : 0.0;
   for (const InletState& in : s.inlets) out.inserted_mass += in.inserted_mass;
-  for (const OutletState& o : s.outlets) out.removed_mass += o.removed_mass, out.outlet_mass.push_back(o.removed_mass);
+  for (size_t k = 0; k < at.outlets; ++k) out.removed_mass += sums[at.outlet(k)], out.outlet_mass.push_back(sums[at.outlet(k)]);
   for (size_t w = 0; w < model.planes.size(); ++w) {
     const auto& n = model.planes[w].normal;
     out.wall_normal_force.push_back(-(s.walls.fx[w] * n[0] + s.walls.fy[w] * n[1] + s.walls.fz[w] * n[2]));
   }
-  measure_sensors(model, s, out.sensors);
-  const MeshLoads& loads = s.mesh_loads;
-  for (size_t m = 0; m < model.meshes.size() && m < loads.fx.size(); ++m) {
-    out.mesh_force.push_back(std::sqrt(loads.fx[m] * loads.fx[m] + loads.fy[m] * loads.fy[m] + loads.fz[m] * loads.fz[m]));
-    const Eigen::Vector3d w = model.meshes[m].motion.velocity(s.time).angular, torque(loads.tx[m], loads.ty[m], loads.tz[m]);
+  out.sensors.assign(at.sensors, {});
+  for (size_t k = 0; k < at.sensors; ++k) {
+    const double* r = sums + at.sensor(k);
+    SensorReading& reading = out.sensors[k];
+    reading.flow = r[0], reading.count_flow = r[1], reading.vx = r[2], reading.vy = r[3], reading.vz = r[4], reading.mass = r[6];
+    const double weight = model.sensors[k].kind == SensorSpec::Kind::plane ? r[5] : r[6];
+    if (weight > 0) {
+      reading.vx /= weight, reading.vy /= weight, reading.vz /= weight;
+      if (model.sensors[k].kind != SensorSpec::Kind::plane) reading.offset = r[7] / weight;
+    }
+  }
+  for (size_t m = 0; m < at.meshes && s.mesh_loads.fx.size() > m; ++m) {
+    const double* l = sums + at.mesh(m);
+    out.mesh_force.push_back(std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]));
+    const Eigen::Vector3d w = model.meshes[m].motion.velocity(s.time).angular, torque(l[3], l[4], l[5]);
     out.mesh_torque.push_back(w.norm() > 0 ? torque.dot(w.normalized()) : torque.norm());
-    out.mesh_power.push_back(loads.power[m]);
-    out.mesh_load.push_back({loads.fx[m], loads.fy[m], loads.fz[m], loads.tx[m], loads.ty[m], loads.tz[m]});
+    out.mesh_power.push_back(l[6]);
+    out.mesh_load.push_back({l[0], l[1], l[2], l[3], l[4], l[5]});
   }
   return out;
 }
+
+Scalars measure(const Model& model, const State& s, const Workspace& work) { return finish_scalars(model, s, measure_parts(model, s, work)); }
 
 std::uint64_t state_hash(const State& s, int width) {
   std::vector<size_t> by_id(s.size());
@@ -203,7 +260,7 @@ void check_numerics(const Model& model, const State& s, const Workspace& work, d
 double mechanical_energy(const Model& model, const State& s) {
   const double g[3] = {model.gravity[0], model.gravity[1], model.gravity[2]};
   double energy = 0;
-  for (size_t p = 0; p < s.size(); ++p) {
+  for (size_t p = 0; p < s.owned(); ++p) {
     if (s.body[p] >= 0 || (!s.attached.empty() && s.attached[p] >= 0)) continue;
     const double m = 1.0 / s.inv_mass[p], inertia = 1.0 / s.inv_inertia[p];
     energy += 0.5 * m * (s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]);
@@ -259,15 +316,18 @@ EnergyWatch::EnergyWatch(const Model& model, const State& state, double fraction
 }
 
 void EnergyWatch::check(const Model& model, const State& s) {
+  if (active()) check(model, s, mechanical_energy(model, s));
+}
+
+void EnergyWatch::check(const Model& model, const State& s, double energy) {
   if (!active()) return;
-  const double energy = mechanical_energy(model, s);
   if (!std::isfinite(energy)) return;  // check_numerics names the particle
   // Against the energy at the start, not the lowest so far: a contact stores elastic energy
   // (not counted here) and gives it back on rebound.
   if (energy - lowest_ > fraction_ * scale_) {
     size_t fastest = 0;
     double v2 = -1;
-    for (size_t p = 0; p < s.size(); ++p) {
+    for (size_t p = 0; p < s.owned(); ++p) {
       const double w = s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p];
       if (w > v2) v2 = w, fastest = p;
     }

@@ -55,6 +55,22 @@ struct Scalars {
 
 Scalars measure(const Model& model, const State& state, const Workspace& work);
 
+/// The additive parts of the scalars: sums over the particles a process owns, the contacts it
+/// lists and its outlets and mesh loads, and the largest overlap. Under domain decomposition
+/// (domain.h) each rank measures its parts (a pair across ranks is listed on one rank), the parts
+/// of all ranks are summed, and the root finishes the row: no rank gathers the state for it.
+struct ScalarParts {
+  std::vector<double> sums;
+  double max_overlap_ratio = 0;
+};
+ScalarParts measure_parts(const Model& model, const State& state, const Workspace& work);
+/// Adds `more` to `total` (sums added, the larger overlap kept).
+void add_parts(ScalarParts& total, const ScalarParts& more);
+/// The row of the whole from the parts of every process: time, step, the inlets' counters and
+/// the plane walls' loads come from `state` (the same on every rank), the rest from the parts.
+/// measure() is finish_scalars(measure_parts()).
+Scalars finish_scalars(const Model& model, const State& state, const ScalarParts& parts);
+
 /// FNV-1a over position, velocity and angular velocity of every particle in id order, and the
 /// history of every contact in id order: equal hashes mean bitwise equal states.
 std::uint64_t state_hash(const State& state, int history_width);
@@ -70,7 +86,8 @@ class NumericalError : public std::runtime_error {
 void check_numerics(const Model& model, const State& state, const Workspace& work, double max_overlap_ratio = 0.5);
 
 /// Kinetic (translation and rotation) plus gravitational potential energy of the free
-/// particles and clumps [J] (glued particles move with their wall and are left out).
+/// particles and clumps [J] (glued particles move with their wall and are left out; under domain
+/// decomposition, the rank's own: ghosts are left out).
 double mechanical_energy(const Model& model, const State& state);
 
 /// Why the energy check cannot be used for this model ("" when it can): the model has an energy
@@ -87,6 +104,9 @@ class EnergyWatch {
   /// Throws NumericalError when the energy exceeds its value at the start by more than the
   /// margin, naming the fastest particle, where it is, and the likely cause.
   void check(const Model& model, const State& state);
+  /// The same with the energy given (under domain decomposition: the sum of every rank's
+  /// mechanical_energy); `state` names the fastest of its particles.
+  void check(const Model& model, const State& state, double energy);
   bool active() const { return source_.empty(); }
   const std::string& source() const { return source_; }
 
