@@ -103,7 +103,8 @@ std::array<int, 3> choose_grid(int ranks, const double extent[3], const bool per
 
 class MpiDomain final : public Domain {
  public:
-  MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested) : local_(model) {
+  MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested, bool neighbour_migration)
+      : local_(model), neighbour_migration_(neighbour_migration) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (model.has_attached)
@@ -179,7 +180,10 @@ class MpiDomain final : public Domain {
       if (!exists) continue;
       n.rank = rank_of(at);
       (o.upper() ? from_ : to_).push_back(n);
+      if (n.rank != rank_) near_.push_back(n.rank);
     }
+    std::sort(near_.begin(), near_.end());
+    near_.erase(std::unique(near_.begin(), near_.end()), near_.end());
     // First cuts from the initial particles (the same on every rank), or evenly over the box.
     for (int a = 0; a < 3; ++a) {
       std::vector<double> coords;
@@ -246,7 +250,7 @@ class MpiDomain final : public Domain {
     pairs.append(pending_pairs_), walls.append(pending_walls_);
     pending_pairs_ = {}, pending_walls_ = {};
     wrap_periodic_axes(s);
-    rebalance(s, pairs, walls);
+    const bool cuts_moved = rebalance(s, pairs, walls);
     const int width = model.history_width;
     const size_t n = s.size(), record = s.record_size();
     // Where each body goes (-1: stays), then free spheres and bodies with their spheres.
@@ -298,30 +302,83 @@ class MpiDomain final : public Domain {
       add_rows(pairs, false, pair_rows, pair_rows_to);
       add_rows(walls, true, wall_rows, wall_rows_to);
     }
-    // Counts, then the doubles, all to all. Per destination: free spheres, clumps (body, count,
-    // spheres), pair histories, wall histories.
+    // Per destination: free spheres, clumps (body, count, spheres), pair histories, wall
+    // histories, in one message with its counts. A particle that left its box since the last
+    // rebuild is in a neighbour's, so the messages go to the neighbours alone; all to all
+    // (counts, then the doubles) after the cuts moved, or when some rank has a particle bound
+    // beyond its neighbours. Either way the parts arrive in rank order: the same state.
     constexpr int kCounts = 5;
-    std::vector<int> counts_out(kCounts * size_), counts_in(kCounts * size_);
-    std::vector<double> send;
-    std::vector<int> send_sizes(size_), receive_sizes(size_);
-    for (int r = 0; r < size_; ++r) {
-      const size_t before = send.size();
-      for (const auto* part : {&spheres[r], &clumps[r], &pair_rows[r], &wall_rows[r]}) send.insert(send.end(), part->begin(), part->end());
-      send_sizes[r] = static_cast<int>(send.size() - before);
-      const int mine[kCounts] = {spheres_to[r], bodies_to[r], pair_rows_to[r], wall_rows_to[r], send_sizes[r]};
-      std::copy(mine, mine + kCounts, counts_out.begin() + kCounts * r);
+    const auto message_to = [&](int r) {
+      std::vector<double> m;
+      for (const auto* part : {&spheres[r], &clumps[r], &pair_rows[r], &wall_rows[r]}) m.insert(m.end(), part->begin(), part->end());
+      return m;
+    };
+    const auto counts_to = [&](int r, size_t doubles) {
+      return std::array<int, kCounts>{spheres_to[r], bodies_to[r], pair_rows_to[r], wall_rows_to[r], static_cast<int>(doubles)};
+    };
+    int far = 0;
+    for (const auto& [id, to] : leaving) far = far || !std::binary_search(near_.begin(), near_.end(), to);
+    int anywhere = far;
+    check(MPI_Allreduce(&far, &anywhere, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD), "MPI_Allreduce");
+    std::vector<std::vector<double>> arrived;  // per source, in rank order
+    std::vector<std::array<int, kCounts>> in_counts;
+    size_t sent = 0;
+    if (!neighbour_migration_ || cuts_moved || anywhere) {
+      std::vector<int> counts_out(kCounts * size_), counts_in(kCounts * size_);
+      std::vector<double> send;
+      std::vector<int> send_sizes(size_), receive_sizes(size_);
+      for (int r = 0; r < size_; ++r) {
+        const std::vector<double> m = message_to(r);
+        send.insert(send.end(), m.begin(), m.end());
+        send_sizes[r] = static_cast<int>(m.size());
+        const std::array<int, kCounts> c = counts_to(r, m.size());
+        std::copy(c.begin(), c.end(), counts_out.begin() + kCounts * r);
+      }
+      check(MPI_Alltoall(counts_out.data(), kCounts, MPI_INT, counts_in.data(), kCounts, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
+      for (int r = 0; r < size_; ++r) receive_sizes[r] = counts_in[kCounts * r + 4];
+      const std::vector<int> send_at = offsets_of(send_sizes), receive_at = offsets_of(receive_sizes);
+      std::vector<double> received(static_cast<size_t>(receive_at.back()));
+      check(MPI_Alltoallv(send.data(), send_sizes.data(), send_at.data(), MPI_DOUBLE, received.data(), receive_sizes.data(),
+                          receive_at.data(), MPI_DOUBLE, MPI_COMM_WORLD),
+            "MPI_Alltoallv");
+      for (int r = 0; r < size_; ++r) {
+        arrived.emplace_back(received.begin() + receive_at[r], received.begin() + receive_at[r + 1]);
+        in_counts.emplace_back();
+        std::copy(counts_in.begin() + kCounts * r, counts_in.begin() + kCounts * (r + 1), in_counts.back().begin());
+      }
+      sent = send.size();
+      ++migrations_all_;
+    } else {
+      const size_t m = near_.size();
+      std::vector<std::vector<double>> out(m);
+      std::vector<std::array<int, kCounts>> out_counts(m);
+      arrived.resize(m), in_counts.resize(m);
+      for (size_t k = 0; k < m; ++k) out[k] = message_to(near_[k]), out_counts[k] = counts_to(near_[k], out[k].size()), sent += out[k].size();
+      requests_.clear();
+      for (size_t k = 0; k < m; ++k) {
+        requests_.emplace_back();
+        check(MPI_Irecv(in_counts[k].data(), kCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
+        requests_.emplace_back();
+        check(MPI_Isend(out_counts[k].data(), kCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Isend");
+      }
+      check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+      requests_.clear();
+      for (size_t k = 0; k < m; ++k) {
+        arrived[k].resize(static_cast<size_t>(in_counts[k][4]));
+        requests_.emplace_back();
+        check(MPI_Irecv(arrived[k].data(), in_counts[k][4], MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
+        requests_.emplace_back();
+        check(MPI_Isend(out[k].data(), static_cast<int>(out[k].size()), MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD,
+                        &requests_.back()),
+              "MPI_Isend");
+      }
+      check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+      ++migrations_near_;
     }
-    check(MPI_Alltoall(counts_out.data(), kCounts, MPI_INT, counts_in.data(), kCounts, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
-    for (int r = 0; r < size_; ++r) receive_sizes[r] = counts_in[kCounts * r + 4];
-    const std::vector<int> send_at = offsets_of(send_sizes), receive_at = offsets_of(receive_sizes);
-    std::vector<double> received(static_cast<size_t>(receive_at.back()));
-    check(MPI_Alltoallv(send.data(), send_sizes.data(), send_at.data(), MPI_DOUBLE, received.data(), receive_sizes.data(),
-                        receive_at.data(), MPI_DOUBLE, MPI_COMM_WORLD),
-          "MPI_Alltoallv");
     s.compact(keep);  // also drops the bodies that left with all their spheres
-    for (int r = 0; r < size_; ++r) {
-      const double* in = received.data() + receive_at[r];
-      const int* count = counts_in.data() + kCounts * r;
+    for (size_t source = 0; source < arrived.size(); ++source) {
+      const double* in = arrived[source].data();
+      const int* count = in_counts[source].data();
       for (int k = 0; k < count[0]; ++k, in += record) s.unpack(in);
       for (int k = 0; k < count[1]; ++k) {
         const std::int32_t b = static_cast<std::int32_t>(s.unpack_body(in));
@@ -336,7 +393,7 @@ class MpiDomain final : public Domain {
       walls.unpack(in, static_cast<size_t>(count[3]), width);
     }
     migrated_ += static_cast<std::int64_t>(leaving.size());
-    bytes_ += 8.0 * static_cast<double>(send.size());
+    bytes_ += 8.0 * static_cast<double>(sent);
   }
 
   void make_ghosts(const Model&, State& s) override {
@@ -539,10 +596,11 @@ class MpiDomain final : public Domain {
 
   std::string statistics() const override {
     const double steps = static_cast<double>(std::max<std::int64_t>(rebuilds_ + refreshes_, 1));
-    return fmt::format("{} steps ({} with a rebuild), mean {:.0f} ghosts from {} neighbours, {} particles migrated, {} rebalances; communication "
+    return fmt::format("{} steps ({} with a rebuild), mean {:.0f} ghosts from {} neighbours, {} particles migrated ({} times to the neighbours, {} "
+                       "all to all), {} rebalances; communication "
                        "{:.3g} s in steps ({:.3g} ms a step), {:.3g} s at rebuilds, {:.3g} s gathering results; {:.3g} kB sent a step",
                        rebuilds_ + refreshes_, rebuilds_, static_cast<double>(ghosts_) / std::max<std::int64_t>(rebuilds_, 1), from_.size(),
-                       migrated_, rebalances_, step_seconds_, 1e3 * step_seconds_ / steps, rebuild_seconds_, gather_seconds_, 1e-3 * bytes_ / steps);
+                       migrated_, migrations_near_, migrations_all_, rebalances_, step_seconds_, 1e3 * step_seconds_ / steps, rebuild_seconds_, gather_seconds_, 1e-3 * bytes_ / steps);
   }
 
   std::string describe() const {
@@ -560,6 +618,9 @@ class MpiDomain final : public Domain {
   /// A box next to this one: its rank, where it lies, the shift [m] of what is sent to it, and
   /// what is sent (to a lower neighbour: owned slots, in message order) or received (from an
   /// upper one: the ghost count, the ghosts in the order of from_).
+  /// Message kinds of a migration between neighbours (tags 32 x kind; 1-4 are the ghosts').
+  static constexpr int kMigrationCounts = 5, kMigrationData = 6;
+
   struct Neighbour {
     Offset offset;
     int rank = MPI_PROC_NULL;
@@ -614,7 +675,9 @@ class MpiDomain final : public Domain {
   /// (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
   /// history: in a dense bed the contacts, not the particles, cost the time); each cut axis gets
   /// its cuts at the quantiles of the work along it.
-  void rebalance(const State& s, const HistoryRows& pairs, const HistoryRows& walls) {
+  /// Moves the cuts to the quantiles of the work when the busiest rank carries more than
+  /// kImbalance times the mean; returns whether it did (the same on every rank).
+  bool rebalance(const State& s, const HistoryRows& pairs, const HistoryRows& walls) {
     const size_t n = s.size();
     std::unordered_map<std::int64_t, double> contacts;
     for (size_t q = 0; q < pairs.size(); ++q) contacts[pairs.a[q]] += 1, contacts[pairs.b[q]] += 1;
@@ -635,7 +698,7 @@ class MpiDomain final : public Domain {
     double most[7];
     check(MPI_Allreduce(stats, most, 7, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
     const double total = sum(mine);
-    if (total < size_ || most[0] <= kImbalance * total / size_) return;
+    if (total < size_ || most[0] <= kImbalance * total / size_) return false;
     for (int a = 0; a < 3; ++a) {
       if (dims_[a] == 1) continue;
       const double lo = periodic_[a] ? low_[a] : -most[1 + 2 * a], hi = periodic_[a] ? low_[a] + period_[a] : most[2 + 2 * a];
@@ -656,6 +719,7 @@ class MpiDomain final : public Domain {
       keep_boxes_wide(a);
     }
     ++rebalances_;
+    return true;
   }
 
   /// One message to each lower neighbour (`out`, by to_) and one from each upper one (`in`, sized
@@ -738,18 +802,21 @@ class MpiDomain final : public Domain {
   std::vector<std::vector<double>> out_, in_;
   std::vector<MPI_Request> requests_;
   std::int64_t migrated_ = 0, rebalances_ = 0, rebuilds_ = 0, refreshes_ = 0, ghosts_ = 0;
+  std::int64_t migrations_near_ = 0, migrations_all_ = 0;  // rebuilds whose migration went to the neighbours, all to all
+  bool neighbour_migration_ = true;
+  std::vector<int> near_;  // the neighbours' ranks (each once, not this one), ascending
   double step_seconds_ = 0, rebuild_seconds_ = 0, gather_seconds_ = 0;  // [s] in MPI and packing
   double bytes_ = 0;  // [B] sent by this rank
 };
 
 }  // namespace
 
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid) {
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid, bool neighbour_migration) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size < 2) return nullptr;
   try {
-    auto domain = std::make_unique<MpiDomain>(model, initial, grid);
+    auto domain = std::make_unique<MpiDomain>(model, initial, grid, neighbour_migration);
     if (note) *note = domain->describe();
     return domain;
   } catch (const CaseError& e) {
@@ -760,7 +827,7 @@ std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, st
 
 #else
 
-std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*, const std::array<int, 3>&) { return nullptr; }
+std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*, const std::array<int, 3>&, bool) { return nullptr; }
 
 #endif
 

@@ -38,6 +38,8 @@ namespace dem::app::mpi {
 /// rank, and when the case cannot be split (glued spheres, a domain too small for the ranks' boxes):
 /// then `note` says why, and the case runs on rank 0 alone. `grid` (nx, ny, nz; zeros: chosen)
 /// asks for a rank grid, whose boxes must have the ranks' count and one reach's width.
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid = {0, 0, 0});
+/// `neighbour_migration` false sends every migration all to all (for tests: the state is the same).
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid = {0, 0, 0},
+                                    bool neighbour_migration = true);
 
 }  // namespace dem::app::mpi
