@@ -176,20 +176,29 @@ TEST(DomainMpi, PeriodicGasConservesParticlesAndMomentumExactly) {
   EXPECT_NEAR(kb, ka, 0.05 * ka);
 }
 
+/// The periodic gas in a flatter box (0.06 x 0.06 x 0.03 m), for grids cut along two axes.
+CaseSpec periodic_gas_grid() {
+  std::string text = kPeriodicGas;
+  const auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
+  replace("max: [0.12, 0.03, 0.03]}\nmaterials", "max: [0.06, 0.06, 0.03]}\nmaterials");
+  for (int k = 0; k < 2; ++k) replace("max: [0.12, 0.03, 0.03]}, velocity", "max: [0.06, 0.06, 0.03]}, velocity");
+  return parse_case_text(text, "periodic_gas_grid.yaml");
+}
+/// 2 x 2 x 1 on four ranks, 1 x N x 1 otherwise.
+std::array<int, 3> gas_grid() {
+  const int ranks = mpi::world().size;
+  return ranks == 4 ? std::array<int, 3>{2, 2, 1} : std::array<int, 3>{1, ranks, 1};
+}
+
 // The same gas in a flatter box on a grid cut along two axes (2 x 2 x 1 on four ranks, 1 x 2 x 1
 // on two): each rank takes ghosts from the neighbours across faces, edges and corners, and on a
 // periodic axis of two boxes its neighbours below and above are the same rank, one period apart.
 // Particles and momentum must be kept exactly all the same.
 TEST(DomainMpi, PeriodicGasOnAGridOfBoxesConservesExactly) {
-  std::string text = kPeriodicGas;
-  const auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
-  replace("max: [0.12, 0.03, 0.03]}\nmaterials", "max: [0.06, 0.06, 0.03]}\nmaterials");
-  for (int k = 0; k < 2; ++k) replace("max: [0.12, 0.03, 0.03]}, velocity", "max: [0.06, 0.06, 0.03]}, velocity");
-  const CaseSpec spec = parse_case_text(text, "periodic_gas_grid.yaml");
+  const CaseSpec spec = periodic_gas_grid();
   const Model model = compile(spec);
   const std::array<double, 4> before = momentum(initial_state(model));
-  const int ranks = mpi::world().size;
-  const std::array<int, 3> grid = ranks == 4 ? std::array<int, 3>{2, 2, 1} : std::array<int, 3>{1, ranks, 1};
+  const std::array<int, 3> grid = gas_grid();
   const Runs runs = whole_and_split(spec, 0.05, grid);
   if (!root()) return;
   const Outcome &whole = runs.whole, &split = runs.split;
@@ -212,13 +221,8 @@ TEST(DomainMpi, PeriodicGasOnAGridOfBoxesConservesExactly) {
 // rebalance), and arrive in the same order: the state is bitwise the one all-to-all migration
 // gives. The gas on the grid of boxes moves particles across faces, edges and corners.
 TEST(DomainMpi, MigrationToTheNeighboursGivesTheStateOfAllToAll) {
-  std::string text = kPeriodicGas;
-  const auto replace = [&](const std::string& from, const std::string& to) { text.replace(text.find(from), from.size(), to); };
-  replace("max: [0.12, 0.03, 0.03]}\nmaterials", "max: [0.06, 0.06, 0.03]}\nmaterials");
-  for (int k = 0; k < 2; ++k) replace("max: [0.12, 0.03, 0.03]}, velocity", "max: [0.06, 0.06, 0.03]}, velocity");
-  const CaseSpec spec = parse_case_text(text, "periodic_gas_grid.yaml");
-  const int ranks = mpi::world().size;
-  const std::array<int, 3> grid = ranks == 4 ? std::array<int, 3>{2, 2, 1} : std::array<int, 3>{1, ranks, 1};
+  const CaseSpec spec = periodic_gas_grid();
+  const std::array<int, 3> grid = gas_grid();
   const Outcome near = simulate(spec, true, 0.02, grid, -1, true), all = simulate(spec, true, 0.02, grid, -1, false);
   // Every rank's own count of migrations to the neighbours.
   const auto times = [](const std::string& statistics, const std::string& how) {
