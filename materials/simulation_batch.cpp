@@ -173,13 +173,7 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
   std::vector<BatchOutcome> out(jobs.size());
   const size_t workers = std::min(jobs.size(), static_cast<size_t>(std::max(1, options.parallel)));
   if (workers <= 1) {
-    // `threads` holds here too (0: OpenMP's default, every core), and is given back afterwards.
-    const int before = omp_get_max_threads();
-    if (options.threads > 0) omp_set_num_threads(options.threads);
-    struct Restore {
-      int threads;
-      ~Restore() { omp_set_num_threads(threads); }
-    } restore{before};
+    // Each simulation runs with `threads` OpenMP threads (run_virtual_test sets and restores them).
     for (size_t k = 0; k < jobs.size(); ++k) {
       out[k] = simulate(k);
       done(k, out[k]);

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include <omp.h>
+
 #include <algorithm>
 
 #include "lab_direct_shear.h"
@@ -57,6 +59,14 @@ SimulatedOutcome run_virtual_test(const MaterialModel& model, const TestSetup& s
   if (!e) throw CaseError(fmt::format("{}: test: unknown test '{}'; valid: {}", setup.location.str(), setup.test, fmt::join(test_names(), ", ")));
   if (!(options.size_factor > 0 && options.size_factor <= 1))
     throw CaseError(fmt::format("{}: size_factor {:g} is out of range; valid: above 0, at most 1", setup.location.str(), options.size_factor));
+  // `threads` is this thread's OpenMP setting for the test's duration, given back afterwards:
+  // the engine's parallel regions read it (omp_get_max_threads), not the compiled model.
+  const int before = omp_get_max_threads();
+  if (options.threads > 0) omp_set_num_threads(options.threads);
+  struct Restore {
+    int threads;
+    ~Restore() { omp_set_num_threads(threads); }
+  } restore{before};
   return e->run(model, setup, options);
 }
 
