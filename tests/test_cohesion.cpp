@@ -86,6 +86,24 @@ TEST(Jkr, NoAttractionBeforeFirstContact) {
   EXPECT_LT(c.force_at(model, 1e-9), 0.0) << "just touching, the neck pulls";
 }
 
+TEST(Jkr, ForceFollowsTheContactRadiusWhateverThePath) {
+  // On the stable branch each contact radius a gives the overlap delta = a^2/R* - sqrt(2 pi W a / E*)
+  // and the force F = 4 E* a^3 / (3 R*) - sqrt(8 pi W E* a^3) in closed form. The kernel solves
+  // for a from the step before; jumps of the overlap in either direction must give the same
+  // force as the closed form, to 1e-9 of the pull-off force.
+  const Model model = compile(load_case("jkr_pull_off.yaml"));
+  OneContact c(model, 1e-3, 1e-3, 1e-8);
+  const double E = model.pair_row(0)[0], R = c.b.r_eff[0], W = 0.1;
+  const double a_c = std::cbrt(kPi * W * R * R / (8 * E)), pull_off = 1.5 * kPi * W * R;
+  c.force_at(model, 1e-6);  // touch
+  for (const double ratio : {1.05, 20.0, 3.0, 1.5, 60.0, 1.01, 8.0}) {
+    const double a = ratio * a_c;
+    const double overlap = a * a / R - std::sqrt(2 * kPi * W * a / E);
+    const double expected = 4 * E * a * a * a / (3 * R) - std::sqrt(8 * kPi * W * E * a * a * a);
+    EXPECT_NEAR(c.force_at(model, overlap), expected, 1e-9 * pull_off) << "a = " << ratio << " a_c";
+  }
+}
+
 TEST(Sjkr, ForceIsCohesionEnergyDensityTimesContactArea) {
   // k = 3e5 J/m^3, two R = 1 mm spheres: overlap 2 um -> 1.88401 mN, 20 um -> 18.75531 mN.
   CaseSpec spec = load_case("jkr_pull_off.yaml");

@@ -23,7 +23,7 @@ constexpr ParamSpec kParams[] = {
     {"surface_energy", "J/m^2", 0.0, 0.0, 10.0, Mixing::geometric, true,
      "surface energy gamma of each surface; work of adhesion W = 2 gamma"},
 };
-constexpr HistorySpec kHistory[] = {{"jkr_neck", 1}};
+constexpr HistorySpec kHistory[] = {{"jkr_neck", 1}};  // the neck's contact radius a [m]; 0: no neck
 
 /// Overlap at which the neck breaks [m] (negative).
 double breaking_overlap(double work, double r_eff, double youngs) {
@@ -31,37 +31,44 @@ double breaking_overlap(double work, double r_eff, double youngs) {
   return a_c * a_c / r_eff - std::sqrt(2.0 * kPi * work * a_c / youngs);
 }
 
-/// Contact radius on the stable branch (a >= a_c) for an overlap; Newton from the right of
-/// the root of a convex increasing function converges monotonically.
-double contact_radius(double overlap, double work, double r_eff, double youngs) {
-  const double k = std::sqrt(2.0 * kPi * work / youngs);
-  double a = std::max(std::pow(2.0 * k * r_eff, 2.0 / 3.0), std::sqrt(2.0 * r_eff * std::max(overlap, 0.0)));
+/// Square root of the contact radius, s = sqrt(a), on the stable branch (a >= a_c) for an
+/// overlap: the root of g(s) = s^4/R* - k s - delta, k = sqrt(2 pi W / E*), which is convex and
+/// increasing there, so Newton converges monotonically from the right of the root, and a step
+/// from its left lands on its right. It starts from the radius of the step before (`previous`,
+/// 0 for a new neck), which the overlap has hardly moved: one or two iterations. Convergence is
+/// quadratic, so after a step of 1e-8 s the root is exact to about 1e-16 s.
+double root_radius(double overlap, double k, double r_eff, double previous) {
+  double s = previous > 0.0 ? std::sqrt(previous) : std::sqrt(std::max(std::cbrt(2.0 * k * r_eff) * std::cbrt(2.0 * k * r_eff),
+                                                                        std::sqrt(2.0 * r_eff * std::max(overlap, 0.0))));
+  const double inv_r = 1.0 / r_eff;
   for (int iteration = 0; iteration < 60; ++iteration) {
-    const double sqrt_a = std::sqrt(a);
-    const double f = a * a / r_eff - k * sqrt_a - overlap;
-    const double df = 2.0 * a / r_eff - 0.5 * k / sqrt_a;
-    const double step = f / df;
-    a -= step;
-    if (std::abs(step) <= 1e-14 * a) break;
+    const double s3 = s * s * s;
+    const double step = (s3 * s * inv_r - k * s - overlap) / (4.0 * s3 * inv_r - k);
+    s -= step;
+    if (std::abs(step) <= 1e-8 * s) break;
   }
-  return a;
+  return s;
 }
 
 void jkr_kernel(const EffectContext& ctx, ContactBatch& b) {
-  double* neck_column = ctx.hist(b, 0);  // 1 while a neck joins the pair, else 0
+  double* neck_column = ctx.hist(b, 0);  // the neck's contact radius [m] while one joins the pair, else 0
   for (int c = 0; c < b.count; ++c) {
-    double* neck = &neck_column[c];
+    double& neck = neck_column[c];
     const double work = 2.0 * ctx.param(b, c, 0);
     if (work <= 0.0) continue;
     const double youngs = ctx.youngs_eff(b, c), r_eff = b.r_eff[c], overlap = b.overlap[c];
-    if (overlap > 0.0) neck[0] = 1.0;
-    if (neck[0] == 0.0) continue;
-    if (overlap < breaking_overlap(work, r_eff, youngs)) {
-      neck[0] = 0.0;
+    if (neck == 0.0 && !(overlap > 0.0)) continue;
+    const double k = std::sqrt(2.0 * kPi * work / youngs);
+    // The neck breaks at delta_c = min over s of s^4/R* - k s = -3/4 k s_c, s_c^3 = k R*/4 (that
+    // is, a_c^3 = pi W R*^2 / (8 E*)), a negative overlap.
+    if (overlap < 0.0 && overlap < -0.75 * k * std::cbrt(0.25 * k * r_eff)) {
+      neck = 0.0;
       continue;
     }
-    const double a = contact_radius(overlap, work, r_eff, youngs);
-    const double force = 4.0 * youngs * a * a * a / (3.0 * r_eff) - std::sqrt(8.0 * kPi * work * youngs * a * a * a);
+    const double s = root_radius(overlap, k, r_eff, neck), a = s * s;
+    neck = a;
+    // F = 4 E* a^3 / (3 R*) - sqrt(8 pi W E* a^3), with sqrt(8 pi W E*) = 2 E* k
+    const double force = 4.0 * youngs * a * a * a / (3.0 * r_eff) - 2.0 * youngs * k * a * s;
     b.fn[c] += force - b.fn_elastic[c];
   }
 }
