@@ -436,10 +436,10 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
         edges.push_back(parameters[i].key);
     }
     if (!missed && edges.empty()) break;
-    if (result.after.chi2 > options.refine_below_chi2 && result.surrogate_chi2 > options.refine_below_chi2) {
+    if (result.after.chi2 > options.no_rival_above_chi2 && result.surrogate_chi2 > options.no_rival_above_chi2) {
       result.words.push_back(fmt::format("Not refined: the simulations at the surrogate's optimum give chi^2 {:.1f} and the surrogate predicted "
                                          "{:.1f}, both above {:.1f}, where it could not rival the best candidate confirmed so far.",
-                                         result.after.chi2, result.surrogate_chi2, options.refine_below_chi2));
+                                         result.after.chi2, result.surrogate_chi2, options.no_rival_above_chi2));
       if (options.progress) options.progress("calibrate: " + result.words.back());
       break;
     }

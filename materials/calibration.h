@@ -77,7 +77,7 @@ struct CalibrationOptions {
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
   int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
   /// Packings a comparison may give an experiment where its verdict depends on them: when chi^2/n
-  /// lies between fits_within_noise and 4 x it, each experiment with a term beyond 2 sigma whose
+  /// lies between fits_within_noise and 4 x it (and chi^2 at most no_rival_above_chi2), each experiment with a term beyond 2 sigma whose
   /// packings scatter gets one more packing at a time, up to this many (compare()). A mean of two
   /// packings that happen to agree can sit far from the model's own mean (a hopper near its
   /// arching limit scatters by 20 %). At most `replicas`: none are added.
@@ -103,11 +103,12 @@ struct CalibrationOptions {
   /// box inside the parameter's limit: each spans half the last box around the best point
   /// simulated so far, and is confirmed in turn. The better confirmed point is the result.
   int refine_rounds = 1;
-  /// No refinement round when both the simulations at the optimum and the surrogate's prediction
-  /// give chi^2 above this: a diagnosis sets it for a runner-up from the best candidate confirmed
-  /// so far (its BIC plus twice rival_margin), as a runner-up that far behind is no rival either
-  /// way. Infinity: refine as above.
-  double refine_below_chi2 = std::numeric_limits<double>::infinity();
+  /// A runner-up of a diagnosis is no rival to the best candidate confirmed so far, either way,
+  /// when its chi^2 lies above this: a diagnosis sets it from that one's BIC plus twice
+  /// rival_margin. Such a runner-up gets no refinement round (when the surrogate's prediction
+  /// lies above it too) and no packings beyond `replicas` in its comparisons (compare()).
+  /// Infinity: refine and add packings as above.
+  double no_rival_above_chi2 = std::numeric_limits<double>::infinity();
   int starts = 8;               ///< NLopt starts (best design points and the centre)
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise

@@ -133,11 +133,12 @@ Comparison compare(const MaterialModel& model, const MeasurementSet& measured, c
   Comparison c = compare_runs(measured, runs, options);
   // More packings where the verdict depends on them: near the line between fitting within the
   // noise and not, the largest residuals decide, and a mean of few packings may sit far from the
-  // model's own mean while they happen to agree. Deterministic tests (one particle) are left.
+  // model's own mean while they happen to agree. Deterministic tests (one particle) are left, and
+  // so is a diagnosis's runner-up too far behind the best candidate to rival it either way.
   const auto undecided = [&](const Comparison& now) {
     std::vector<size_t> out;
     const double per_n = now.chi2_per_n();
-    if (per_n <= options.fits_within_noise || per_n > 4 * options.fits_within_noise) return out;
+    if (per_n <= options.fits_within_noise || per_n > 4 * options.fits_within_noise || now.chi2 > options.no_rival_above_chi2) return out;
     for (size_t k = 0; k < runs.size(); ++k) {
       if (runs[k].replicas >= options.most_replicas) continue;
       bool beyond = false, scatters = false;

@@ -331,13 +331,13 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
         signature_points[0].push_back(it->start.at(added.key));
         signature_points[1].push_back(it->stronger.count(added.key) ? it->stronger.at(added.key) : it->start.at(added.key));
       }
-      // A runner-up is not refined where it cannot rival the best candidate confirmed so far:
-      // when both its simulations and its surrogate lie beyond that one's BIC by twice the
-      // margin (calibration.h, refine_below_chi2).
+      // A runner-up that cannot rival the best candidate confirmed so far (its simulations beyond
+      // that one's BIC by twice the margin) is neither refined (when its surrogate lies beyond too)
+      // nor given more packings (calibration.h, no_rival_above_chi2).
       CalibrationOptions confirming_options = options;
       for (const CandidateResult& done : d.candidates)
         if (done.confirmed)
-          confirming_options.refine_below_chi2 = std::min(confirming_options.refine_below_chi2,
+          confirming_options.no_rival_above_chi2 = std::min(confirming_options.no_rival_above_chi2,
                                                           done.bic + 2 * options.rival_margin - cr.k * std::log(static_cast<double>(std::max(n, 1))));
       if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
       cr.fit = calibrate(with, measured, params, confirming_options, &at_start.at(cr.name), signature_points);

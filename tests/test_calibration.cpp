@@ -383,6 +383,13 @@ TEST(Calibration, PackingsAreAddedWhereTheVerdictDependsOnThem) {
   EXPECT_LT(std::abs(adaptive.residual("hopper", "mass_flow_rate")), 2.0);
   for (const ExperimentRun& run : adaptive.runs) EXPECT_EQ(run.replicas, run.id == "hopper" ? 3 : 2) << run.id;
   EXPECT_EQ(adaptive.simulations(), 8 * 2 + 1);
+  // A diagnosis's runner-up whose chi^2 lies beyond the bar of a rival gets no packings; just
+  // below the bar, it gets them as before.
+  CalibrationOptions behind = o;
+  behind.no_rival_above_chi2 = 0.9 * two.chi2;
+  EXPECT_EQ(compare(model, set, behind).simulations(), 8 * 2);
+  behind.no_rival_above_chi2 = 1.1 * two.chi2;
+  EXPECT_EQ(compare(model, set, behind).simulations(), 8 * 2 + 1);
 
   set.experiments[1].observed["angle_deg"].value += 20;  // far from fitting: no decision turns on the noise
   const Comparison far = compare(model, set, o);
@@ -511,11 +518,11 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
              refined.value[0], refined.after.chi2_per_n());
   // A runner-up of a diagnosis whose simulations and surrogate both lie beyond the bar (a leader's
   // BIC plus twice the rival margin) is not refined; just above both, it is.
-  o.refine_below_chi2 = 0.9 * std::min(once.after.chi2, once.surrogate_chi2);
+  o.no_rival_above_chi2 = 0.9 * std::min(once.after.chi2, once.surrogate_chi2);
   const CalibrationResult behind = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
   EXPECT_EQ(behind.after.chi2, once.after.chi2);
   EXPECT_TRUE(std::any_of(behind.words.begin(), behind.words.end(), [](const std::string& w) { return w.starts_with("Not refined"); }));
-  o.refine_below_chi2 = 1.1 * std::min(once.after.chi2, once.surrogate_chi2);
+  o.no_rival_above_chi2 = 1.1 * std::min(once.after.chi2, once.surrogate_chi2);
   const CalibrationResult within = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
   EXPECT_EQ(within.after.chi2, refined.after.chi2);
 }
