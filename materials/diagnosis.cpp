@@ -492,6 +492,7 @@ BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double 
       {"design factor 0.5", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 0.5); }, false},
       {"two packings per comparison instead of three", [](CalibrationOptions& o) { o.replicas = std::min(o.replicas, 2); }, false},
       {"wall parameters not screened", [](CalibrationOptions& o) { o.wall_candidates = false; }, true},
+      {"one candidate confirmed instead of two", [](CalibrationOptions& o) { o.confirm_candidates = std::min(o.confirm_candidates, 1); }, true},
   };
   plan.seconds = seconds(plan.options);
   for (const Step& step : ladder) {
@@ -511,18 +512,6 @@ BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double 
 
 }  // namespace
 
-namespace {
-
-/// The passes a plan reserves: the leading candidate's confirmation only. A runner-up is
-/// confirmed when time is left for it, or past the budget when the screen cannot tell it from the
-/// leader (fit_confirmations); reserving its time would cost the leader's design and packings.
-CalibrationOptions as_planned(CalibrationOptions o) {
-  o.confirm_candidates = std::min(o.confirm_candidates, 1);
-  return o;
-}
-
-}  // namespace
-
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
   // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
   // `parallel` simulations at once.
@@ -530,12 +519,12 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
   pass /= std::max(1, options.parallel);
   return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::diagnosis_passes(as_planned(o), p, effects, walls); });
+                       [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls); });
 }
 
 BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget) {
   return fit_to_budget(options, pass, left, budget, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::screen_and_confirmation_passes(as_planned(o), p, effects, walls); });
+                       [&](const CalibrationOptions& o) { return detail::screen_and_confirmation_passes(o, p, effects, walls); });
 }
 
 // ---- ledger -------------------------------------------------------------------------------
