@@ -77,8 +77,9 @@ struct CalibrationOptions {
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
   int replicas = 3;             ///< packings per experiment when comparing (>= 2 measures the noise)
   /// Packings a comparison may give an experiment where its verdict depends on them: when chi^2/n
-  /// lies between fits_within_noise and 4 x it (and chi^2 at most no_rival_above_chi2), each experiment with a term beyond 2 sigma whose
-  /// packings scatter gets one more packing at a time, up to this many (compare()). A mean of two
+  /// lies between fits_within_noise and 4 x it (and chi^2 at most no_rival_above_chi2), each
+  /// experiment with a term beyond 2 sigma whose packings scatter gets one more packing at a
+  /// time, up to this many (compare()). A mean of two
   /// packings that happen to agree can sit far from the model's own mean (a hopper near its
   /// arching limit scatters by 20 %). At most `replicas`: none are added.
   int most_replicas = 6;

@@ -25,11 +25,10 @@ constexpr ParamSpec kParams[] = {
 };
 constexpr HistorySpec kHistory[] = {{"jkr_neck", 1}};  // the neck's contact radius a [m]; 0: no neck
 
-/// Overlap at which the neck breaks [m] (negative).
-double breaking_overlap(double work, double r_eff, double youngs) {
-  const double a_c = std::cbrt(kPi * work * r_eff * r_eff / (8.0 * youngs));
-  return a_c * a_c / r_eff - std::sqrt(2.0 * kPi * work * a_c / youngs);
-}
+/// Overlap at which the neck breaks [m] (negative), k = sqrt(2 pi W / E*): the least overlap of
+/// the stable branch, delta_c = min over s of s^4/R* - k s = -3/4 k s_c with s_c^3 = k R*/4
+/// (that is, a_c^3 = pi W R*^2 / (8 E*)), where d delta/da = 0.
+double breaking_overlap(double k, double r_eff) { return -0.75 * k * std::cbrt(0.25 * k * r_eff); }
 
 /// Square root of the contact radius, s = sqrt(a), on the stable branch (a >= a_c) for an
 /// overlap: the root of g(s) = s^4/R* - k s - delta, k = sqrt(2 pi W / E*), which is convex and
@@ -38,8 +37,8 @@ double breaking_overlap(double work, double r_eff, double youngs) {
 /// 0 for a new neck), which the overlap has hardly moved: one or two iterations. Convergence is
 /// quadratic, so after a step of 1e-8 s the root is exact to about 1e-16 s.
 double root_radius(double overlap, double k, double r_eff, double previous) {
-  double s = previous > 0.0 ? std::sqrt(previous) : std::sqrt(std::max(std::cbrt(2.0 * k * r_eff) * std::cbrt(2.0 * k * r_eff),
-                                                                        std::sqrt(2.0 * r_eff * std::max(overlap, 0.0))));
+  const double first = previous > 0.0 ? previous : std::max(std::pow(2.0 * k * r_eff, 2.0 / 3.0), std::sqrt(2.0 * r_eff * std::max(overlap, 0.0)));
+  double s = std::sqrt(first);
   const double inv_r = 1.0 / r_eff;
   for (int iteration = 0; iteration < 60; ++iteration) {
     const double s3 = s * s * s;
@@ -59,9 +58,7 @@ void jkr_kernel(const EffectContext& ctx, ContactBatch& b) {
     const double youngs = ctx.youngs_eff(b, c), r_eff = b.r_eff[c], overlap = b.overlap[c];
     if (neck == 0.0 && !(overlap > 0.0)) continue;
     const double k = std::sqrt(2.0 * kPi * work / youngs);
-    // The neck breaks at delta_c = min over s of s^4/R* - k s = -3/4 k s_c, s_c^3 = k R*/4 (that
-    // is, a_c^3 = pi W R*^2 / (8 E*)), a negative overlap.
-    if (overlap < 0.0 && overlap < -0.75 * k * std::cbrt(0.25 * k * r_eff)) {
+    if (overlap < 0.0 && overlap < breaking_overlap(k, r_eff)) {
       neck = 0.0;
       continue;
     }
@@ -76,7 +73,7 @@ void jkr_kernel(const EffectContext& ctx, ContactBatch& b) {
 double jkr_range(const double* row, const double* params, double radius_max) {
   // |delta_c| grows as R*^(1/3): the largest particle bounds every pair.
   const double work = 2.0 * params[0];
-  return work > 0.0 ? -breaking_overlap(work, radius_max, row[0]) : 0.0;
+  return work > 0.0 ? -breaking_overlap(std::sqrt(2.0 * kPi * work / row[0]), radius_max) : 0.0;
 }
 
 /// Surface energy [J/m^2] that gives a pull-off force of one particle weight between two
