@@ -241,7 +241,7 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 }  // namespace
 
 CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& given, const Comparison* before, const std::vector<std::vector<double>>& include) {
+                            const CalibrationOptions& given, const Comparison* before, const EarlierPoints& earlier) {
   const Clock::time_point t0 = Clock::now();
   CalibrationOptions options = given;  // a budget may reduce it
   CalibrationResult result;
@@ -321,9 +321,26 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
   // far inside the box; its optimum from several starts. A point whose simulation fails is
   // skipped; bad input (CaseError) stops the calibration.
+  // Known points: data from the start, where they hold a value of every term.
+  int known = 0;
+  for (const SimulatedPoint& point : earlier.known) {
+    if (static_cast<int>(point.x.size()) != p) continue;
+    Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
+    for (size_t i = 0; i < names.size(); ++i) {
+      const auto it = point.values.find(names[i]);
+      v[static_cast<Eigen::Index>(i)] = it == point.values.end() ? kNaN : it->second;
+    }
+    if (v.allFinite()) add_point(Eigen::Map<const Eigen::VectorXd>(point.x.data(), p), v), ++known;
+  }
+  if (known > 0) {
+    result.words.push_back(fmt::format("{} point{} simulated before, with a model this one equals there, fed the surrogate beside the "
+                                       "design's own.",
+                                       known, known == 1 ? "" : "s"));
+    if (options.progress) options.progress("calibrate: " + result.words.back());
+  }
   // The points the first round takes from `include`: inside the box, at most all but one.
   std::vector<Eigen::VectorXd> included;
-  for (const std::vector<double>& x : include) {
+  for (const std::vector<double>& x : earlier.include) {
     if (static_cast<int>(x.size()) != p || static_cast<int>(included.size()) + 1 >= points) continue;
     bool inside = true;
     for (int i = 0; i < p; ++i) inside = inside && x[i] >= parameters[i].min && x[i] <= parameters[i].max;
@@ -515,6 +532,12 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     if (flagged[i]) result.unidentified.push_back(parameters[i].key);
 
   result.wall_seconds = seconds_since(t0);
+  for (Eigen::Index r = 0; r < all_points.rows(); ++r) {
+    SimulatedPoint point;
+    for (int i = 0; i < p; ++i) point.x.push_back(all_points(r, i));
+    for (size_t t = 0; t < names.size(); ++t) point.values[names[t]] = all_values(r, static_cast<Eigen::Index>(t));
+    result.points.push_back(std::move(point));
+  }
 
   // Words.
   std::vector<std::string> fitted;

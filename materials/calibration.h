@@ -248,6 +248,14 @@ struct FitParameter {
 std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::vector<std::string>& keys = {});
 
 /// Quadratic response surfaces, one per numeric term, in x normalised to [-1, 1] over `box`.
+/// A point of a parameter space whose simulations were made: parameter values (physical units,
+/// in the order of the calibration's parameters) and the simulated value of each term
+/// (experiment/observable).
+struct SimulatedPoint {
+  std::vector<double> x;
+  std::map<std::string, double> values;
+};
+
 struct Surrogate {
   std::vector<FitParameter> box;
   std::vector<std::string> terms;   ///< term names (experiment/observable)
@@ -298,18 +306,30 @@ struct CalibrationResult {
   MaterialModel fitted;
   Comparison before, after;                         ///< real simulations at the start and at the fit
   std::vector<ContourMap> contours;
+  /// Every point whose simulations fed a surrogate (design points, confirmations and the known
+  /// points it was given), with the simulated value of each numeric term (the mean over packings
+  /// for a confirmation).
+  std::vector<SimulatedPoint> points;
   int simulations = 0;
   double wall_seconds = 0;
 };
 
+/// What a calibration may take from simulations made before it (a diagnosis's).
+struct EarlierPoints {
+  /// Points (values of the parameters, physical units) the first round's design takes in place of
+  /// as many of its own, where they lie inside the box: points already simulated (a diagnosis's
+  /// signature runs) then come from the store (options.store) instead of running again.
+  std::vector<std::vector<double>> include;
+  /// Points simulated with a model that equals the calibrated one at them (the model without an
+  /// effect is the model with it at the strength where it changes nothing): data of every
+  /// surrogate whose box holds them, beside the design's own points; nothing is run for them.
+  std::vector<SimulatedPoint> known;
+};
+
 /// Fits `parameters` (empty: the model's tunable ranges). `before`: an existing comparison of
-/// `model` (its simulation noise is reused); nullptr: compared first. `include`: points (values
-/// of `parameters`, physical units) the first round's design takes in place of as many of its
-/// own, where they lie inside the box: points already simulated (a diagnosis's signature runs)
-/// then come from the store (options.store) instead of running again.
+/// `model` (its simulation noise is reused); nullptr: compared first.
 CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& options, const Comparison* before = nullptr,
-                            const std::vector<std::vector<double>>& include = {});
+                            const CalibrationOptions& options, const Comparison* before = nullptr, const EarlierPoints& earlier = {});
 
 /// The Fig. 5 map for parameters px, py of a result, for the two observations whose contours
 /// cross most steeply (from different tests when there are).

@@ -60,6 +60,7 @@ std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& mode
       c.parameters = {{full, {lo, hi}}};
       c.start = {{full, start}};
       c.stronger = {{full, std::clamp(now + 2.0 * (start - now), lo, hi)}};
+      if (now == get_parameter(model, full)) c.unchanged = {{full, now}};
       c.add = [](MaterialModel&) {};
       out.push_back(std::move(c));
     }
@@ -326,11 +327,19 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       params.insert(params.end(), cr.adds.begin(), cr.adds.end());
       // Its signature runs are two points of its design, taken from the store: the fitted
       // parameters at the base's values, its own at the start and at the stronger step.
-      std::vector<std::vector<double>> signature_points(2, std::vector<double>(d.base.value.begin(), d.base.value.end()));
+      EarlierPoints earlier;
+      earlier.include.assign(2, std::vector<double>(d.base.value.begin(), d.base.value.end()));
       for (const FitParameter& added : cr.adds) {
-        signature_points[0].push_back(it->start.at(added.key));
-        signature_points[1].push_back(it->stronger.count(added.key) ? it->stronger.at(added.key) : it->start.at(added.key));
+        earlier.include[0].push_back(it->start.at(added.key));
+        earlier.include[1].push_back(it->stronger.count(added.key) ? it->stronger.at(added.key) : it->start.at(added.key));
       }
+      // Every point the model as it is was simulated at is a point of the candidate's space too,
+      // its own parameters where it changes nothing: the candidate's surrogate takes them as data.
+      if (std::all_of(cr.adds.begin(), cr.adds.end(), [&](const FitParameter& a) { return it->unchanged.count(a.key) > 0; }))
+        for (SimulatedPoint point : d.base.points) {
+          for (const FitParameter& added : cr.adds) point.x.push_back(it->unchanged.at(added.key));
+          earlier.known.push_back(std::move(point));
+        }
       // A runner-up that cannot rival the best candidate confirmed so far (its simulations beyond
       // that one's BIC by twice the margin) is neither refined (when its surrogate lies beyond too)
       // nor given more packings (calibration.h, no_rival_above_chi2).
@@ -340,7 +349,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
           confirming_options.no_rival_above_chi2 = std::min(confirming_options.no_rival_above_chi2,
                                                           done.bic + 2 * options.rival_margin - cr.k * std::log(static_cast<double>(std::max(n, 1))));
       if (options.progress) options.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
-      cr.fit = calibrate(with, measured, params, confirming_options, &at_start.at(cr.name), signature_points);
+      cr.fit = calibrate(with, measured, params, confirming_options, &at_start.at(cr.name), earlier);
       cr.confirmed = true;
       cr.chi2 = cr.fit.after.chi2;
       cr.bic = bic(cr.chi2, cr.k, cr.fit.after.n);

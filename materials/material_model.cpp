@@ -279,6 +279,7 @@ EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale&
     c.parameters[std::string(f.key)] = {lo, hi};
     c.start[std::string(f.key)] = std::clamp(f.start * factor, lo, hi);
     c.stronger[std::string(f.key)] = std::clamp(lo + 2.0 * (c.start[std::string(f.key)] - lo), lo, hi);
+    if (f.min == 0.0) c.unchanged[std::string(f.key)] = 0.0;  // FittedParam: a strength of 0 adds nothing
   }
   for (const StartValue& v : spec.also_set) c.start[std::string(v.key)] = v.value;
   const Stage s = effect.stage;

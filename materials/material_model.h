@@ -45,6 +45,11 @@ struct EffectCandidate {
   /// key -> the value of a second, stronger step for the signature (twice as far from where the
   /// candidate changes nothing as `start`).
   std::map<std::string, double> stronger;
+  /// key -> the value at which the candidate changes nothing: the model with it there simulates
+  /// as the model without it, so the model's own simulations are points of the candidate's
+  /// calibration too. Empty when there is none (a clump of aspect ratio 1 is two coincident
+  /// spheres, not the model's sphere).
+  std::map<std::string, double> unchanged;
 };
 
 /// The candidates the model does not yet use: every effect of the table that declares itself a

@@ -71,6 +71,31 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   }
 }
 
+TEST(Diagnose, TheModelsOwnSimulationsArePointsOfEachCandidatesFit) {
+  // Every point the model as it is was simulated at is a point of a candidate's parameter space,
+  // the candidate's own parameters where it changes nothing (rolling friction 0): its surrogate
+  // takes them as data, nothing is simulated again for them.
+  const Analytic sim;
+  const Diagnosis d = diagnose(dry_spheres(), rolling_gravel(sim), {}, analytic_options(sim));
+  ASSERT_FALSE(d.base.points.empty());
+  int confirmed = 0;
+  for (const CandidateResult& c : d.candidates) {
+    if (!c.confirmed || c.kind == "shape") continue;
+    ++confirmed;
+    for (const SimulatedPoint& own : d.base.points) {
+      const auto same = [&](const SimulatedPoint& q) {
+        if (q.x.size() != own.x.size() + 1 || q.values != own.values) return false;
+        return std::equal(own.x.begin(), own.x.end(), q.x.begin()) && q.x.back() == (c.kind == "parameter" ? q.x.back() : 0.0);
+      };
+      EXPECT_TRUE(std::any_of(c.fit.points.begin(), c.fit.points.end(), same)) << c.name;
+    }
+    const std::string said = fmt::format("{} points simulated before", d.base.points.size());
+    EXPECT_TRUE(std::any_of(c.fit.words.begin(), c.fit.words.end(), [&](const std::string& w) { return w.find(said) != std::string::npos; }))
+        << c.name;
+  }
+  EXPECT_GE(confirmed, 1);
+}
+
 /// The dry spheres with liquid bridges of this liquid content, at friction 0.5.
 MaterialModel wet_spheres(double liquid_content) {
   MaterialModel m = dry_spheres();

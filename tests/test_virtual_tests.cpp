@@ -3,19 +3,24 @@
 // loose/close packing, the lifted-cylinder angle of repose (no heap without rolling resistance,
 // a heap that steepens with it), the rotating drum's dynamic angle and wall slip, and hopper
 // discharge against Beverloo's law and arching. Apparatus shrunk (size_factor) and particles
-// coarse and soft so each simulation takes a few seconds.
+// coarse and soft so each simulation takes a few seconds. Also: a diagnosis candidate at its
+// `unchanged` values compiles to the model's own contact law.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <numbers>
 #include <numeric>
 
 #include "calibration.h"
+#include "material_model.h"
 #include "measurements.h"
+#include "sim.h"
+#include "virtual_test_support.h"
 #include "virtual_tests.h"
 
 namespace dem::materials {
@@ -316,6 +321,63 @@ TEST(Batch, SimulationsInParallelGiveTheSerialOutcomes) {
     EXPECT_EQ(serial.runs[e].particles, parallel.runs[e].particles) << serial.runs[e].id;
   }
   EXPECT_EQ(serial.chi2, parallel.chi2);
+}
+
+TEST(MaterialModel, EveryCandidateAddsNothingAtItsUnchangedValue) {
+  // A diagnosis takes the model's own simulations as a candidate's at its `unchanged` values
+  // (EffectCandidate::unchanged): there the compiled contact law must give the model's forces and
+  // torques, its time step and its interaction range, along a path that presses, slides, rolls
+  // and pulls apart (the history of every effect in play).
+  const MaterialModel m = read_material_model(std::string(DEMDESIGN_SOURCE_DIR) + "/materials/glass_beads.yaml");
+  const auto compiled = [](const MaterialModel& model) {
+    TestOptions o;
+    CaseSpec spec = detail::base_case(model, o, {}, "unchanged");
+    spec.particles.push_back(detail::particle_box(model, 1, Vec3(0, 0, 0), Vec3(0.1, 0.1, 0.1)));
+    return compile(spec);
+  };
+  // Normal force, tangential force and rolling torque along the path, a row per step.
+  const auto path = [](const Model& model) {
+    const double r = 0.003, mass = 0.5 * 2500 * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    test::OneContact one(model, r, r, mass);
+    std::vector<std::array<double, 7>> out;
+    for (int step = 0; step <= 400; ++step) {
+      // Approach, press to 20 um, slide and roll, then pull apart to a 20 um gap.
+      const double phase = std::numbers::pi * step / 300.0, overlap = 20e-6 * std::sin(phase);
+      ContactBatch& b = one.b;
+      b.vn[0] = -20e-6 * std::numbers::pi / 300.0 * std::cos(phase) / 1e-6;
+      b.vtx[0] = 0, b.vty[0] = 0.02, b.vtz[0] = 0.01 * std::cos(0.05 * step);
+      b.wx[0] = 0, b.wy[0] = 5.0, b.wz[0] = -3.0;
+      const double fn = one.force_at(model, overlap);
+      out.push_back({fn, b.ftx[0], b.fty[0], b.ftz[0], b.mx[0] / r, b.my[0] / r, b.mz[0] / r});
+    }
+    return out;
+  };
+  const Model without = compiled(m);
+  const auto plain = path(without);
+  int checked = 0;
+  for (const EffectCandidate& c : missing_effects(m)) {
+    if (c.unchanged.empty()) continue;
+    MaterialModel with = m;
+    c.add(with);
+    for (const auto& [key, v] : c.start) set_parameter(with, key, v);
+    const auto started = path(compiled(with));  // the effect at work: the path must show it
+    for (const auto& [key, v] : c.unchanged) set_parameter(with, key, v);
+    const Model model = compiled(with);
+    EXPECT_EQ(model.dt, without.dt) << c.name;
+    EXPECT_EQ(model.interaction_range, without.interaction_range) << c.name;
+    const auto unchanged = path(model);
+    double differs = 0;
+    for (size_t step = 0; step < plain.size(); ++step) {
+      const double scale = std::max(1e-9, std::abs(plain[step][0]));  // [N]
+      for (size_t k = 0; k < 7; ++k) {
+        ASSERT_NEAR(unchanged[step][k], plain[step][k], 1e-12 * scale) << c.name << " step " << step << " column " << k;
+        differs = std::max(differs, std::abs(started[step][k] - plain[step][k]) / scale);
+      }
+    }
+    EXPECT_GT(differs, 1e-3) << c.name << " at its start values should change the path's forces";
+    ++checked;
+  }
+  EXPECT_EQ(checked, 5);  // epsd, cdt, liquid_bridge, jkr, sjkr (a clump has no unchanged value)
 }
 
 }  // namespace

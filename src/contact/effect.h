@@ -140,7 +140,10 @@ using EffectRange = double (*)(const double* row, const double* params, double r
 struct FittedParam {
   std::string_view key;  ///< one of the effect's ParamSpec keys
   double start;          ///< value the effect is added with
-  double min, max;       ///< range the fit searches (clipped to the ParamSpec's range)
+  /// Range the fit searches (clipped to the ParamSpec's range). A `min` of 0 declares that the
+  /// effect adds nothing at 0 (no force, no torque, no change of the time step): a diagnosis then
+  /// takes the model's own simulations as the effect's at 0 (test EveryCandidateAddsNothingAtZero).
+  double min, max;
 };
 
 /// A parameter given a value (not fitted) when the effect is added.
