@@ -23,6 +23,11 @@ Generated silo(MapReader& reader, const EquipmentSpec& spec) {
   const double gate_speed = reader.number("shutter_speed", 2.0, 0.01, 100.0, "m/s");
   const double margin = reader.number("margin", 0.05, 0.0, 10.0, "m");
   const int around = static_cast<int>(reader.integer("segments", 48, 12, 360));
+  // [m] longest side of the floor's cells along the radius and of the wall's up it (at least a
+  // segment's width): the wear map's resolution. Default: as wide as a segment around (square
+  // cells). A lab silo that keeps no wear map takes one cell from orifice to wall and one up it:
+  // fewer triangles near each particle, so fewer closest-point tests a step.
+  const double cell = reader.number("cell", std::min(kCell, kPi * diameter / around), 1e-4, 100.0, "m");
   const SourceLocation& where = spec.location;
   const double radius = 0.5 * diameter, hole = 0.5 * orifice;
 
@@ -30,7 +35,6 @@ Generated silo(MapReader& reader, const EquipmentSpec& spec) {
   out.camera = "side";
   {
     MeshBuilder silo;
-    const double cell = std::min(kCell, 2 * kPi * radius / around);
     silo.grid([&](double u, double w) {  // floor annulus, normal +z
       const double r = hole + u * (radius - hole), angle = 2 * kPi * w;
       return Vec3(r * std::cos(angle), r * std::sin(angle), 0);

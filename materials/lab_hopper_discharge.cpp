@@ -56,6 +56,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
     params["open_at"] = open_at;
     params["liner_material"] = wall_material;
     params["segments"] = std::clamp(segments_around(radius, 0.5 * d50), 48, 360);
+    params["cell"] = height;  // no wear map: one cell from the orifice to the wall, one up it
     EquipmentSpec equipment;
     equipment.type = "silo";
     equipment.params = std::make_shared<const YAML::Node>(params);
