@@ -131,6 +131,15 @@ inline int design_points(const CalibrationOptions& o, int k) {
   return o.design_points > 0 ? o.design_points : std::max(b + 1, static_cast<int>(std::ceil(o.design_factor * b)) + 2);
 }
 
+/// Design points of one round fitting `k` parameters of which the last `added` change nothing at
+/// points already simulated (EarlierPoints::known, the plain fit's): twice the coefficients of the
+/// quadratic that involve the added ones, at least k + 2. The fewest a confirmation takes when a
+/// budget asks for it; the known points determine the rest.
+inline int design_points_beside_known(int k, int added) {
+  const auto b = [](int q) { return 1 + q + q * (q + 1) / 2; };
+  return std::max(k + 2, 2 * (b(k) - b(k - added)));
+}
+
 /// Passes over the experiments (a simulation of each) that a calibration of `p` parameters
 /// makes after its first comparison: the design rounds and the confirming comparison.
 inline int calibration_passes(const CalibrationOptions& o, int p) { return std::max(1, o.rounds) * design_points(o, p) + std::max(1, o.replicas); }
@@ -158,12 +167,16 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
 /// Which candidate confirmations fit what is left of a budget [s], each at its cost [s], in rank
 /// order: the first always; a later one when it fits, or when it is tied (the signature screen
 /// cannot tell it from the leader), then beyond the budget. `left` is what remains after those
-/// kept (negative when the tied ones exceed it).
+/// kept (negative when the tied ones exceed it). When tied ones would go beyond the budget and
+/// `smaller` gives a cheaper cost for some (a confirmation with fewer design points; NaN: none),
+/// every confirmation is planned at its cheaper cost (`reduced`).
 struct ConfirmationPlan {
   std::vector<size_t> kept, dropped, beyond;  ///< indices into the costs; beyond: kept past the budget
   double left = 0;
+  bool reduced = false;  ///< planned at the `smaller` costs
 };
-ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left);
+ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left,
+                                   const std::vector<double>& smaller = {});
 
 /// Simulations run at once: `parallel` in this process; under a batch runner (MPI ranks) the
 /// count is the runner's, and one is assumed.

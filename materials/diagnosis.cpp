@@ -270,6 +270,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     // projection. When no candidate passes the screen although the model misfits, the leading
     // ones are confirmed anyway: recalibration, not the screen, decides.
     const detail::ConfirmationChoice choice = detail::choose_confirmations(d.candidates, options);
+    std::map<std::string, int> design_points_of;  // a confirmation's design points, where a budget reduced them
     const bool screen_silent = choice.screen_silent;
     std::vector<size_t> confirming = choice.confirming;
     std::vector<std::string> undecided = choice.undecided, nonlinear = choice.nonlinear;
@@ -288,7 +289,35 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
         costs.push_back(experiments * detail::calibration_passes(options, d.candidates[rank].k) * per_simulation);
         tied.push_back(std::find(undecided.begin(), undecided.end(), d.candidates[rank].name) != undecided.end());
       }
-      const detail::ConfirmationPlan plan = detail::fit_confirmations(costs, tied, left);
+      // A candidate whose plain-fit points are points of its own space (EffectCandidate::unchanged)
+      // can be confirmed with fewer design points of its own: the cost a tie past the budget
+      // falls back on (fit_confirmations).
+      std::vector<double> smaller(costs.size(), detail::kNaN);
+      std::map<std::string, int> fewer_points;
+      for (size_t k = 0; k < confirming.size(); ++k) {
+        const CandidateResult& cr = d.candidates[confirming[k]];
+        const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
+        const bool known = it != effects.end() &&
+                           std::all_of(cr.adds.begin(), cr.adds.end(), [&](const FitParameter& a) { return it->unchanged.count(a.key) > 0; });
+        CalibrationOptions o = options;
+        o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
+        if (!known || o.design_points >= detail::design_points(options, cr.k)) continue;
+        smaller[k] = experiments * detail::calibration_passes(o, cr.k) * per_simulation;
+        fewer_points[cr.name] = o.design_points;
+      }
+      const detail::ConfirmationPlan plan = detail::fit_confirmations(costs, tied, left, smaller);
+      if (plan.reduced) {
+        design_points_of = fewer_points;
+        for (size_t k = 0; k < costs.size(); ++k)
+          if (std::isfinite(smaller[k])) costs[k] = smaller[k];
+        std::vector<std::string> which;
+        for (const auto& [name, points] : fewer_points) which.push_back(fmt::format("{} {}", name, points));
+        d.words.push_back(fmt::format("To fit the budget of {} with a tie, the confirmations design fewer points ({} a round, against {}): "
+                                      "the plain fit's points, where each candidate changes nothing, determine the rest of their surrogates.",
+                                      detail::duration_text(given.budget_seconds), join(which),
+                                      detail::design_points(options, d.candidates[confirming.front()].k)));
+        if (options.progress) options.progress("diagnose: " + d.words.back());
+      }
       std::vector<size_t> kept;
       std::vector<std::string> dropped, beyond;
       double each = 0;
@@ -312,9 +341,14 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
         if (options.progress) options.progress("diagnose: " + d.words.back());
       }
     }
+    const auto options_for = [&](const std::string& name) {
+      CalibrationOptions o = options;
+      if (const auto it = design_points_of.find(name); it != design_points_of.end()) o.design_points = it->second;
+      return o;
+    };
     if (command.outermost()) {
       int passes = 0;
-      for (const size_t rank : confirming) passes += detail::calibration_passes(options, d.candidates[rank].k);
+      for (const size_t rank : confirming) passes += detail::calibration_passes(options_for(d.candidates[rank].name), d.candidates[rank].k);
       count.plan_remaining(experiments * passes);
     }
     for (const size_t rank : confirming) {
@@ -343,7 +377,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       // A runner-up that cannot rival the best candidate confirmed so far (its simulations beyond
       // that one's BIC by twice the margin) is neither refined (when its surrogate lies beyond too)
       // nor given more packings (calibration.h, no_rival_above_chi2).
-      CalibrationOptions confirming_options = options;
+      CalibrationOptions confirming_options = options_for(cr.name);
       for (const CandidateResult& done : d.candidates)
         if (done.confirmed)
           confirming_options.no_rival_above_chi2 = std::min(confirming_options.no_rival_above_chi2,
@@ -462,18 +496,29 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
   return out;
 }
 
-ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left) {
-  ConfirmationPlan plan;
-  for (size_t k = 0; k < costs.size(); ++k) {
-    const bool fits = plan.kept.empty() || costs[k] <= left;
-    if (!fits && !tied[k]) {
-      plan.dropped.push_back(k);
-      continue;
+ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left, const std::vector<double>& smaller) {
+  const auto fit = [&](const std::vector<double>& cost) {
+    ConfirmationPlan plan;
+    double rest = left;
+    for (size_t k = 0; k < cost.size(); ++k) {
+      const bool fits = plan.kept.empty() || cost[k] <= rest;
+      if (!fits && !tied[k]) {
+        plan.dropped.push_back(k);
+        continue;
+      }
+      if (!fits) plan.beyond.push_back(k);
+      plan.kept.push_back(k), rest -= cost[k];
     }
-    if (!fits) plan.beyond.push_back(k);
-    plan.kept.push_back(k), left -= costs[k];
-  }
-  plan.left = left;
+    plan.left = rest;
+    return plan;
+  };
+  ConfirmationPlan plan = fit(costs);
+  if (plan.beyond.empty() || std::none_of(smaller.begin(), smaller.end(), [](double c) { return std::isfinite(c); })) return plan;
+  std::vector<double> cheaper = costs;
+  for (size_t k = 0; k < std::min(costs.size(), smaller.size()); ++k)
+    if (std::isfinite(smaller[k])) cheaper[k] = smaller[k];
+  plan = fit(cheaper);
+  plan.reduced = true;
   return plan;
 }
 

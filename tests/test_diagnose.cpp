@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "analytic_lab.h"
@@ -329,6 +330,22 @@ TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
   EXPECT_EQ(roomy.kept, (std::vector<size_t>{0, 1}));
   EXPECT_TRUE(roomy.beyond.empty());
   EXPECT_EQ(detail::fit_confirmations({600}, {false}, 100).kept, (std::vector<size_t>{0}));
+  // A tie past the budget falls back on the cheaper confirmations (fewer design points where the
+  // plain fit's points stand in): 350 + 350 fit the 700 s; the untied third still waits.
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  const detail::ConfirmationPlan cheaper = detail::fit_confirmations({600, 600, 600}, {false, true, false}, 700, {350, 350, none});
+  EXPECT_TRUE(cheaper.reduced);
+  EXPECT_EQ(cheaper.kept, (std::vector<size_t>{0, 1}));
+  EXPECT_TRUE(cheaper.beyond.empty());
+  EXPECT_EQ(cheaper.dropped, (std::vector<size_t>{2}));
+  EXPECT_DOUBLE_EQ(cheaper.left, 0);
+  // Without a tie past the budget the full confirmations stay.
+  EXPECT_FALSE(detail::fit_confirmations({600, 600}, {false, false}, 1300, {350, 350}).reduced);
+  // Fewest design points beside the plain fit's: twice the coefficients that involve the added
+  // parameter (3 parameters, one added: 4 of 10), at least k + 2.
+  EXPECT_EQ(detail::design_points_beside_known(3, 1), 8);
+  EXPECT_EQ(detail::design_points_beside_known(2, 1), 6);
+  EXPECT_EQ(detail::design_points_beside_known(1, 1), 4);
 }
 
 // Progress over the whole command: every line counts one more of the diagnosis' simulations,
