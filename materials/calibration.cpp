@@ -317,13 +317,24 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     }
     return next;
   };
-  // One round: a Latin hypercube in `box`, every experiment at every point as one batch (common
-  // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
-  // far inside the box; its optimum from several starts. A point whose simulation fails is
-  // skipped; bad input (CaseError) stops the calibration.
-  // Known points: data from the start, where they hold a value of every term.
+  // Known points: data from the start, where they hold a value of every term, unless the walls'
+  // first stage gave a wall pair another value than they were simulated with (a cohesive
+  // candidate holds the rebound down, so its drops ask for a livelier wall).
   int known = 0;
-  for (const SimulatedPoint& point : earlier.known) {
+  std::vector<std::string> moved;
+  for (size_t k = 0; k < model.wall_pairs.size() && k < given_model.wall_pairs.size(); ++k)
+    for (const auto& [key, value] : model.wall_pairs[k].params)
+      if (const auto it = given_model.wall_pairs[k].params.find(key); it == given_model.wall_pairs[k].params.end() || it->second != value)
+        moved.push_back(fmt::format("{}.{} {:.3g}", model.wall_pairs[k].material_a == model.name ? model.wall_pairs[k].material_b
+                                                                                                 : model.wall_pairs[k].material_a,
+                                    key, value));
+  if (!moved.empty() && !earlier.known.empty()) {
+    const bool one = earlier.known.size() == 1;
+    result.words.push_back(fmt::format("The {} point{} simulated before {} left out: the drops gave {} a new value ({}).", earlier.known.size(),
+                                       one ? "" : "s", one ? "was" : "were", moved.size() == 1 ? "a wall pair" : "wall pairs", join(moved)));
+    if (options.progress) options.progress("calibrate: " + result.words.back());
+  }
+  for (const SimulatedPoint& point : moved.empty() ? earlier.known : std::vector<SimulatedPoint>{}) {
     if (static_cast<int>(point.x.size()) != p) continue;
     Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
     for (size_t i = 0; i < names.size(); ++i) {
@@ -338,6 +349,10 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                        known, known == 1 ? "" : "s"));
     if (options.progress) options.progress("calibrate: " + result.words.back());
   }
+  // One round: a Latin hypercube in `box`, every experiment at every point as one batch (common
+  // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
+  // far inside the box; its optimum from several starts. A point whose simulation fails is
+  // skipped; bad input (CaseError) stops the calibration.
   // The points the first round takes from `include`: inside the box, at most all but one.
   std::vector<Eigen::VectorXd> included;
   for (const std::vector<double>& x : earlier.include) {

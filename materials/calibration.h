@@ -323,6 +323,8 @@ struct EarlierPoints {
   /// Points simulated with a model that equals the calibrated one at them (the model without an
   /// effect is the model with it at the strength where it changes nothing): data of every
   /// surrogate whose box holds them, beside the design's own points; nothing is run for them.
+  /// Left out when the walls' first stage (CalibrationOptions::walls_first) changes a wall pair's
+  /// parameter: they were simulated with the value before.
   std::vector<SimulatedPoint> known;
 };
 

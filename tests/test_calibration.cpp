@@ -567,6 +567,20 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
   const CalibrationResult kept = calibrate(measured, set, {{"friction", 0.1, 0.9}}, analytic_options(sim));
   EXPECT_DOUBLE_EQ(get_parameter(kept.fitted, "steel.restitution"), 0.5);
   EXPECT_TRUE(kept.fitted.fitted_first.empty());
+  // Points simulated before with the guessed wall are not points of a calibration whose drops
+  // give the wall another value: left out, and said; with the wall kept, they are data.
+  EarlierPoints earlier;
+  earlier.known.push_back(fit.points.front());
+  earlier.known.front().x = {0.123456};  // a point no design of these calibrations makes
+  const auto holds = [](const CalibrationResult& r, const SimulatedPoint& q) {
+    return std::any_of(r.points.begin(), r.points.end(), [&](const SimulatedPoint& x) { return x.x == q.x && x.values == q.values; });
+  };
+  const CalibrationResult moved = calibrate(start, set, {{"friction", 0.1, 0.9}}, analytic_options(sim), nullptr, earlier);
+  EXPECT_FALSE(holds(moved, earlier.known.front()));
+  EXPECT_TRUE(std::any_of(moved.words.begin(), moved.words.end(),
+                          [](const std::string& w) { return w.find("The 1 point simulated before was left out") != std::string::npos; }));
+  const CalibrationResult same = calibrate(measured, set, {{"friction", 0.1, 0.9}}, analytic_options(sim), nullptr, earlier);
+  EXPECT_TRUE(holds(same, earlier.known.front()));
 }
 
 }  // namespace
