@@ -255,6 +255,17 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   const detail::WallsFirst walls = detail::fit_walls_first(given_model, measured, parameters, options);
   const MaterialModel& model = walls.model;
   result.words = walls.words;
+  // Wall pairs the first stage gave another value: points simulated before (EarlierPoints::known)
+  // had the old one and are left out below; a design reduced to stand beside them
+  // (design_points_beside_known) takes the full rule again.
+  std::vector<std::string> moved;
+  for (size_t k = 0; k < model.wall_pairs.size() && k < given_model.wall_pairs.size(); ++k)
+    for (const auto& [key, value] : model.wall_pairs[k].params)
+      if (const auto it = given_model.wall_pairs[k].params.find(key); it == given_model.wall_pairs[k].params.end() || it->second != value)
+        moved.push_back(fmt::format("{}.{} {:.3g}", model.wall_pairs[k].material_a == model.name ? model.wall_pairs[k].material_b
+                                                                                                 : model.wall_pairs[k].material_a,
+                                    key, value));
+  if (!moved.empty() && !earlier.known.empty() && options.design_points > 0 && options.design_points <= basis_size(p)) options.design_points = 0;
 
   const int n = static_cast<int>(measured.experiments.size());
   const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
@@ -321,13 +332,6 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   // first stage gave a wall pair another value than they were simulated with (a cohesive
   // candidate holds the rebound down, so its drops ask for a livelier wall).
   int known = 0;
-  std::vector<std::string> moved;
-  for (size_t k = 0; k < model.wall_pairs.size() && k < given_model.wall_pairs.size(); ++k)
-    for (const auto& [key, value] : model.wall_pairs[k].params)
-      if (const auto it = given_model.wall_pairs[k].params.find(key); it == given_model.wall_pairs[k].params.end() || it->second != value)
-        moved.push_back(fmt::format("{}.{} {:.3g}", model.wall_pairs[k].material_a == model.name ? model.wall_pairs[k].material_b
-                                                                                                 : model.wall_pairs[k].material_a,
-                                    key, value));
   if (!moved.empty() && !earlier.known.empty()) {
     const bool one = earlier.known.size() == 1;
     result.words.push_back(fmt::format("The {} point{} simulated before {} left out: the drops gave {} a new value ({}).", earlier.known.size(),

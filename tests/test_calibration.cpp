@@ -581,6 +581,11 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
                           [](const std::string& w) { return w.find("The 1 point simulated before was left out") != std::string::npos; }));
   const CalibrationResult same = calibrate(measured, set, {{"friction", 0.1, 0.9}}, analytic_options(sim), nullptr, earlier);
   EXPECT_TRUE(holds(same, earlier.known.front()));
+  // A design reduced to stand beside the known points takes the full rule again without them
+  // (two points could not fit a quadratic in one parameter).
+  CalibrationOptions beside = analytic_options(sim);
+  beside.design_points = 2;
+  EXPECT_NO_THROW(calibrate(start, set, {{"friction", 0.1, 0.9}}, beside, nullptr, earlier));
 }
 
 }  // namespace
