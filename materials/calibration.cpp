@@ -338,8 +338,8 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                        one ? "" : "s", one ? "was" : "were", moved.size() == 1 ? "a wall pair" : "wall pairs", join(moved)));
     if (options.progress) options.progress("calibrate: " + result.words.back());
   }
-  for (const SimulatedPoint& point : moved.empty() ? earlier.known : std::vector<SimulatedPoint>{}) {
-    if (static_cast<int>(point.x.size()) != p) continue;
+  for (const SimulatedPoint& point : earlier.known) {
+    if (!moved.empty() || static_cast<int>(point.x.size()) != p) continue;
     Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
     for (size_t i = 0; i < names.size(); ++i) {
       const auto it = point.values.find(names[i]);

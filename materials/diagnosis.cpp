@@ -68,6 +68,12 @@ std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& mode
   return out;
 }
 
+/// Whether every parameter the candidate adds has a value where it changes nothing: the plain
+/// fit's points are then points of the candidate's space (EarlierPoints::known).
+bool takes_plain_points(const EffectCandidate& c, const CandidateResult& cr) {
+  return std::all_of(cr.adds.begin(), cr.adds.end(), [&](const FitParameter& a) { return c.unchanged.count(a.key) > 0; });
+}
+
 }  // namespace
 
 Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters, const CalibrationOptions& given) {
@@ -297,8 +303,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       for (size_t k = 0; k < confirming.size(); ++k) {
         const CandidateResult& cr = d.candidates[confirming[k]];
         const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
-        const bool known = it != effects.end() &&
-                           std::all_of(cr.adds.begin(), cr.adds.end(), [&](const FitParameter& a) { return it->unchanged.count(a.key) > 0; });
+        const bool known = it != effects.end() && takes_plain_points(*it, cr);
         CalibrationOptions o = options;
         o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
         if (!known || o.design_points >= detail::design_points(options, cr.k)) continue;
@@ -369,7 +374,7 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       }
       // Every point the model as it is was simulated at is a point of the candidate's space too,
       // its own parameters where it changes nothing: the candidate's surrogate takes them as data.
-      if (std::all_of(cr.adds.begin(), cr.adds.end(), [&](const FitParameter& a) { return it->unchanged.count(a.key) > 0; }))
+      if (takes_plain_points(*it, cr))
         for (SimulatedPoint point : d.base.points) {
           for (const FitParameter& added : cr.adds) point.x.push_back(it->unchanged.at(added.key));
           earlier.known.push_back(std::move(point));
