@@ -270,6 +270,17 @@ std::vector<ExperimentRun> simulate_experiments(const MaterialModel& model, cons
                                                 const CalibrationOptions& options, int replicas, Progress* progress,
                                                 const std::string& prefix);
 
+/// Each experiment simulated with each model, `replicas` packings each, all one batch (so that
+/// every core stays busy): runs[m][e] is model m's run of experiment e. An experiment any model
+/// cannot simulate (bad input, a numerical failure) is left out of every model's runs, its error in
+/// `failed[e]`; the others still run. A progress step, labelled with the model's name, as each finishes.
+struct RunsByModel {
+  std::vector<std::vector<ExperimentRun>> runs;
+  std::vector<std::string> failed;  ///< per experiment: "" or the first error
+};
+RunsByModel simulate_with_each(const std::vector<const MaterialModel*>& models, const std::vector<std::string>& names,
+                               const std::vector<Experiment>& experiments, const CalibrationOptions& options, int replicas, Progress* progress);
+
 /// A candidate's runs at its two signature strengths (diagnose).
 struct SignatureRuns {
   std::vector<ExperimentRun> start;     ///< at its start values, with `replicas` packings

@@ -1,5 +1,5 @@
-// Diagnosis (which missing effect explains the misfit) and the ledger of calibrations (rules in
-// calibration.h).
+// Diagnosis: which missing effect explains the misfit (rules in calibration.h; its budget plan in
+// diagnosis_budget.cpp).
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -67,6 +67,9 @@ std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& mode
   }
   return out;
 }
+
+/// Candidate experiments simulated to separate a rival, however little of the budget is left.
+constexpr int kFewestSeparators = 4;
 
 /// Whether every parameter the candidate adds has a value where it changes nothing: the plain
 /// fit's points are then points of the candidate's space (EarlierPoints::known).
@@ -303,10 +306,10 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
       for (size_t k = 0; k < confirming.size(); ++k) {
         const CandidateResult& cr = d.candidates[confirming[k]];
         const auto it = std::find_if(effects.begin(), effects.end(), [&](const EffectCandidate& c) { return c.name == cr.name; });
-        const bool known = it != effects.end() && takes_plain_points(*it, cr);
+        const bool beside_plain = it != effects.end() && takes_plain_points(*it, cr);
         CalibrationOptions o = options;
         o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
-        if (!known || o.design_points >= detail::design_points(options, cr.k)) continue;
+        if (!beside_plain || o.design_points >= detail::design_points(options, cr.k)) continue;
         smaller[k] = experiments * detail::calibration_passes(o, cr.k) * per_simulation;
         fewer_points[cr.name] = o.design_points;
       }
@@ -438,12 +441,26 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                                         best->why, c.name, c.why));
           // Which experiment would decide: both fitted models simulated on candidates.
           if (options.propose_experiments) {
-            std::vector<Separator> found = separating_experiments(best->fit.fitted, best->name, c.fit.fitted, c.name, measured, options);
+            SeparationPlan plan;
+            plan.apart = apart_by_experiment(best->fit.after, c.fit.after);
+            // With a budget, as many candidate experiments as what is left of it pays for, the
+            // most promising first, and never fewer than kFewestSeparators.
+            if (given.budget_seconds > 0 && command.outermost() && count.done() > 0) {
+              const double per_candidate = 2 * std::max(1, std::min(options.replicas, options.signature_replicas)) * count.elapsed() / count.done();
+              plan.most = std::max(kFewestSeparators, static_cast<int>((given.budget_seconds - count.elapsed()) / per_candidate));
+            }
+            SeparationSearch search = separating_experiments(best->fit.fitted, best->name, c.fit.fitted, c.name, measured, options, plan);
+            std::vector<Separator>& found = search.found;
             if (!found.empty() && found.front().separation >= options.separation_needed)
               d.words.push_back(fmt::format("To tell {} from {}, measure {}.", best->name, c.name, found.front().words));
             else
               d.words.push_back(fmt::format("No experiment tried separates {} from {} by {:.0f} sigma{}.", best->name, c.name, options.separation_needed,
                                             found.empty() ? "" : fmt::format(" (best: {})", found.front().words)));
+            if (!search.untried.empty())
+              d.words.push_back(fmt::format("Within the budget of {}, {} of {} candidate experiments were simulated, those of the experiments on "
+                                            "which the two fitted models already lie furthest apart; not tried: {}.",
+                                            detail::duration_text(given.budget_seconds), search.candidates - static_cast<int>(search.untried.size()),
+                                            search.candidates, join(search.untried, "; ")));
             if (found.size() > 3) found.resize(3);
             d.separators[c.name] = std::move(found);
           }
@@ -467,210 +484,6 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
                             : fmt::format("{}: {} (signature only, not confirmed).", cr.name, screen);
   }
   return d;
-}
-
-// ---- budget -------------------------------------------------------------------------------
-
-namespace detail {
-int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {
-  if (effects + walls == 0) return 0;
-  const int screened = effects + (o.wall_candidates ? walls : 0);
-  return screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1)  // two strengths
-         + o.confirm_candidates * detail::calibration_passes(o, p + 1);
-}
-
-int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
-  // The calibration and its confirming comparison, then the screen and the confirmations.
-  return detail::calibration_passes(o, p) + screen_and_confirmation_passes(o, p, effects, walls);
-}
-
-ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options) {
-  ConfirmationChoice out;
-  out.screen_silent = std::none_of(ranked.begin(), ranked.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
-  const double leader = ranked.empty() ? 0.0 : ranked.front().explained;
-  const auto chosen = [&](const CandidateResult& cr, int rank) {
-    const bool tied = rank > 0 && cr.explained >= 0.05 && leader - cr.explained <= options.screen_margin;
-    if (tied) out.undecided.push_back(cr.name);
-    if (rank < options.confirm_candidates && (cr.explained >= 0.05 || out.screen_silent)) return true;
-    if (tied) return true;
-    if (cr.explained >= 0.05 && cr.agreement < 0.5) return out.nonlinear.push_back(cr.name), true;
-    return false;
-  };
-  for (size_t rank = 0; rank < ranked.size() && static_cast<int>(out.confirming.size()) < options.confirm_candidates + 2; ++rank)
-    if (chosen(ranked[rank], static_cast<int>(rank))) out.confirming.push_back(rank);
-  return out;
-}
-
-ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left, const std::vector<double>& smaller) {
-  const auto fit = [&](const std::vector<double>& cost) {
-    ConfirmationPlan plan;
-    double rest = left;
-    for (size_t k = 0; k < cost.size(); ++k) {
-      const bool fits = plan.kept.empty() || cost[k] <= rest;
-      if (!fits && !tied[k]) {
-        plan.dropped.push_back(k);
-        continue;
-      }
-      if (!fits) plan.beyond.push_back(k);
-      plan.kept.push_back(k), rest -= cost[k];
-    }
-    plan.left = rest;
-    return plan;
-  };
-  ConfirmationPlan plan = fit(costs);
-  if (plan.beyond.empty() || std::none_of(smaller.begin(), smaller.end(), [](double c) { return std::isfinite(c); })) return plan;
-  std::vector<double> cheaper = costs;
-  for (size_t k = 0; k < std::min(costs.size(), smaller.size()); ++k)
-    if (std::isfinite(smaller[k])) cheaper[k] = smaller[k];
-  plan = fit(cheaper);
-  plan.reduced = true;
-  return plan;
-}
-
-}  // namespace detail
-
-namespace {
-
-/// The ladder of reductions applied in turn until `passes` passes of `pass` seconds fit `left`.
-BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double left, double budget, int candidates,
-                         const std::function<int(const CalibrationOptions&)>& passes) {
-  BudgetPlan plan{options, {}, 0};
-  const auto seconds = [&](const CalibrationOptions& o) { return passes(o) * pass; };
-  struct Step {
-    const char* words;
-    void (*apply)(CalibrationOptions&);
-    bool diagnosis_only;
-  };
-  // What goes first costs the least insight. The wall parameters' screen goes late: a wall pair
-  // the starting material only guessed (a steel restitution) misfits like missing physics, and
-  // without the screen a diagnosis would offer an effect to absorb it.
-  const Step ladder[] = {
-      {"one surrogate round instead of two (no zoom on the optimum)", [](CalibrationOptions& o) { o.rounds = 1; }, false},
-      {"design factor 1 instead of 2 (fewer design points)", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 1.0); }, false},
-      {"signatures with one packing", [](CalibrationOptions& o) { o.signature_replicas = 1; }, true},
-      {"design factor 0.5", [](CalibrationOptions& o) { o.design_factor = std::min(o.design_factor, 0.5); }, false},
-      {"two packings per comparison instead of three", [](CalibrationOptions& o) { o.replicas = std::min(o.replicas, 2); }, false},
-      {"wall parameters not screened", [](CalibrationOptions& o) { o.wall_candidates = false; }, true},
-      {"one candidate confirmed instead of two", [](CalibrationOptions& o) { o.confirm_candidates = std::min(o.confirm_candidates, 1); }, true},
-  };
-  plan.seconds = seconds(plan.options);
-  for (const Step& step : ladder) {
-    if (plan.seconds <= left) break;
-    if (step.diagnosis_only && candidates == 0) continue;
-    CalibrationOptions reduced = plan.options;
-    step.apply(reduced);
-    const double s = seconds(reduced);
-    if (s < plan.seconds) plan.options = reduced, plan.seconds = s, plan.given_up.emplace_back(step.words);
-  }
-  if (plan.seconds > left)
-    plan.given_up.push_back(fmt::format("still about {} at the least: the budget of {} cannot be met with these experiments (use --size-factor, or "
-                                        "fewer experiments)",
-                                        detail::duration_text(plan.seconds), detail::duration_text(budget)));
-  return plan;
-}
-
-}  // namespace
-
-BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
-  // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
-  // `parallel` simulations at once.
-  double pass = 0;
-  for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
-  pass /= std::max(1, options.parallel);
-  return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls); });
-}
-
-BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget) {
-  return fit_to_budget(options, pass, left, budget, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::screen_and_confirmation_passes(o, p, effects, walls); });
-}
-
-// ---- ledger -------------------------------------------------------------------------------
-
-std::vector<std::string> model_effects(const MaterialModel& model) {
-  std::vector<std::string> out;
-  for (const ContactSpec::Choice* c : {&model.contact.normal, &model.contact.damping, &model.contact.tangential, &model.contact.rolling, &model.contact.twisting})
-    if (c->model != "none") out.push_back(c->model);
-  for (const auto& c : model.contact.adhesion) out.push_back(c.model);
-  for (const auto& c : model.contact.extra) out.push_back(c.model);
-  if (!model.shape.empty()) out.push_back(fmt::format("clump (aspect {:.2f})", get_parameter(model, "clump_aspect_ratio")));
-  return out;
-}
-
-LedgerEntry ledger_entry(const MaterialModel& model, const Comparison& comparison, const std::string& label, const std::vector<std::string>& parameter_keys) {
-  LedgerEntry e;
-  e.label = label;
-  const std::time_t t = std::time(nullptr);
-  std::tm local{};
-  localtime_r(&t, &local);
-  char buffer[64];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S", &local);
-  e.time = buffer;
-  e.effects = model_effects(model);
-  for (const std::string& key : parameter_keys) e.parameters[key] = get_parameter(model, key);
-  for (const Term& term : comparison.terms) e.residuals[term.name()] = term.residual;
-  e.chi2 = comparison.chi2;
-  e.n = comparison.n;
-  return e;
-}
-
-std::vector<LedgerEntry> read_ledger(const std::string& path) {
-  std::vector<LedgerEntry> out;
-  if (!std::filesystem::exists(path)) return out;
-  try {
-    const YAML::Node root = YAML::LoadFile(path);
-    for (const YAML::Node& v : root["versions"]) {
-      LedgerEntry e;
-      e.version = v["version"].as<int>();
-      e.label = v["label"].as<std::string>("");
-      e.time = v["time"].as<std::string>("");
-      if (v["effects"])
-        for (const auto& x : v["effects"]) e.effects.push_back(x.as<std::string>());
-      if (v["parameters"])
-        for (const auto& kv : v["parameters"]) e.parameters[kv.first.as<std::string>()] = kv.second.as<double>();
-      if (v["residuals"])
-        for (const auto& kv : v["residuals"]) e.residuals[kv.first.as<std::string>()] = kv.second.as<double>();
-      e.chi2 = v["chi2"].as<double>(0);
-      e.n = v["n"].as<int>(0);
-      out.push_back(std::move(e));
-    }
-  } catch (const YAML::Exception& error) {
-    throw CaseError(fmt::format("{}:{}:{}: the error ledger cannot be read: {}", path, error.mark.line + 1, error.mark.column + 1, error.msg));
-  }
-  return out;
-}
-
-std::vector<LedgerEntry> append_ledger(const std::string& path, const std::string& material, std::vector<LedgerEntry> entries) {
-  std::vector<LedgerEntry> all = read_ledger(path);
-  int next = all.empty() ? 1 : all.back().version + 1;
-  for (LedgerEntry& e : entries) e.version = next++, all.push_back(std::move(e));
-  YAML::Emitter out;
-  out << YAML::Comment("Error ledger: every model version of this material with its normalised residual on every observation "
-                       "(simulated - measured, in sigma) and chi^2/n. Appended by demdesign calibrate and diagnose.");
-  out << YAML::BeginMap << YAML::Key << "material" << YAML::Value << material << YAML::Key << "versions" << YAML::Value << YAML::BeginSeq;
-  for (const LedgerEntry& e : all) {
-    out << YAML::BeginMap;
-    out << YAML::Key << "version" << YAML::Value << e.version;
-    out << YAML::Key << "label" << YAML::Value << e.label;
-    out << YAML::Key << "time" << YAML::Value << e.time;
-    out << YAML::Key << "effects" << YAML::Value << YAML::Flow << e.effects;
-    out << YAML::Key << "parameters" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    for (const auto& [k, v] : e.parameters) out << YAML::Key << k << YAML::Value << v;
-    out << YAML::EndMap;
-    out << YAML::Key << "chi2" << YAML::Value << e.chi2 << YAML::Key << "n" << YAML::Value << e.n;
-    out << YAML::Key << "chi2_per_n" << YAML::Value << e.chi2_per_n();
-    out << YAML::Key << "residuals" << YAML::Value << YAML::BeginMap;
-    for (const auto& [k, v] : e.residuals) out << YAML::Key << k << YAML::Value << v;
-    out << YAML::EndMap << YAML::EndMap;
-  }
-  out << YAML::EndSeq << YAML::EndMap;
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error(fmt::format("{}: cannot write the error ledger", path));
-  file << out.c_str() << "\n";
-  return all;
 }
 
 }  // namespace dem::materials

@@ -246,6 +246,38 @@ std::vector<ExperimentRun> detail::simulate_experiments(const MaterialModel& mod
   return runs_of(experiments, outcomes, 0, replicas);
 }
 
+detail::RunsByModel detail::simulate_with_each(const std::vector<const MaterialModel*>& models, const std::vector<std::string>& names,
+                                               const std::vector<Experiment>& experiments, const CalibrationOptions& options, int replicas,
+                                               Progress* progress) {
+  replicas = std::max(1, replicas);
+  RunsByModel out;
+  out.failed.assign(experiments.size(), std::string());
+  std::vector<Job> jobs;
+  for (const MaterialModel* model : models)
+    for (const Experiment& e : experiments)
+      for (int r = 0; r < replicas; ++r) jobs.push_back({model, &e.setup, options.seed + static_cast<std::uint64_t>(r)});
+  const size_t per_model = experiments.size() * static_cast<size_t>(replicas);
+  const std::vector<BatchOutcome> outcomes = run_batch(
+      jobs, options,
+      [&](size_t k, const BatchOutcome& b) {
+        if (b.error != BatchOutcome::Error::none || !progress) return;
+        const Experiment& e = experiments[(k % per_model) / static_cast<size_t>(replicas)];
+        progress->step(e, fmt::format("{} {}, replica {} of {}{}", names[k / per_model], e.id, k % replicas + 1, replicas, b.stored ? ", stored" : ""),
+                       b.stored ? 0.0 : b.outcome.wall_seconds);
+      },
+      [](const BatchOutcome&) { return false; });
+  for (size_t k = 0; k < outcomes.size(); ++k) {
+    std::string& failed = out.failed[(k % per_model) / static_cast<size_t>(replicas)];
+    if (outcomes[k].error != BatchOutcome::Error::none && failed.empty()) failed = outcomes[k].message;
+  }
+  for (size_t m = 0; m < models.size(); ++m) {
+    out.runs.push_back(runs_of(experiments, outcomes, m * per_model, replicas));
+    for (size_t e = 0; e < experiments.size(); ++e)
+      if (!out.failed[e].empty()) out.runs.back()[e] = ExperimentRun{};
+  }
+  return out;
+}
+
 std::vector<detail::SignatureRuns> detail::simulate_signatures(const MaterialModel& model, const std::vector<EffectCandidate>& candidates,
                                                                const std::vector<FitParameter>& parameters, const MeasurementSet& measured,
                                                                const CalibrationOptions& options, int replicas, Progress* progress) {

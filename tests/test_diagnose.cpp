@@ -14,6 +14,7 @@
 #include "calibration.h"
 #include "calibration_support.h"
 #include "calibration_report.h"
+#include "discrimination.h"
 #include "material_model.h"
 #include "measurements.h"
 
@@ -164,6 +165,41 @@ TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
   const double off_a = std::abs(truth_value - best.predicted_a) / best.sigma, off_b = std::abs(truth_value - best.predicted_b) / best.sigma;
   std::printf("named: %s; truth %.4g (%.1f and %.1f sigma from the two)\n", best.words.c_str(), truth_value, off_a, off_b);
   EXPECT_GE(std::max(off_a, off_b) - std::min(off_a, off_b), 2.0) << "the measurement decides between the two";
+}
+
+TEST(Discrimination, TheMostPromisingCandidatesAreSimulatedFirstAndAsManyAsPlanned) {
+  // Two experiments, the fitted models 2 sigma apart on the density and 0.5 on the heap: the
+  // standard set-ups of the tests the file lacks come first, then the density's variants, then
+  // the heap's; a plan of 3 simulates the first three and lists the rest as untried.
+  const Analytic sim;
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}, {"lift_speed", 0.05}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  set = synthesise(set, dry_spheres(), sim, 5);
+  const std::map<std::string, double> apart{{"aor", 0.5}, {"density", 2.0}};
+  const std::vector<Experiment> plain = separating_candidates(dry_spheres(), set);
+  const std::vector<Experiment> ordered = separating_candidates(dry_spheres(), set, apart);
+  ASSERT_EQ(plain.size(), ordered.size());
+  const auto kinds = [](const std::vector<Experiment>& list) {
+    std::vector<std::string> out;  // "standard", "density", "aor" in their order, runs merged
+    for (const Experiment& e : list) {
+      const std::string kind = e.id.rfind("density at ", 0) == 0 ? "density" : e.id.rfind("aor at ", 0) == 0 ? "aor" : "standard";
+      if (out.empty() || out.back() != kind) out.push_back(kind);
+    }
+    return out;
+  };
+  EXPECT_EQ(kinds(ordered), (std::vector<std::string>{"standard", "density", "aor"}));
+  EXPECT_EQ(kinds(plain), (std::vector<std::string>{"standard", "aor", "density"})) << "without a plan, the file's order";
+
+  SeparationPlan plan;
+  plan.apart = apart, plan.most = 3;
+  const SeparationSearch search = separating_experiments(dry_spheres(), "dry", wet_spheres(0.03), "wet", set, analytic_options(sim), plan);
+  EXPECT_EQ(search.candidates, static_cast<int>(ordered.size()));
+  ASSERT_EQ(search.untried.size(), ordered.size() - 3);
+  EXPECT_EQ(search.untried.front(), ordered[3].id);
+  for (const Separator& s : search.found)
+    EXPECT_TRUE(s.id == ordered[0].id || s.id == ordered[1].id || s.id == ordered[2].id) << s.id;
+  EXPECT_FALSE(search.found.empty());
 }
 
 TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
