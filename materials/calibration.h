@@ -393,8 +393,9 @@ struct BudgetPlan {
 };
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent = 0);
 /// The same for what a diagnosis has left after calibrating the model as it is (the signature
-/// screen and the confirmations), at `pass` [s] a pass over the experiments as measured so far,
-/// into `left` [s] of the budget `budget` [s].
+/// screen and the confirmations), at `pass` [s] a pass over the experiments as measured so far
+/// (a candidate's passes cost more: detail::kScreenCost, kConfirmationCost), into `left` [s] of
+/// the budget `budget` [s].
 BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget);
 
 /// BIC = chi^2 + k ln n.

@@ -150,6 +150,14 @@ int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls)
 /// The part of diagnosis_passes after the calibration of the model as it is: the signature screen
 /// and the confirmations.
 int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls);
+/// The signature screen's part of it.
+int screen_passes(const CalibrationOptions& o, int effects, int walls);
+/// What a simulation of the signature screen and of a confirmation costs against one of the model
+/// as it is, which the plan after its calibration has measured: a candidate's effect (cohesion,
+/// liquid bridges, clumps) slows the flows. On the cross-engine sets (tests/data/cross_engine,
+/// 2026-12-05, 68dc73d, one core a simulation) the screens' simulations took 16-19 s on average
+/// against 7-8 s for the plain model's, the confirmations' 7.5-9.4 s.
+constexpr double kScreenCost = 2.0, kConfirmationCost = 1.2;
 
 /// Which of the candidates, ranked by the residual their signatures explain, are confirmed by
 /// recalibration: the leading confirm_candidates the screen passes (or, when the screen passes

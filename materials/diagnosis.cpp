@@ -139,10 +139,10 @@ Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, s
     const BudgetPlan rest = plan_screen_within_budget(options, pass, fitted, lacking, walls, given.budget_seconds - count.elapsed(), given.budget_seconds);
     if (!rest.given_up.empty()) {
       options = rest.options;
-      d.words.push_back(fmt::format("Planned again after calibrating the model as it is ({} spent, at {:.1f} s a simulation): about {} for the "
-                                    "screen and the confirmations; given up: {}.",
-                                    detail::duration_text(count.elapsed()), count.elapsed() / count.done(), detail::duration_text(rest.seconds),
-                                    join(rest.given_up, "; ")));
+      d.words.push_back(fmt::format("Planned again after calibrating the model as it is ({} spent, at {:.1f} s a simulation, a candidate's "
+                                    "screen simulations counted at {:.1f} times that): about {} for the screen and the confirmations; given up: {}.",
+                                    detail::duration_text(count.elapsed()), count.elapsed() / count.done(), detail::kScreenCost,
+                                    detail::duration_text(rest.seconds), join(rest.given_up, "; ")));
       if (options.progress) options.progress("diagnose: " + d.words.back());
     }
   }

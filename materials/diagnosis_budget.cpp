@@ -13,11 +13,15 @@
 namespace dem::materials {
 
 namespace detail {
-int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {
+int screen_passes(const CalibrationOptions& o, int effects, int walls) {
   if (effects + walls == 0) return 0;
   const int screened = effects + (o.wall_candidates ? walls : 0);
-  return screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1)  // two strengths
-         + o.confirm_candidates * detail::calibration_passes(o, p + 1);
+  return screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);  // two strengths
+}
+
+int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {
+  if (effects + walls == 0) return 0;
+  return screen_passes(o, effects, walls) + o.confirm_candidates * detail::calibration_passes(o, p + 1);
 }
 
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
@@ -74,7 +78,7 @@ namespace {
 
 /// The ladder of reductions applied in turn until `passes` passes of `pass` seconds fit `left`.
 BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double left, double budget, int candidates,
-                         const std::function<int(const CalibrationOptions&)>& passes) {
+                         const std::function<double(const CalibrationOptions&)>& passes) {
   BudgetPlan plan{options, {}, 0};
   const auto seconds = [&](const CalibrationOptions& o) { return passes(o) * pass; };
   struct Step {
@@ -119,12 +123,17 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
   pass /= std::max(1, options.parallel);
   return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::diagnosis_passes(o, p, effects, walls); });
+                       [&](const CalibrationOptions& o) { return static_cast<double>(detail::diagnosis_passes(o, p, effects, walls)); });
 }
 
 BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget) {
-  return fit_to_budget(options, pass, left, budget, effects + walls,
-                       [&](const CalibrationOptions& o) { return detail::screen_and_confirmation_passes(o, p, effects, walls); });
+  // Passes of the plain model's cost: a candidate's simulations cost more (kScreenCost,
+  // kConfirmationCost).
+  return fit_to_budget(options, pass, left, budget, effects + walls, [&](const CalibrationOptions& o) {
+    if (effects + walls == 0) return 0.0;
+    return detail::kScreenCost * detail::screen_passes(o, effects, walls) +
+           detail::kConfirmationCost * o.confirm_candidates * detail::calibration_passes(o, p + 1);
+  });
 }
 
 }  // namespace dem::materials
