@@ -51,6 +51,7 @@ struct RunArgs {
   bool resume = false;
   long variant = -1;  ///< run this variant of the case's sweep (the sweep runner's children)
   std::string rank_grid;  ///< "NXxNYxNZ": the grid of boxes under mpirun (empty: chosen)
+  std::string balance = "work";  ///< under mpirun: what the cuts balance, work or time
   bool report = true;
 };
 
@@ -192,7 +193,8 @@ int run_case(const RunArgs& args) {
     if (!(in >> grid[0] >> x1 >> grid[1] >> x2 >> grid[2]) || x1 != 'x' || x2 != 'x' || !in.eof() || grid[0] < 1 || grid[1] < 1 || grid[2] < 1)
       throw dem::CaseError(fmt::format("--rank-grid '{}': expected three box counts as NXxNYxNZ, for example 2x2x1", args.rank_grid));
   }
-  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid) : nullptr;
+  const dem::app::mpi::Balance balance = args.balance == "time" ? dem::app::mpi::Balance::time : dem::app::mpi::Balance::work;
+  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid, true, balance) : nullptr;
   if (world.active() && !domain && grid[0] > 0 && world.size > 1) throw dem::CaseError(fmt::format("--rank-grid {}: {}", args.rank_grid, domain_note));
   if (world.active() && !domain) {  // cannot be split: rank 0 runs it alone, the others wait
     if (world.rank != 0) return 0;
@@ -320,7 +322,10 @@ int main(int argc, char** argv) {
     cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
     cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
     cmd->add_option("--rank-grid", args.rank_grid, "under mpirun: the grid of boxes, NXxNYxNZ (default: chosen from the domain's shape)");
-    cmd->add_flag("--resume", args.resume, "continue from OUT/checkpoint.bin (written every output.checkpoint_every, and on SIGINT/SIGTERM)");
+    cmd->add_option("--balance", args.balance,
+                    "under mpirun: what the cuts balance: work (particles and contacts, reproducible) or time (each rank's measured computing time)")
+        ->check(CLI::IsMember({"work", "time"}));
+    cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
   };
   app.add_option("case", args.case_path, "case file (YAML) to run");
   add_run_options(&app);

@@ -103,8 +103,8 @@ std::array<int, 3> choose_grid(int ranks, const double extent[3], const bool per
 
 class MpiDomain final : public Domain {
  public:
-  MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested, bool neighbour_migration)
-      : local_(model), neighbour_migration_(neighbour_migration) {
+  MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested, bool neighbour_migration, Balance balance)
+      : local_(model), neighbour_migration_(neighbour_migration), balance_(balance) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (model.has_attached)
@@ -200,6 +200,8 @@ class MpiDomain final : public Domain {
 
   const Model& local_model() const override { return local_; }
   bool root() const override { return rank_ == 0; }
+  int rank() const override { return rank_; }
+  int ranks() const override { return size_; }
 
   bool any(bool mine) override {
     Timed timed{step_seconds_};
@@ -526,72 +528,8 @@ class MpiDomain final : public Domain {
 
   State gather(const State& s) override {
     Timed timed{gather_seconds_};
-    const int width = local_.history_width;
-    std::vector<double> mine;
-    // Header: particles, pair rows, wall rows, lost, lost mass, then per outlet mass and count.
-    const size_t owned = s.owned();
-    const HistoryRows pairs = histories_by_id(s.pairs, s, width, false), walls = histories_by_id(s.wall_pairs, s, width, true);
-    mine.insert(mine.end(), {static_cast<double>(owned), static_cast<double>(pairs.size()), static_cast<double>(walls.size()),
-                             static_cast<double>(s.lost), s.lost_mass, static_cast<double>(s.bodies.size())});
-    for (const OutletState& o : s.outlets) mine.insert(mine.end(), {o.removed_mass, static_cast<double>(o.removed)});
-    for (const TriangleRecords& r : s.records)
-      for (const auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy})
-        mine.insert(mine.end(), c->begin(), c->end());
-    for (size_t b = 0; b < s.bodies.size(); ++b) s.pack_body(b, mine);
-    for (size_t p = 0; p < owned; ++p) s.pack(p, mine);
-    for (const HistoryRows* rows : {&pairs, &walls})
-      for (size_t q = 0; q < rows->size(); ++q) rows->pack(q, width, mine);
-    const std::vector<std::vector<double>> parts = gather_to_root(mine);
-    State whole = s;
-    whole.compact(std::vector<std::uint8_t>(s.size(), 0));
-    whole.ghosts = 0;
-    whole.pairs.clear(), whole.wall_pairs.clear();
-    whole.x_built.clear(), whole.y_built.clear(), whole.z_built.clear();
-    whole.candidate_begin.assign(1, 0), whole.mesh_candidates.clear();
-    if (rank_ != 0) return whole;
-    whole.lost = 0, whole.lost_mass = 0;
-    for (OutletState& o : whole.outlets) o = {};
-    for (TriangleRecords& r : whole.records)
-      for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) std::fill(c->begin(), c->end(), 0.0);
-    const size_t record = s.record_size();
-    HistoryRows all_pairs, all_walls;
-    for (const std::vector<double>& part : parts) {
-      const double* in = part.data();
-      const size_t particles = static_cast<size_t>(in[0]), pair_rows = static_cast<size_t>(in[1]), wall_rows = static_cast<size_t>(in[2]);
-      whole.lost += static_cast<std::int64_t>(in[3]), whole.lost_mass += in[4];
-      const size_t bodies = static_cast<size_t>(in[5]);
-      in += 6;
-      for (OutletState& o : whole.outlets) o.removed_mass += in[0], o.removed += static_cast<std::int64_t>(in[1]), in += 2;
-      for (TriangleRecords& r : whole.records)
-        for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy})
-          for (double& v : *c) v += *in++;
-      const std::int32_t first_body = static_cast<std::int32_t>(whole.bodies.size());
-      for (size_t k = 0; k < bodies; ++k, in += State::kBodyRecord) whole.unpack_body(in);
-      for (size_t k = 0; k < particles; ++k, in += record) {
-        whole.unpack(in);
-        if (whole.body.back() >= 0) whole.body.back() += first_body;
-      }
-      in = all_pairs.unpack(in, pair_rows, width);
-      all_walls.unpack(in, wall_rows, width);
-    }
-    // The lists by slot, as the engine keeps them (rebuild_contacts carries them by id).
-    std::unordered_map<std::int64_t, std::int32_t> slot_of;
-    for (size_t p = 0; p < whole.size(); ++p) slot_of[whole.id[p]] = static_cast<std::int32_t>(p);
-    for (size_t q = 0; q < all_pairs.size(); ++q) {
-      const auto a = slot_of.find(all_pairs.a[q]), b = slot_of.find(all_pairs.b[q]);
-      if (a == slot_of.end() || b == slot_of.end()) continue;
-      whole.pairs.i.push_back(a->second), whole.pairs.j.push_back(b->second);
-      whole.pairs.history.insert(whole.pairs.history.end(), all_pairs.rows.begin() + static_cast<std::ptrdiff_t>(q * width),
-                                 all_pairs.rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
-    }
-    for (size_t q = 0; q < all_walls.size(); ++q) {
-      const auto a = slot_of.find(all_walls.a[q]);
-      if (a == slot_of.end()) continue;
-      whole.wall_pairs.i.push_back(a->second), whole.wall_pairs.j.push_back(static_cast<std::int32_t>(all_walls.b[q]));
-      whole.wall_pairs.history.insert(whole.wall_pairs.history.end(), all_walls.rows.begin() + static_cast<std::ptrdiff_t>(q * width),
-                                      all_walls.rows.begin() + static_cast<std::ptrdiff_t>((q + 1) * width));
-    }
-    return whole;
+    const std::vector<std::vector<double>> parts = gather_to_root(pack_share(s, local_.history_width));
+    return rank_ == 0 ? merge_shares(s, parts, local_.history_width) : shared_part(s);
   }
 
   std::string statistics() const override {
@@ -611,7 +549,8 @@ class MpiDomain final : public Domain {
       for (double c : cuts_[a]) at += fmt::format("{}{:.4g}", at.empty() ? "" : ", ", c);
       cuts += fmt::format("{}{} at {} m{}", cuts.empty() ? "" : "; ", "xyz"[a], at, periodic_[a] ? " across the period" : "");
     }
-    return fmt::format("{} ranks as a {} x {} x {} grid of boxes (cuts: {}), ghost reach {:.3g} m", size_, dims_[0], dims_[1], dims_[2], cuts, reach_);
+    return fmt::format("{} ranks as a {} x {} x {} grid of boxes (cuts: {}), ghost reach {:.3g} m, balanced by {}", size_, dims_[0], dims_[1], dims_[2],
+                       cuts, reach_, balance_ == Balance::time ? "measured time" : "particles and contacts");
   }
 
  private:
@@ -674,9 +613,11 @@ class MpiDomain final : public Domain {
   /// New cuts when the most loaded rank carries more than kImbalance times the mean work
   /// (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
   /// history: in a dense bed the contacts, not the particles, cost the time); each cut axis gets
-  /// its cuts at the quantiles of the work along it.
-  /// Moves the cuts to the quantiles of the work when the busiest rank carries more than
-  /// kImbalance times the mean; returns whether it did (the same on every rank).
+  /// its cuts at the quantiles of the work along it. Balanced by time (Balance::time), a rank's
+  /// work is the time it computed since the last rebuild (its wall time less the time in
+  /// communication and packing), shared among its particles by their work: what a pair across a
+  /// face, a mesh contact or a slower core costs is then measured, not modelled.
+  /// Returns whether the cuts moved (the same on every rank).
   bool rebalance(const State& s, const HistoryRows& pairs, const HistoryRows& walls) {
     const size_t n = s.size();
     std::unordered_map<std::int64_t, double> contacts;
@@ -689,6 +630,14 @@ class MpiDomain final : public Domain {
       if (it != contacts.end()) work[p] += it->second;
       mine += work[p];
     }
+    if (balance_ == Balance::time) {
+      const double now = MPI_Wtime(), communicated = step_seconds_ + rebuild_seconds_ + gather_seconds_;
+      const double computed = std::max(0.0, (now - balanced_at_) - (communicated - communicated_at_));
+      balanced_at_ = now, communicated_at_ = communicated;
+      const double per_work = mine > 0 ? computed / mine : 0.0;
+      for (double& w : work) w *= per_work;
+      mine = computed;
+    }
     double stats[7] = {mine};  // work, then -low and high along each axis
     for (int a = 0; a < 3; ++a) {
       double lo = kInfinity, hi = -kInfinity;
@@ -698,7 +647,8 @@ class MpiDomain final : public Domain {
     double most[7];
     check(MPI_Allreduce(stats, most, 7, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
     const double total = sum(mine);
-    if (total < size_ || most[0] <= kImbalance * total / size_) return false;
+    if (balance_ == Balance::work ? total < size_ : !(total > 0)) return false;
+    if (most[0] <= kImbalance * total / size_) return false;
     for (int a = 0; a < 3; ++a) {
       if (dims_[a] == 1) continue;
       const double lo = periodic_[a] ? low_[a] : -most[1 + 2 * a], hi = periodic_[a] ? low_[a] + period_[a] : most[2 + 2 * a];
@@ -804,6 +754,8 @@ class MpiDomain final : public Domain {
   std::int64_t migrated_ = 0, rebalances_ = 0, rebuilds_ = 0, refreshes_ = 0, ghosts_ = 0;
   std::int64_t migrations_near_ = 0, migrations_all_ = 0;  // rebuilds whose migration went to the neighbours, all to all
   bool neighbour_migration_ = true;
+  Balance balance_ = Balance::work;
+  double balanced_at_ = MPI_Wtime(), communicated_at_ = 0;  // [s] wall clock and time in communication at the last rebalance check
   std::vector<int> near_;  // the neighbours' ranks (each once, not this one), ascending
   double step_seconds_ = 0, rebuild_seconds_ = 0, gather_seconds_ = 0;  // [s] in MPI and packing
   double bytes_ = 0;  // [B] sent by this rank
@@ -811,12 +763,13 @@ class MpiDomain final : public Domain {
 
 }  // namespace
 
-std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid, bool neighbour_migration) {
+std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid, bool neighbour_migration,
+                                    Balance balance) {
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size < 2) return nullptr;
   try {
-    auto domain = std::make_unique<MpiDomain>(model, initial, grid, neighbour_migration);
+    auto domain = std::make_unique<MpiDomain>(model, initial, grid, neighbour_migration, balance);
     if (note) *note = domain->describe();
     return domain;
   } catch (const CaseError& e) {
@@ -827,7 +780,7 @@ std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, st
 
 #else
 
-std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*, const std::array<int, 3>&, bool) { return nullptr; }
+std::unique_ptr<Domain> make_domain(const Model&, const State&, std::string*, const std::array<int, 3>&, bool, Balance) { return nullptr; }
 
 #endif
 

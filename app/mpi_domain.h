@@ -6,8 +6,10 @@
 // (a periodic axis counts with its period, the axis of gravity at half its extent: particles
 // travel along it), with every box at least one ghost reach wide along each axis it is cut across.
 // The cuts along each axis sit at quantiles of the work (a particle weighs one plus its
-// contacts), recomputed at a rebuild when the most loaded rank carries more than 10 % above the
-// mean. The outer boxes of a non-periodic axis reach to infinity; along a periodic axis the last
+// contacts; or, with Balance::time, each rank's measured computing time since the last rebuild,
+// shared among its particles by that weight), recomputed at a rebuild when the most loaded rank
+// carries more than 10 % above the mean. Time-balanced cuts depend on the machine's timing, so
+// such runs are not reproducible bit for bit; the default is reproducible. The outer boxes of a non-periodic axis reach to infinity; along a periodic axis the last
 // box's upper neighbour is the first, seen one period on.
 //
 // Ghosts: of its up to 26 neighbours, a rank receives the particles of the 13 that lie above it
@@ -23,7 +25,8 @@
 // Clumps belong to the rank of their centre and move with all their spheres; the ghost layer and
 // the narrowest box are deeper by how far a clump's spheres stick out. Not decomposed: spheres
 // glued to walls (a shear cell; such a case runs on rank 0 alone). Rank 0 gathers the whole
-// state for every row of scalars, frame and checkpoint.
+// state for every frame; rows of scalars are sums over the ranks and checkpoints are written by
+// every rank (output/checkpoint.h).
 #pragma once
 
 #include <array>
@@ -39,7 +42,9 @@ namespace dem::app::mpi {
 /// then `note` says why, and the case runs on rank 0 alone. `grid` (nx, ny, nz; zeros: chosen)
 /// asks for a rank grid, whose boxes must have the ranks' count and one reach's width.
 /// `neighbour_migration` false sends every migration all to all (for tests: the state is the same).
+/// `balance` is what the cuts balance (the header above).
+enum class Balance { work, time };
 std::unique_ptr<Domain> make_domain(const Model& model, const State& initial, std::string* note, const std::array<int, 3>& grid = {0, 0, 0},
-                                    bool neighbour_migration = true);
+                                    bool neighbour_migration = true, Balance balance = Balance::work);
 
 }  // namespace dem::app::mpi

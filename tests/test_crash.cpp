@@ -302,6 +302,109 @@ TEST(KillAndResumeLong, DiagnoseOfAShippedFileKilledThenRerunWritesTheSameLedger
             << rerun_seconds << " s; same ledger\n";
 }
 
+#ifdef DEMDESIGN_MPIEXEC
+/// Starts `mpirun -np ranks demdesign args` in a process group of its own (killing the group
+/// kills every rank at once, as a node failure would), output to `log`.
+pid_t start_ranks(int ranks, const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, STDOUT_FILENO), ::dup2(fd, STDERR_FILENO);
+    for (const char* v : {"OMPI_ALLOW_RUN_AS_ROOT", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM"}) ::setenv(v, "1", 1);
+    ::setenv("OMP_NUM_THREADS", "1", 1), ::setenv("OMP_WAIT_POLICY", "passive", 1);
+    std::vector<std::string> all{DEMDESIGN_MPIEXEC, "-np", std::to_string(ranks), "--oversubscribe", DEMDESIGN_BINARY};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(DEMDESIGN_MPIEXEC, argv.data());
+    ::_exit(127);
+  }
+  ::setpgid(pid, pid);
+  return pid;
+}
+
+/// The last row of OUT/scalars.csv by column name.
+std::map<std::string, double> last_scalars(const fs::path& out) {
+  std::istringstream in(read_text(out / "scalars.csv"));
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  std::map<std::string, double> row;
+  std::istringstream names(header), values(last);
+  for (std::string name, value; std::getline(names, name, ',') && std::getline(values, value, ',');) row[name] = std::stod(value);
+  return row;
+}
+
+std::string end_line(const fs::path& out, const std::string& key) {
+  const std::string info = read_text(out / "run_info.yaml");
+  const auto at = info.find("  " + key + ": ", info.find("end:"));
+  return at == std::string::npos ? "" : info.substr(at, info.find('\n', at) - at);
+}
+
+// A run split over 4 ranks is killed with SIGKILL (every rank at once) at a seeded random moment
+// after a seeded number of per-rank checkpoints, and resumed on 4 ranks and on 2. The resumed run
+// cuts its boxes again from the particles it reads, so its forces are summed in another order
+// than the uninterrupted run's: the two agree to round-off at the checkpoint, and the flow off
+// the plate then scatters them as two runs of one case on different rank counts scatter. The
+// resumed run ends at the uninterrupted run's step and time; the mass inserted (the inlet's
+// random stream is part of the checkpoint) agrees within 1 %, the mass the outlet removed and the
+// particles left on the plate within 10 %.
+TEST(KillAndResume, SplitRunKilledOnFourRanksResumesOnFourAndOnTwo) {
+  const fs::path c = checkpoint_case();
+  const fs::path reference = kScratch / "split_reference";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start_ranks(4, run_args(c, reference), kScratch / "split_reference.log")), 0) << read_text(kScratch / "split_reference.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(fs::exists(reference / "checkpoint.ranks.bin"));
+  EXPECT_FALSE(fs::exists(reference / "checkpoint.bin")) << "no rank gathers the state for a checkpoint";
+  const std::map<std::string, double> expected = last_scalars(reference);
+  std::mt19937 random(20261205);
+  for (const int resume_on : {4, 2}) {
+    const fs::path out = kScratch / ("split_trial" + std::to_string(resume_on));
+    const int checkpoints_before_kill = std::uniform_int_distribution<int>(2, 20)(random);
+    const double part_of_interval = std::uniform_real_distribution<double>(0.0, 0.9)(random);
+    const pid_t pid = start_ranks(4, run_args(c, out), kScratch / "split_trial.log");
+    int seen = 0;
+    ino_t last = 0;
+    auto last_seen = std::chrono::steady_clock::now();
+    double interval = 0.0;
+    while (seen < checkpoints_before_kill && ::waitpid(pid, nullptr, WNOHANG) == 0) {
+      struct stat info {};
+      if (::stat((out / "checkpoint.ranks.bin").c_str(), &info) == 0 && info.st_ino != last) {
+        last = info.st_ino;
+        const auto now = std::chrono::steady_clock::now();
+        if (seen > 0) interval = std::chrono::duration<double>(now - last_seen).count();
+        last_seen = now, ++seen;
+      }
+      std::this_thread::sleep_for(1ms);
+    }
+    std::this_thread::sleep_for(std::chrono::duration<double>(part_of_interval * interval));
+    const bool running = ::kill(-pid, SIGKILL) == 0;
+    const int status = wait_exit(pid);
+    EXPECT_TRUE(running && status == 128 + SIGKILL) << "the run ended before the kill: " << read_text(kScratch / "split_trial.log");
+    auto args = run_args(c, out);
+    args.push_back("--resume");
+    const fs::path log = kScratch / ("split_resume" + std::to_string(resume_on) + ".log");
+    ASSERT_EQ(wait_exit(start_ranks(resume_on, args, log)), 0) << read_text(log);
+    EXPECT_NE(read_text(log).find("and the shares of 4 ranks"), std::string::npos) << read_text(log);
+    for (const std::string key : {"completed", "step", "time_s"}) EXPECT_EQ(end_line(out, key), end_line(reference, key)) << key;
+    const std::map<std::string, double> got = last_scalars(out);
+    std::printf("killed after %d checkpoints, resumed on %d ranks: particles %.0f (uninterrupted %.0f), inserted %.6g kg (%.6g), "
+                "removed %.6g kg (%.6g), kinetic %.4g J (%.4g)\n",
+                checkpoints_before_kill, resume_on, got.at("particles"), expected.at("particles"), got.at("inserted_mass_kg"),
+                expected.at("inserted_mass_kg"), got.at("removed_mass_kg"), expected.at("removed_mass_kg"), got.at("kinetic_translation_J"),
+                expected.at("kinetic_translation_J"));
+    EXPECT_NEAR(got.at("inserted_mass_kg"), expected.at("inserted_mass_kg"), 0.01 * expected.at("inserted_mass_kg"));
+    EXPECT_NEAR(got.at("removed_mass_kg"), expected.at("removed_mass_kg"), 0.1 * expected.at("removed_mass_kg"));
+    EXPECT_NEAR(got.at("particles"), expected.at("particles"), 0.1 * expected.at("particles"));
+  }
+  std::printf("uninterrupted run on 4 ranks: %.1f s\n", seconds);
+}
+#endif
+
 TEST(KillAndResume, SigtermWritesACheckpointAndExitsCleanly) {
   const fs::path c = checkpoint_case();
   const fs::path out = kScratch / "sigterm";

@@ -39,13 +39,13 @@ struct Outcome {
 };
 
 Outcome simulate(const CaseSpec& spec, bool decomposed, double duration, const std::array<int, 3>& grid = {0, 0, 0}, long ghost_pass_parallel_min = -1,
-                 bool neighbour_migration = true) {
+                 bool neighbour_migration = true, mpi::Balance balance = mpi::Balance::work) {
   const Model model = compile(spec);
   Outcome out;
   State state = initial_state(model);
   Workspace work;
   if (ghost_pass_parallel_min >= 0) work.ghost_pass_parallel_min = ghost_pass_parallel_min;
-  std::unique_ptr<Domain> domain = decomposed ? mpi::make_domain(model, state, &out.note, grid, neighbour_migration) : nullptr;
+  std::unique_ptr<Domain> domain = decomposed ? mpi::make_domain(model, state, &out.note, grid, neighbour_migration, balance) : nullptr;
   RunOptions options;
   options.write_files = false;
   options.progress = false;
@@ -262,13 +262,33 @@ TEST(DomainMpi, GhostPassOnTwoThreadsSumsAsOnOne) {
 TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
   // The shipped settling bed (rolling resistance, liquid bridges), 2,000 beads poured from a tall
   // region: two ranks cut z (twice as tall as wide, so even at half weight), most beads fall
-  // from the upper rank to the lower, the cuts move with them (balance by particle count). At
-  // rest the floor carries the weight.
+  // from the upper rank to the lower, the cuts move with them (balance by particles and
+  // contacts; and, in a third run, by each rank's measured computing time). At rest the floor
+  // carries the weight.
   CaseSpec spec = parse_case_file(DEMDESIGN_SOURCE_DIR "/cases/settling_bed.yaml");
   spec.particles[0].count = 2000;
   const double duration = 0.3;
   const Runs runs = whole_and_split(spec, duration);
+  const Outcome timed = simulate(spec, true, duration, {0, 0, 0}, -1, true, mpi::Balance::time);
+  // The beads gather on the lower ranks: their measured time exceeds the mean, the cuts move.
+  const auto rebalances = [](const std::string& statistics) {
+    const size_t at = statistics.find(" rebalances");
+    size_t start = at;
+    while (start != std::string::npos && start > 0 && std::isdigit(static_cast<unsigned char>(statistics[start - 1]))) --start;
+    return at != std::string::npos && start < at ? std::stol(statistics.substr(start, at - start)) : -1L;
+  };
+  EXPECT_GT(rebalances(timed.statistics), 0) << timed.statistics;
   if (!root()) return;
+  EXPECT_NE(timed.note.find("balanced by measured time"), std::string::npos) << timed.note;
+  {
+    double weight = 0;
+    for (size_t p = 0; p < timed.whole.size(); ++p) weight += 9.81 / timed.whole.inv_mass[p];
+    const double f = mean_over(timed.rows, duration - 0.05, duration, [](const Scalars& r) { return r.wall_normal_force[0]; });
+    std::printf("  balanced by time: %s; floor %.5g N (weight %.5g N)\n", timed.statistics.c_str(), f, weight);
+    ASSERT_EQ(timed.whole.size(), runs.whole.whole.size());
+    EXPECT_LT(timed.rows.back().kinetic_translation, 1e-3) << "the time-balanced run must have settled";
+    EXPECT_NEAR(f, weight, 0.03 * weight) << "the floor carries the weight (time-balanced run)";
+  }
   const Outcome &whole = runs.whole, &split = runs.split;
   ASSERT_EQ(split.whole.size(), whole.whole.size());
   double weight = 0;

@@ -64,6 +64,9 @@ class Domain {
   virtual const Model& local_model() const = 0;
   /// Whether this rank writes the results (rank 0).
   virtual bool root() const = 0;
+  /// This rank's number (the root's is 0) and how many ranks share the run (per-rank checkpoints).
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
   /// Keeps this rank's share of a whole state (the same on every rank: the initial state or a
   /// checkpoint); its contact histories are kept for the first rebuild.
   virtual void distribute(State& state) = 0;
@@ -84,6 +87,17 @@ class Domain {
 
 /// Removes the ghost slots (they are rebuilt from their owners).
 void drop_ghosts(State& state);
+
+/// One rank's share of a whole state as numbers: its counters (lost particles, outlets), its
+/// part of the mesh records, its owned bodies and particles and the histories of the contacts
+/// it lists, keyed by particle id. What gather() sends to the root and a per-rank checkpoint holds.
+std::vector<double> pack_share(const State& state, int history_width);
+/// The whole state from every rank's share: `like` gives what the ranks hold alike (time, step,
+/// walls, inlets, meshes); its particles, lists and counters are replaced by the shares'
+/// (counters and records summed, particles appended in share order, lists by slot).
+State merge_shares(const State& like, const std::vector<std::vector<double>>& shares, int history_width);
+/// `like` without its particles, bodies, lists and run totals: what merge_shares keeps of it.
+State shared_part(const State& like);
 
 /// A whole state gathered on the root, made ready for results: `state` with its lists rebuilt
 /// and histories carried (frames, checkpoints), `evaluated` a copy with this instant's contact

@@ -2,18 +2,24 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <optional>
 #include <type_traits>
+
+#include "core/domain.h"
 
 namespace dem {
 
 namespace {
 
 constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
+/// A rank's share: magic, model hash, step, rank, ranks, count, then `count` doubles.
+constexpr char kShareMagic[8] = {'D', 'E', 'M', 'S', 'H', 'A', 'R', '1'};
 /// Version 5 lacks State::lists_drift_velocity: read as zero, which is always a valid drift
 /// (verlet.h), so its runs resume.
 constexpr char kMagic5[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
@@ -123,6 +129,119 @@ State load_checkpoint(const std::string& path, const Model& model) {
   State state;
   visit(reader, state, version);
   return state;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path shares_directory(const std::string& directory) { return fs::path(directory) / "checkpoint.ranks"; }
+
+std::string share_name(std::int64_t step, int rank, int ranks) { return fmt::format("step-{}.rank-{}-of-{}.bin", step, rank, ranks); }
+
+/// A share file's step, rank and ranks' count, from its name; nullopt for any other file
+/// (a temporary one among them).
+struct ShareName {
+  std::int64_t step;
+  int rank, ranks;
+};
+std::optional<ShareName> parse_share_name(const fs::path& file) {
+  long long step = 0;
+  int rank = 0, ranks = 0;
+  if (std::sscanf(file.filename().c_str(), "step-%lld.rank-%d-of-%d", &step, &rank, &ranks) != 3) return std::nullopt;
+  if (file.filename() != share_name(step, rank, ranks)) return std::nullopt;
+  return ShareName{step, rank, ranks};
+}
+
+/// The ranks' count of the shares of `step` in `shares`, from their names (0 when there are none).
+int share_count(const fs::path& shares, std::int64_t step) {
+  int count = 0;
+  std::error_code error;
+  for (const fs::directory_entry& e : fs::directory_iterator(shares, error))
+    if (const std::optional<ShareName> name = parse_share_name(e.path()); name && name->step == step) count = std::max(count, name->ranks);
+  return count;
+}
+
+std::vector<double> load_share(const fs::path& path, const Model& model, std::int64_t step, int rank, int ranks) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw std::runtime_error(fmt::format("{}: the share of rank {} of {} at step {} is missing; this per-rank checkpoint cannot be resumed",
+                                         path.string(), rank, ranks, step));
+  Reader reader{in, path.string(), static_cast<std::uint64_t>(fs::file_size(path))};
+  char magic[sizeof kShareMagic];
+  reader.read(magic, sizeof magic);
+  if (std::memcmp(magic, kShareMagic, sizeof magic) != 0) throw std::runtime_error(fmt::format("{}: not a demdesign checkpoint share of this version", path.string()));
+  std::uint64_t hash = 0;
+  std::int64_t at = 0;
+  std::int32_t r = 0, n = 0;
+  reader(hash), reader(at), reader(r), reader(n);
+  if (hash != model.hash) throw std::runtime_error(fmt::format("{}: the share belongs to a different model; run without --resume to start again", path.string()));
+  if (at != step || r != rank || n != ranks) throw std::runtime_error(fmt::format("{}: the share's header does not match its name", path.string()));
+  std::vector<double> share;
+  reader(share);
+  return share;
+}
+
+}  // namespace
+
+void save_checkpoint_share(const std::string& directory, const Model& model, std::int64_t step, int rank, int ranks,
+                           const std::vector<double>& share) {
+  const fs::path shares = shares_directory(directory);
+  fs::create_directories(shares);
+  const fs::path target = shares / share_name(step, rank, ranks);
+  const std::string temporary = target.string() + ".part";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(kShareMagic, sizeof kShareMagic);
+    Writer writer{out};
+    writer(model.hash), writer(static_cast<std::int64_t>(step)), writer(static_cast<std::int32_t>(rank)), writer(static_cast<std::int32_t>(ranks));
+    writer(share);
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write the checkpoint share (disk full?)", temporary));
+  }
+  fs::rename(temporary, target);
+}
+
+void commit_checkpoint_shares(const std::string& directory, const Model& model, const State& like) {
+  save_checkpoint((fs::path(directory) / "checkpoint.ranks.bin").string(), model, shared_part(like));
+  std::error_code error;
+  fs::remove(fs::path(directory) / "checkpoint.bin", error);
+  std::vector<fs::path> stale;
+  for (const fs::directory_entry& e : fs::directory_iterator(shares_directory(directory), error)) {
+    const std::optional<ShareName> name = parse_share_name(e.path());
+    if (e.path().extension() == ".part" || (name && name->step != like.step)) stale.push_back(e.path());
+  }
+  for (const fs::path& p : stale) fs::remove(p, error);
+}
+
+void save_whole_checkpoint(const std::string& directory, const Model& model, const State& state) {
+  save_checkpoint((fs::path(directory) / "checkpoint.bin").string(), model, state);
+  std::error_code error;
+  fs::remove(fs::path(directory) / "checkpoint.ranks.bin", error);
+  fs::remove_all(shares_directory(directory), error);
+}
+
+State load_resumable(const std::string& directory, const Model& model, std::string* from) {
+  const fs::path whole_path = fs::path(directory) / "checkpoint.bin", ranks_path = fs::path(directory) / "checkpoint.ranks.bin";
+  const bool whole_exists = fs::exists(whole_path), ranks_exist = fs::exists(ranks_path);
+  if (!whole_exists && !ranks_exist) throw std::runtime_error(fmt::format("{}: no checkpoint to resume from", whole_path.string()));
+  std::optional<State> whole;
+  if (whole_exists) whole = load_checkpoint(whole_path.string(), model);
+  if (ranks_exist) {
+    const State like = load_checkpoint(ranks_path.string(), model);
+    if (!whole || like.step > whole->step) {
+      const fs::path shares = shares_directory(directory);
+      const int ranks = share_count(shares, like.step);
+      if (ranks == 0) throw std::runtime_error(fmt::format("{}: no share of step {} in {}; this per-rank checkpoint cannot be resumed",
+                                                           ranks_path.string(), like.step, shares.string()));
+      std::vector<std::vector<double>> parts;
+      for (int rank = 0; rank < ranks; ++rank) parts.push_back(load_share(shares / share_name(like.step, rank, ranks), model, like.step, rank, ranks));
+      if (from) *from = fmt::format("{} and the shares of {} ranks in {}", ranks_path.string(), ranks, shares.string());
+      return merge_shares(like, parts, model.history_width);
+    }
+  }
+  if (from) *from = whole_path.string();
+  return std::move(*whole);
 }
 
 }  // namespace dem

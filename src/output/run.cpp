@@ -252,7 +252,6 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   RunSummary summary;
   summary.output_directory = options.output_directory.empty() ? model.output.directory : options.output_directory;
   const std::string out = summary.output_directory;
-  const std::string checkpoint_path = out + "/checkpoint.bin";
   const double duration = options.duration >= 0 ? options.duration : model.duration;
   const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
   // Under domain decomposition every rank steps its share with the domain's model; the root
@@ -263,9 +262,10 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   work.domain = domain;
 
   if (options.resume) {
-    state = load_checkpoint(checkpoint_path, model);
+    std::string from;
+    state = load_resumable(out, model, &from);
     if (writer) summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
-    if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", checkpoint_path, state.time, state.step);
+    if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", from, state.time, state.step);
   }
   if (writer) print_setup(model, state, log);
   EnergyWatch energy(model, state, model.energy_rise_limit);
@@ -392,7 +392,8 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     const bool scalars_due = state.step % every == 0 || last;
     const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
     const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
-    if (domain && (frame_due || checkpoint_due || last || stopping)) gather_whole();
+    // A checkpoint needs no gather: each rank writes its share (checkpoint.h).
+    if (domain && (frame_due || last || stopping)) gather_whole();
     if (check_due) {
       // Under domain decomposition every rank's energy, summed before any rank may throw; the
       // root judges it.
@@ -439,8 +440,24 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       write_frame(*frames, *results);
       if (options.on_frame) options.on_frame(model, *results, *results_work, out, last);
     }
-    if (checkpoint_due && writer) {
-      save_checkpoint(checkpoint_path, model, *results);
+    if (checkpoint_due && domain) {
+      // Every rank's share on disk before the root names the step: a failed write on any rank
+      // stops every rank, the last complete checkpoint kept.
+      std::string failed;
+      try {
+        save_checkpoint_share(out, model, state.step, domain->rank(), domain->ranks(), pack_share(state, stepped.history_width));
+      } catch (const std::exception& e) {
+        failed = e.what();
+      }
+      if (domain->any(!failed.empty()))
+        throw std::runtime_error(failed.empty() ? fmt::format("t = {:.6g} s: another rank could not write its checkpoint share (its log says why)", state.time)
+                                                : failed);
+      if (writer) {
+        commit_checkpoint_shares(out, model, state);
+        write_tables();
+      }
+    } else if (checkpoint_due && writer) {
+      save_whole_checkpoint(out, model, *results);
       write_tables();
     }
     if (stopping) {

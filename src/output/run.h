@@ -24,7 +24,7 @@ struct RunOptions {
   std::string output_directory;   ///< overrides the case's when not empty
   bool write_files = true;
   bool progress = true;
-  bool resume = false;            ///< continue from OUT/checkpoint.bin
+  bool resume = false;            ///< continue from OUT's checkpoint (load_resumable, checkpoint.h)
   /// Called after each particle frame is written (the app renders images here; the engine
   /// knows nothing of rendering). `last` is true for the final frame of the run.
   std::function<void(const Model&, const State&, const Workspace&, const std::string& out, bool last)> on_frame;
@@ -47,7 +47,8 @@ struct RunSummary {
 void print_setup(const Model& model, const State& state, std::ostream& log);
 
 /// Runs from the state as it is (prepare() is called here) to the model's end time. With
-/// options.resume the state is replaced by OUT/checkpoint.bin. `log` gets the set-up, progress
+/// options.resume the state is replaced by OUT's checkpoint (checkpoint.bin, or under domain
+/// decomposition every rank's share, checkpoint.h). `log` gets the set-up, progress
 /// and summary lines. SIGINT and SIGTERM stop the run after the current step with a checkpoint.
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
 
