@@ -152,6 +152,8 @@ int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls)
 int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls);
 /// The signature screen's part of it.
 int screen_passes(const CalibrationOptions& o, int effects, int walls);
+/// The same with the screen's passes counted `screen` times and the confirmations' `confirmation` times.
+double weighted_screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls, double screen, double confirmation);
 /// What a simulation of the signature screen and of a confirmation costs against one of the model
 /// as it is, which the plan after its calibration has measured: a candidate's effect (cohesion,
 /// liquid bridges, clumps) slows the flows. On the cross-engine sets (tests/data/cross_engine,

@@ -19,9 +19,13 @@ int screen_passes(const CalibrationOptions& o, int effects, int walls) {
   return screened * (std::max(1, std::min(o.replicas, o.signature_replicas)) + 1);  // two strengths
 }
 
+double weighted_screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls, double screen, double confirmation) {
+  if (effects + walls == 0) return 0.0;
+  return screen * screen_passes(o, effects, walls) + confirmation * o.confirm_candidates * detail::calibration_passes(o, p + 1);
+}
+
 int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {
-  if (effects + walls == 0) return 0;
-  return screen_passes(o, effects, walls) + o.confirm_candidates * detail::calibration_passes(o, p + 1);
+  return static_cast<int>(weighted_screen_and_confirmation_passes(o, p, effects, walls, 1.0, 1.0));
 }
 
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls) {
@@ -130,9 +134,7 @@ BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double p
   // Passes of the plain model's cost: a candidate's simulations cost more (kScreenCost,
   // kConfirmationCost).
   return fit_to_budget(options, pass, left, budget, effects + walls, [&](const CalibrationOptions& o) {
-    if (effects + walls == 0) return 0.0;
-    return detail::kScreenCost * detail::screen_passes(o, effects, walls) +
-           detail::kConfirmationCost * o.confirm_candidates * detail::calibration_passes(o, p + 1);
+    return detail::weighted_screen_and_confirmation_passes(o, p, effects, walls, detail::kScreenCost, detail::kConfirmationCost);
   });
 }
 

@@ -100,6 +100,16 @@ bool root() { return mpi::world().rank == 0; }
 
 /// The case run whole (in this process alone) and split over the ranks; the root prints how the
 /// split was cut.
+/// The count written just before `phrase` in a domain's statistics line ("23 times to the
+/// neighbours", "45 rebalances"); -1 when the phrase or the count is missing.
+long count_before(const std::string& statistics, const std::string& phrase) {
+  const size_t at = statistics.find(phrase);
+  if (at == std::string::npos) return -1L;
+  size_t start = at;
+  while (start > 0 && std::isdigit(static_cast<unsigned char>(statistics[start - 1]))) --start;
+  return start < at ? std::stol(statistics.substr(start, at - start)) : -1L;
+}
+
 struct Runs {
   Outcome whole, split;
 };
@@ -225,16 +235,9 @@ TEST(DomainMpi, MigrationToTheNeighboursGivesTheStateOfAllToAll) {
   const std::array<int, 3> grid = gas_grid();
   const Outcome near = simulate(spec, true, 0.02, grid, -1, true), all = simulate(spec, true, 0.02, grid, -1, false);
   // Every rank's own count of migrations to the neighbours.
-  const auto times = [](const std::string& statistics, const std::string& how) {
-    const size_t at = statistics.find(how);
-    if (at == std::string::npos) return -1L;
-    size_t start = at;
-    while (start > 0 && std::isdigit(static_cast<unsigned char>(statistics[start - 1]))) --start;
-    return start < at ? std::stol(statistics.substr(start, at - start)) : -1L;
-  };
   std::printf("  rank %d: %s\n", mpi::world().rank, near.statistics.c_str());
-  EXPECT_GT(times(near.statistics, " times to the neighbours"), 0) << near.statistics;
-  EXPECT_EQ(times(all.statistics, " times to the neighbours"), 0) << all.statistics;
+  EXPECT_GT(count_before(near.statistics, " times to the neighbours"), 0) << near.statistics;
+  EXPECT_EQ(count_before(all.statistics, " times to the neighbours"), 0) << all.statistics;
   if (!root()) return;
   ASSERT_EQ(near.whole.size(), 1800u);
   EXPECT_EQ(state_hash(near.whole, compile(spec).history_width), state_hash(all.whole, compile(spec).history_width));
@@ -271,13 +274,7 @@ TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {
   const Runs runs = whole_and_split(spec, duration);
   const Outcome timed = simulate(spec, true, duration, {0, 0, 0}, -1, true, mpi::Balance::time);
   // The beads gather on the lower ranks: their measured time exceeds the mean, the cuts move.
-  const auto rebalances = [](const std::string& statistics) {
-    const size_t at = statistics.find(" rebalances");
-    size_t start = at;
-    while (start != std::string::npos && start > 0 && std::isdigit(static_cast<unsigned char>(statistics[start - 1]))) --start;
-    return at != std::string::npos && start < at ? std::stol(statistics.substr(start, at - start)) : -1L;
-  };
-  EXPECT_GT(rebalances(timed.statistics), 0) << timed.statistics;
+  EXPECT_GT(count_before(timed.statistics, " rebalances"), 0) << timed.statistics;
   if (!root()) return;
   EXPECT_NE(timed.note.find("balanced by measured time"), std::string::npos) << timed.note;
   {
