@@ -30,6 +30,7 @@
 #include "mesh_health.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
+#include "mpi_frames.h"
 #include "output/results_hdf5.h"
 #include "output/run.h"
 #include "report.h"
@@ -212,12 +213,10 @@ int run_case(const RunArgs& args) {
   options.output_directory = args.out;
   options.progress = !args.quiet;
   options.resume = args.resume;
-  // Images of the flow: every render_every-th frame, and always the last.
-  int frame_count = 0;
+  // A split run's ranks write each frame together, with no gather (parallel HDF5).
+  if (domain) options.share_frame = dem::app::mpi::collective_frames();
+  // Images of the flow: every render_every-th frame, and always the last (run.h).
   options.on_frame = [&](const dem::Model& m, const dem::State& s, const dem::Workspace&, const std::string& out, bool last) {
-    const bool due = m.output.render_every > 0 && frame_count % m.output.render_every == 0;
-    ++frame_count;
-    if (!due && !last) return;
     const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, s.step);
     std::filesystem::create_directories(out + "/renders");
     dem::app::render_state(m, s, image_options(m), path);

@@ -24,9 +24,10 @@
 //
 // Clumps belong to the rank of their centre and move with all their spheres; the ghost layer and
 // the narrowest box are deeper by how far a clump's spheres stick out. Not decomposed: spheres
-// glued to walls (a shear cell; such a case runs on rank 0 alone). Rank 0 gathers the whole
-// state for every frame; rows of scalars are sums over the ranks and checkpoints are written by
-// every rank (output/checkpoint.h).
+// glued to walls (a shear cell; such a case runs on rank 0 alone). Frames are written by
+// every rank together (mpi_frames.h), rows of scalars are sums over the ranks and checkpoints are
+// written by every rank (output/checkpoint.h); rank 0 gathers the whole state for rendered
+// frames and at the end.
 #pragma once
 
 #include <array>

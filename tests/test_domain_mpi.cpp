@@ -10,18 +10,25 @@
 #include <omp.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <numeric>
+#include <set>
 #include <sstream>
 
 #include "case/spec.h"
 #include "core/domain.h"
 #include "core/model.h"
 #include "core/particles.h"
+#include "core/step.h"
 #include "equipment.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
+#include "mpi_frames.h"
+#include "output/results_hdf5.h"
 #include "output/run.h"
 #include "statistics/diagnostics.h"
 
@@ -260,6 +267,123 @@ TEST(DomainMpi, GhostPassOnTwoThreadsSumsAsOnOne) {
   for (size_t p = 0; p < one.whole.size(); ++p)
     differ += one.whole.x[p] != two.whole.x[p] || one.whole.vy[p] != two.whole.vy[p] || one.whole.wz[p] != two.whole.wz[p];
   EXPECT_EQ(differ, 0u) << "particles whose state differs between one and two threads";
+}
+
+/// The state's own particles (no ghosts) as a frame's columns.
+ParticleFrame frame_of(const State& s) {
+  ParticleFrame f;
+  f.time = s.time, f.step = s.step, f.count = s.owned();
+  f.id = s.id.data();
+  f.x = s.x.data(), f.y = s.y.data(), f.z = s.z.data();
+  f.vx = s.vx.data(), f.vy = s.vy.data(), f.vz = s.vz.data();
+  f.wx = s.wx.data(), f.wy = s.wy.data(), f.wz = s.wz.data();
+  f.radius = s.radius.data(), f.material = s.material.data();
+  return f;
+}
+
+/// A frame's rows in the order of their particle ids.
+StoredFrame by_id(const StoredFrame& f) {
+  std::vector<size_t> order(f.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return f.id[a] < f.id[b]; });
+  StoredFrame out;
+  out.time = f.time, out.step = f.step;
+  for (size_t k : order) {
+    out.id.push_back(f.id[k]);
+    for (int c = 0; c < 3; ++c) out.position.push_back(f.position[3 * k + c]), out.velocity.push_back(f.velocity[3 * k + c]);
+    out.radius.push_back(f.radius[k]);
+    out.material.push_back(f.material[k]);
+  }
+  return out;
+}
+
+TEST(DomainMpi, FramesWrittenTogetherEqualTheSerialFrameOfTheSameState) {
+  // The periodic gas split over the ranks and stepped until particles have crossed the cuts: every
+  // rank writes its own particles into one frame file (parallel HDF5, collective), and the root
+  // writes the gathered state alone with the serial writer. Read back, the two hold the same
+  // particles with the same values to the bit; only the order of the rows may differ.
+  namespace fs = std::filesystem;
+  const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
+  const Model model = compile(spec);
+  State state = initial_state(model);
+  std::string note;
+  const std::unique_ptr<Domain> domain = mpi::make_domain(model, state, &note);
+  ASSERT_TRUE(domain) << note;
+  const auto share_frame = mpi::collective_frames();
+  ASSERT_TRUE(share_frame) << "this MPI build writes frames together (parallel HDF5)";
+  const fs::path dir = fs::temp_directory_path() / fmt::format("demdesign_frames_together_{}_ranks", domain->ranks());
+  if (root()) fs::remove_all(dir);
+  domain->any(false);  // the directory is clean before any rank writes
+
+  Workspace work;
+  work.domain = domain.get();
+  domain->distribute(state);
+  prepare(domain->local_model(), state, work);
+  for (int k = 0; k < 400; ++k) step(domain->local_model(), state, work);
+  FrameWriter together((dir / "together").string(), {"beads"}, {});
+  together.write_frame(frame_of(state), share_frame(state.owned()));
+  const State whole = domain->gather(state);
+  if (!root()) return;
+  FrameWriter alone((dir / "alone").string(), {"beads"}, {});
+  alone.write_frame(frame_of(whole));
+
+  ASSERT_EQ(together.frames().size(), 1u);
+  EXPECT_EQ(together.frames()[0].count, whole.size());
+  const StoredFrame a = by_id(read_frame((dir / "together" / together.frames()[0].file).string()));
+  const StoredFrame b = by_id(read_frame((dir / "alone" / alone.frames()[0].file).string()));
+  ASSERT_EQ(a.size(), 1800u);
+  ASSERT_EQ(b.size(), 1800u);
+  EXPECT_EQ(a.step, 400);
+  EXPECT_EQ(a.time, b.time);
+  EXPECT_EQ(a.step, b.step);
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_EQ(std::set<std::int64_t>(a.id.begin(), a.id.end()).size(), a.size()) << "every particle once, no ghosts";
+  EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.velocity, b.velocity);
+  EXPECT_EQ(a.radius, b.radius);
+  EXPECT_EQ(a.material, b.material);
+  fs::remove_all(dir);
+}
+
+TEST(DomainMpi, ASplitRunWritesItsFramesTogetherWithoutGathering) {
+  // A whole run with files: the frames are written by every rank together. The XDMF lists each,
+  // with every particle once, at the step and time the file says; the log tells how they were written.
+  namespace fs = std::filesystem;
+  const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
+  const Model model = compile(spec);
+  State state = initial_state(model);
+  std::string note;
+  const std::unique_ptr<Domain> domain = mpi::make_domain(model, state, &note);
+  ASSERT_TRUE(domain) << note;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("demdesign_split_run_frames_{}_ranks", domain->ranks());
+  if (root()) fs::remove_all(dir);
+  domain->any(false);
+  Workspace work;
+  RunOptions options;
+  options.progress = false;
+  options.duration = 0.01;
+  options.output_directory = dir.string();
+  options.domain = domain.get();
+  options.share_frame = mpi::collective_frames();
+  std::ostringstream log;
+  run(model, state, work, options, log);
+  if (!root()) return;
+  EXPECT_NE(log.str().find(fmt::format("written together by {} ranks", domain->ranks())), std::string::npos) << log.str();
+  FrameWriter listed(dir.string(), {}, {});
+  listed.adopt_existing();
+  ASSERT_EQ(listed.frames().size(), 21u) << "the first frame and 20 in the run";
+  for (const FrameInfo& info : listed.frames()) {
+    const StoredFrame f = read_frame((dir / info.file).string());
+    EXPECT_EQ(f.step, info.step);
+    EXPECT_EQ(f.time, info.time);
+    EXPECT_EQ(info.count, 1800u);
+    ASSERT_EQ(f.size(), 1800u) << info.file;
+    EXPECT_EQ(std::set<std::int64_t>(f.id.begin(), f.id.end()).size(), f.size()) << info.file << ": every particle once";
+  }
+  // The last frame is the run's final state, which the root returns whole.
+  const StoredFrame last = by_id(read_frame((dir / listed.frames().back().file).string()));
+  EXPECT_EQ(last.step, state.step);
+  fs::remove_all(dir);
 }
 
 TEST(DomainMpi, SettlingBedMatchesTheSingleRankRun) {

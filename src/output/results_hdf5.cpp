@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <type_traits>
 
 namespace dem {
 namespace {
@@ -96,16 +97,38 @@ T check(T result, const std::string& path, const char* what) {
   return result;
 }
 
+static_assert(std::is_same_v<hid_t, std::int64_t>, "FrameShare carries HDF5 identifiers as std::int64_t");
+
+// The rows of a dataset this process writes: all of them (one process), or one rank's block of a
+// file every rank writes together, through a collective transfer list.
+struct Rows {
+  hsize_t offset = 0, total = 0;
+  hid_t transfer = H5P_DEFAULT;
+};
+
 // Datasets are contiguous and uncompressed: simplest for every reader, and n = 0 is a valid extent.
 void write_dataset(hid_t file, const std::string& path, const char* name, hid_t file_type, hid_t memory_type,
-                   std::size_t n, std::size_t width, const void* data) {
-  const hsize_t dims[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(width)};
-  Handle space(check(H5Screate_simple(width == 1 ? 1 : 2, dims, nullptr), path, "H5Screate_simple"), H5Sclose);
+                   std::size_t n, std::size_t width, const void* data, const Rows& rows) {
+  const int dimensions = width == 1 ? 1 : 2;
+  const hsize_t dims[2] = {rows.total, static_cast<hsize_t>(width)};
+  Handle space(check(H5Screate_simple(dimensions, dims, nullptr), path, "H5Screate_simple"), H5Sclose);
   Handle set(H5Dcreate2(file, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
   if (!set.valid()) fail(path, fmt::format("creating dataset '{}' failed ({})", name, hdf5_error_text()));
-  // H5Dwrite rejects a null buffer even for an empty selection, and there is nothing to write anyway.
-  if (n > 0 && H5Dwrite(set.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
-    fail(path, fmt::format("writing dataset '{}' failed ({})", name, hdf5_error_text()));
+  // An empty frame has nothing to write. Otherwise every rank takes part in the (collective)
+  // write, with its block of rows or with none.
+  if (rows.total > 0) {
+    const hsize_t start[2] = {rows.offset, 0}, count[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(width)};
+    Handle memory(check(H5Screate_simple(dimensions, count, nullptr), path, "H5Screate_simple"), H5Sclose);
+    if (n > 0) {
+      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), path, "H5Sselect_hyperslab");
+    } else {
+      check(H5Sselect_none(space.get()), path, "H5Sselect_none");
+      check(H5Sselect_none(memory.get()), path, "H5Sselect_none");
+    }
+    static const double nothing = 0;  // H5Dwrite rejects a null buffer even for an empty selection
+    if (H5Dwrite(set.get(), memory_type, memory.get(), space.get(), rows.transfer, n > 0 ? data : &nothing) < 0)
+      fail(path, fmt::format("writing dataset '{}' failed ({})", name, hdf5_error_text()));
+  }
   check(set.close(), path, "H5Dclose");
 }
 
@@ -218,60 +241,110 @@ FrameWriter::FrameWriter(std::string directory, std::vector<std::string> materia
   }
 }
 
-void FrameWriter::write_frame(const ParticleFrame& f) {
-  const std::size_t n = f.count;
+void FrameWriter::check_columns(const ParticleFrame& f) const {
   // Every column but clump and orientation is required; the four quaternion columns come together.
-  if (n > 0) {
-    const void* required[] = {f.id, f.x, f.y, f.z, f.vx, f.vy, f.vz, f.wx, f.wy, f.wz, f.radius, f.material};
-    for (const void* column : required)
-      if (column == nullptr) throw std::invalid_argument(fmt::format("frame at step {}: a required column is null", f.step));
-    const int quaternion_columns = (f.qw != nullptr) + (f.qx != nullptr) + (f.qy != nullptr) + (f.qz != nullptr);
-    if (quaternion_columns != 0 && quaternion_columns != 4)
-      throw std::invalid_argument(fmt::format("frame at step {}: give all four orientation columns or none", f.step));
-  }
+  if (f.count == 0) return;
+  const void* required[] = {f.id, f.x, f.y, f.z, f.vx, f.vy, f.vz, f.wx, f.wy, f.wz, f.radius, f.material};
+  for (const void* column : required)
+    if (column == nullptr) throw std::invalid_argument(fmt::format("frame at step {}: a required column is null", f.step));
+  const int quaternion_columns = (f.qw != nullptr) + (f.qx != nullptr) + (f.qy != nullptr) + (f.qz != nullptr);
+  if (quaternion_columns != 0 && quaternion_columns != 4)
+    throw std::invalid_argument(fmt::format("frame at step {}: give all four orientation columns or none", f.step));
+}
 
+void FrameWriter::prepare(std::int64_t step) {
   const fs::path frames_dir = fs::path(directory_) / kFramesDir;
-  const std::string name = frame_file_name(f.step);
-  const fs::path final_path = frames_dir / name;
-  const fs::path part_path = frames_dir / (name + ".part");
   std::error_code ec;
   fs::create_directories(frames_dir, ec);
   if (ec) fail(frames_dir.string(), fmt::format("cannot create the directory ({})", ec.message()));
-
   // A resumed run rewinds: unlist the frames from this step on before their files are replaced, so the
   // XDMF never describes a file whose content changed under it.
-  if (!frames_.empty() && frames_.back().step >= f.step) {
+  if (!frames_.empty() && frames_.back().step >= step) {
     std::vector<FrameInfo> kept;
-    std::copy_if(frames_.begin(), frames_.end(), std::back_inserter(kept), [&](const FrameInfo& i) { return i.step < f.step; });
+    std::copy_if(frames_.begin(), frames_.end(), std::back_inserter(kept), [&](const FrameInfo& i) { return i.step < step; });
     write_xdmf(kept);
     frames_ = std::move(kept);
   }
+}
 
-  // Write beside the final name and publish by rename only once the file is complete on disk.
+void FrameWriter::publish_and_list(const std::string& part, const FrameInfo& frame) {
+  const fs::path frames_dir = fs::path(directory_) / kFramesDir;
   try {
-    write_hdf5(part_path.string(), f);
-    sync_to_disk(part_path.string(), false);
-    publish(part_path, final_path);
+    sync_to_disk(part, false);
+    publish(part, fs::path(directory_) / frame.file);
   } catch (...) {
-    fs::remove(part_path, ec);
+    std::error_code ec;
+    fs::remove(part, ec);
     throw;
   }
   sync_to_disk(frames_dir.string(), true);
-
   // List the frame; if the XDMF cannot be replaced the old one stays valid and so does our list.
   std::vector<FrameInfo> listed = frames_;
-  listed.push_back({f.time, f.step, std::string(kFramesDir) + "/" + name, n});
+  listed.push_back(frame);
   write_xdmf(listed);
   frames_ = std::move(listed);
 }
 
-void FrameWriter::write_hdf5(const std::string& path, const ParticleFrame& f) {
+void FrameWriter::write_frame(const ParticleFrame& f) {
+  check_columns(f);
+  prepare(f.step);
+  // Write beside the final name and publish by rename only once the file is complete on disk.
+  const std::string name = frame_file_name(f.step);
+  const std::string part = (fs::path(directory_) / kFramesDir / (name + ".part")).string();
+  try {
+    write_hdf5(part, f, FrameShare{0, f.count, true, -1, -1, {}});
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(part, ec);
+    throw;
+  }
+  publish_and_list(part, {f.time, f.step, std::string(kFramesDir) + "/" + name, f.count});
+}
+
+void FrameWriter::write_frame(const ParticleFrame& mine, const FrameShare& share) {
+  const std::string name = frame_file_name(mine.step);
+  const std::string part = (fs::path(directory_) / kFramesDir / (name + ".part")).string();
+  // Every rank learns of a failure on any rank at each of the three stages, so none waits for the
+  // others in a collective call they never reach.
+  std::string error;
+  const auto stage = [&](const auto& work) {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (share.all(error.empty())) return;
+    if (share.root) {
+      std::error_code ec;
+      fs::remove(part, ec);
+    }
+    throw std::runtime_error(error.empty() ? fmt::format("frame at step {}: another rank could not write its part (its message is on its "
+                                                         "standard error)", mine.step)
+                                           : error);
+  };
+  stage([&] {
+    check_columns(mine);
+    if (share.root) prepare(mine.step);  // the directory exists before any rank opens the file
+  });
+  stage([&] { write_hdf5(part, mine, share); });
+  const FrameInfo frame{mine.time, mine.step, std::string(kFramesDir) + "/" + name, share.total};
+  stage([&] {
+    if (share.root) publish_and_list(part, frame);
+  });
+  if (!share.root) {  // the same list as the root's, though only the root writes it
+    std::erase_if(frames_, [&](const FrameInfo& i) { return i.step >= frame.step; });
+    frames_.push_back(frame);
+  }
+}
+
+void FrameWriter::write_hdf5(const std::string& path, const ParticleFrame& f, const FrameShare& share) {
   const std::size_t n = f.count;
   const QuietHdf5 quiet;
+  const Rows rows{share.offset, share.total, share.transfer >= 0 ? share.transfer : H5P_DEFAULT};
 
   // H5F_CLOSE_SEMI: H5Fclose fails rather than defer the close while something is open, so its
   // success below really means the file is flushed and complete.
-  Handle access(check(H5Pcreate(H5P_FILE_ACCESS), path, "H5Pcreate"), H5Pclose);
+  Handle access(check(share.file_access >= 0 ? H5Pcopy(share.file_access) : H5Pcreate(H5P_FILE_ACCESS), path, "H5Pcreate"), H5Pclose);
   check(H5Pset_fclose_degree(access.get(), H5F_CLOSE_SEMI), path, "H5Pset_fclose_degree");
   Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get()), H5Fclose);
   if (!file.valid()) fail(path, fmt::format("H5Fcreate failed ({})", hdf5_error_text()));
@@ -288,16 +361,16 @@ void FrameWriter::write_hdf5(const std::string& path, const ParticleFrame& f) {
     return vec3_.data();
   };
   const hid_t f64 = H5T_IEEE_F64LE, i64 = H5T_STD_I64LE, i32 = H5T_STD_I32LE;
-  write_dataset(root, path, "id", i64, H5T_NATIVE_INT64, n, 1, f.id);
-  write_dataset(root, path, "position", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.x, f.y, f.z));
-  write_dataset(root, path, "velocity", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.vx, f.vy, f.vz));
-  write_dataset(root, path, "angular_velocity", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.wx, f.wy, f.wz));
-  write_dataset(root, path, "radius", f64, H5T_NATIVE_DOUBLE, n, 1, f.radius);
-  write_dataset(root, path, "material", i32, H5T_NATIVE_INT32, n, 1, f.material);
+  write_dataset(root, path, "id", i64, H5T_NATIVE_INT64, n, 1, f.id, rows);
+  write_dataset(root, path, "position", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.x, f.y, f.z), rows);
+  write_dataset(root, path, "velocity", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.vx, f.vy, f.vz), rows);
+  write_dataset(root, path, "angular_velocity", f64, H5T_NATIVE_DOUBLE, n, 3, interleave(f.wx, f.wy, f.wz), rows);
+  write_dataset(root, path, "radius", f64, H5T_NATIVE_DOUBLE, n, 1, f.radius, rows);
+  write_dataset(root, path, "material", i32, H5T_NATIVE_INT32, n, 1, f.material, rows);
 
   int32_.assign(n, -1);
   if (f.clump != nullptr) std::copy(f.clump, f.clump + n, int32_.begin());
-  write_dataset(root, path, "clump", i32, H5T_NATIVE_INT32, n, 1, int32_.data());
+  write_dataset(root, path, "clump", i32, H5T_NATIVE_INT32, n, 1, int32_.data(), rows);
 
   // Orientation rows are w x y z; identity for free spheres when the engine gives no quaternions.
   quat_.resize(4 * n);
@@ -308,17 +381,17 @@ void FrameWriter::write_hdf5(const std::string& path, const ParticleFrame& f) {
     quat_[4 * p + 2] = given ? f.qy[p] : 0.0;
     quat_[4 * p + 3] = given ? f.qz[p] : 0.0;
   }
-  write_dataset(root, path, "orientation", f64, H5T_NATIVE_DOUBLE, n, 4, quat_.data());
+  write_dataset(root, path, "orientation", f64, H5T_NATIVE_DOUBLE, n, 4, quat_.data(), rows);
 
   // |v| [m/s], stored so ParaView can colour by speed without a Calculator filter.
   scalar_.resize(n);
   for (std::size_t p = 0; p < n; ++p) scalar_[p] = std::sqrt(f.vx[p] * f.vx[p] + f.vy[p] * f.vy[p] + f.vz[p] * f.vz[p]);
-  write_dataset(root, path, "speed", f64, H5T_NATIVE_DOUBLE, n, 1, scalar_.data());
+  write_dataset(root, path, "speed", f64, H5T_NATIVE_DOUBLE, n, 1, scalar_.data(), rows);
 
-  // Polyvertex cells 0..n-1: the Xdmf3 reader makes no cells without them, and ParaView then draws nothing.
+  // Polyvertex cells 0..total-1 (this rank's rows from its offset): the Xdmf3 reader makes no cells without them, and ParaView then draws nothing.
   int64_.resize(n);
-  for (std::size_t p = 0; p < n; ++p) int64_[p] = static_cast<std::int64_t>(p);
-  write_dataset(root, path, "connectivity", i64, H5T_NATIVE_INT64, n, 1, int64_.data());
+  for (std::size_t p = 0; p < n; ++p) int64_[p] = static_cast<std::int64_t>(share.offset + p);
+  write_dataset(root, path, "connectivity", i64, H5T_NATIVE_INT64, n, 1, int64_.data(), rows);
 
   write_attribute(root, path, "time", f64, H5T_NATIVE_DOUBLE, &f.time);
   write_attribute(root, path, "step", i64, H5T_NATIVE_INT64, &f.step);

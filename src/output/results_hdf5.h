@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +28,20 @@ struct ParticleFrame {
   const std::int32_t* clump = nullptr;
   /// Orientation quaternion of the body the sphere belongs to; all four nullptr -> identity.
   const double *qw = nullptr, *qx = nullptr, *qy = nullptr, *qz = nullptr;
+};
+
+/// How the ranks of a split run write one frame together into one file, each rank its own particles
+/// as one block of rows (app/mpi_frames.h makes it, with parallel HDF5's MPI-IO driver). The file
+/// holds what one process writes, the rows in rank order; no rank gathers the particles.
+struct FrameShare {
+  std::size_t offset = 0;   ///< this rank's first row
+  std::size_t total = 0;    ///< the rows of every rank
+  bool root = true;         ///< this rank publishes the file and keeps the XDMF
+  std::int64_t file_access = -1;  ///< HDF5 file-access property list (hid_t) opening the file on every rank
+  std::int64_t transfer = -1;     ///< HDF5 dataset-transfer property list (hid_t): collective writes
+  /// True on every rank when `ok` is true on every rank (collective): a failed write anywhere
+  /// fails the frame on every rank.
+  std::function<bool(bool ok)> all;
 };
 
 /// One frame listed in the XDMF; `file` is relative to the writer's directory.
@@ -96,6 +111,10 @@ class FrameWriter {
   /// Throws std::invalid_argument for a missing column, std::runtime_error with the path on an I/O
   /// failure (e.g. disk full); the XDMF then still lists the frames it listed before.
   void write_frame(const ParticleFrame& frame);
+  /// The same written by every rank of a split run together (collective): `mine` holds this rank's
+  /// particles, `share` where they go. Only the share's root touches the XDMF; every rank throws when
+  /// any rank failed.
+  void write_frame(const ParticleFrame& mine, const FrameShare& share);
 
   const std::vector<FrameInfo>& frames() const { return frames_; }
 
@@ -107,7 +126,12 @@ class FrameWriter {
   const std::string& directory() const { return directory_; }
 
  private:
-  void write_hdf5(const std::string& path, const ParticleFrame& frame);
+  void write_hdf5(const std::string& path, const ParticleFrame& frame, const FrameShare& share);
+  void check_columns(const ParticleFrame& frame) const;
+  /// Makes the frames directory and unlists the frames from `step` on (a resumed run rewinds).
+  void prepare(std::int64_t step);
+  /// Publishes the complete `part` file under the frame's name and lists it in the XDMF.
+  void publish_and_list(const std::string& part, const FrameInfo& frame);
   void write_xdmf(const std::vector<FrameInfo>& frames) const;
 
   std::string directory_;

@@ -143,9 +143,11 @@ FrameWriter make_frame_writer(const Model& model, const std::string& directory) 
                       {"time_step_s", fmt::format("{:.9g}", model.dt)}});
 }
 
-void write_frame(FrameWriter& writer, const State& s) {
+/// The state's particles (a split run's rank: its own, without the ghosts) as a frame, written by
+/// this process or, with `share`, by every rank together.
+void write_frame(FrameWriter& writer, const State& s, const FrameShare* share = nullptr) {
   // Orientation per sphere: its body's, identity for free spheres.
-  const size_t n = s.size();
+  const size_t n = s.owned();
   std::vector<double> qw(n, 1.0), qx(n, 0.0), qy(n, 0.0), qz(n, 0.0);
   for (size_t p = 0; p < n; ++p) {
     const std::int32_t b = s.body[p];
@@ -160,7 +162,8 @@ void write_frame(FrameWriter& writer, const State& s) {
   frame.wx = s.wx.data(), frame.wy = s.wy.data(), frame.wz = s.wz.data();
   frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
   frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
-  writer.write_frame(frame);
+  if (share) writer.write_frame(frame, *share);
+  else writer.write_frame(frame);
 }
 
 /// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
@@ -254,10 +257,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const std::string out = summary.output_directory;
   const double duration = options.duration >= 0 ? options.duration : model.duration;
   const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
-  // Under domain decomposition every rank steps its share with the domain's model; the root
-  // gathers the whole state wherever a result is due and writes it as one process would.
+  // Under domain decomposition every rank steps its share with the domain's model; the ranks
+  // write each frame together (options.share_frame) or the root gathers the whole state for it,
+  // and the root gathers it for images and at the end and writes the rest as one process would.
   Domain* domain = options.domain;
   const bool writer = domain == nullptr || domain->root();
+  const bool collective = domain != nullptr && static_cast<bool>(options.share_frame);
   const Model& stepped = domain ? domain->local_model() : model;
   work.domain = domain;
 
@@ -303,9 +308,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     lost_total = row.lost;
     return row;
   };
-  gather_whole();
+  // Particles in the whole run, for the progress line: every rank's, as of the last row.
+  double particles_now = domain ? domain->sum(static_cast<double>(state.owned())) : 0.0;
+  if (!collective) gather_whole();
   if (!options.resume) {
     Scalars row = measure_row();
+    particles_now = static_cast<double>(row.particles);
     if (writer) summary.scalars.push_back(std::move(row));
   }
 
@@ -321,19 +329,38 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       model.output.checkpoint_every > 0 ? std::max<std::int64_t>(1, std::llround(model.output.checkpoint_every / model.dt)) : 0;
 
   std::optional<FrameWriter> frames;
-  if (options.write_files && writer) {
-    write_file_atomically(out + "/run_info.yaml", run_info(model));
+  double frame_seconds = 0;  // [s] this rank's time writing frames
+  const auto write_frame_now = [&](const State& whole_or_mine) {
+    const auto begun = std::chrono::steady_clock::now();
+    if (collective) {
+      const FrameShare share = options.share_frame(state.owned());
+      write_frame(*frames, state, &share);
+    } else {
+      write_frame(*frames, whole_or_mine);
+    }
+    frame_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
+  };
+  if (options.write_files && (writer || collective)) {
+    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model));
     frames.emplace(make_frame_writer(model, out));
-    if (options.resume) frames->adopt_existing();
-    else write_frame(*frames, *results);
+    if (options.resume && writer) frames->adopt_existing();
+    else if (!options.resume) write_frame_now(*results);
   }
   // Trouble present from the start (particles created overlapping): told before the first step.
-  if (!options.resume && writer) {
+  // With frames written together no rank holds the whole state: each checks its share.
+  if (!options.resume && (writer || collective)) {
+    std::optional<NumericalError> found;
     try {
-      check_numerics(model, *results, *results_work, model.max_overlap_ratio);
+      if (collective) check_numerics(stepped, state, work, model.max_overlap_ratio);
+      else check_numerics(model, *results, *results_work, model.max_overlap_ratio);
     } catch (const NumericalError& e) {
-      if (model.stop_on_trouble) throw;
-      fmt::print(log, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+      found = e;
+    }
+    if (collective && domain->any(found.has_value()) && !found)
+      found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
+    if (found) {
+      if (model.stop_on_trouble) throw *found;
+      fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", found->what());
     }
   }
   // The rows so far, the events and the ParaView script (at checkpoints, on trouble, at the end).
@@ -370,6 +397,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const auto start = Clock::now();
   auto last_progress = start;
   std::int64_t particle_steps = 0;
+  std::int64_t loop_frames = 0;  // frames written in the loop; on_frame follows every render_every-th
   // Steps until the next one that checks, records or writes run as one advance() (each closing
   // kick gives the next step's drift, step.h); under domain decomposition one at a time.
   const auto steps_to_next_event = [&] {
@@ -381,7 +409,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   while (state.step < last_step) {
     if (domain) {
       step(stepped, state, work);
-      particle_steps += static_cast<std::int64_t>(results->size());
+      particle_steps += static_cast<std::int64_t>(particles_now);
     } else {
       particle_steps += advance(stepped, state, work, steps_to_next_event());
     }
@@ -392,8 +420,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     const bool scalars_due = state.step % every == 0 || last;
     const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
     const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
-    // A checkpoint needs no gather: each rank writes its share (checkpoint.h).
-    if (domain && (frame_due || last || stopping)) gather_whole();
+    const bool render_due = frame_due && options.on_frame &&
+                            (last || (model.output.render_every > 0 && loop_frames % model.output.render_every == 0));
+    if (frame_due) ++loop_frames;
+    // A checkpoint needs no gather: each rank writes its share (checkpoint.h); nor does a frame
+    // the ranks write together.
+    if (domain && ((frame_due && !collective) || render_due || last || stopping)) gather_whole();
     if (check_due) {
       // Under domain decomposition every rank's energy, summed before any rank may throw; the
       // root judges it.
@@ -434,11 +466,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     }
     if (scalars_due) {
       Scalars row = measure_row();
+      particles_now = static_cast<double>(row.particles);
       if (writer) summary.scalars.push_back(std::move(row));
     }
     if (frames && frame_due) {
-      write_frame(*frames, *results);
-      if (options.on_frame) options.on_frame(model, *results, *results_work, out, last);
+      write_frame_now(*results);
+      if (render_due && writer) options.on_frame(model, *results, *results_work, out, last);
     }
     if (checkpoint_due && domain) {
       // Every rank's share on disk before the root names the step: a failed write on any rank
@@ -473,7 +506,8 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       const std::int64_t done = state.step - first_step;
       const double left = elapsed / static_cast<double>(done) * static_cast<double>(last_step - state.step);
       fmt::print(log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
-                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), results->size(), particle_steps / elapsed,
+                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), domain ? static_cast<std::size_t>(particles_now) : state.size(),
+                 particle_steps / elapsed,
                  format_duration(left));
       log.flush();
     }
@@ -513,6 +547,9 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
                frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
   }
   if (domain) fmt::print(log, "  domain (rank 0): {}\n", domain->statistics());
+  if (domain && frames)
+    fmt::print(log, "  frames: {} {}, {:.3g} s on rank 0\n", frames->frames().size(),
+               collective ? fmt::format("written together by {} ranks (parallel HDF5)", domain->ranks()) : "gathered on rank 0", frame_seconds);
   if (domain) {  // the caller (reports, renders) gets the whole state, with this instant's forces
     state = std::move(whole->evaluated);
     work = std::move(whole->work);

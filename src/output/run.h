@@ -11,6 +11,7 @@
 #include "core/model.h"
 #include "core/state.h"
 #include "core/workspace.h"
+#include "output/results_hdf5.h"
 #include "statistics/diagnostics.h"
 #include "statistics/events.h"
 
@@ -25,13 +26,18 @@ struct RunOptions {
   bool write_files = true;
   bool progress = true;
   bool resume = false;            ///< continue from OUT's checkpoint (load_resumable, checkpoint.h)
-  /// Called after each particle frame is written (the app renders images here; the engine
-  /// knows nothing of rendering). `last` is true for the final frame of the run.
+  /// Called after a particle frame is written, with the whole state: after every
+  /// model.output.render_every-th frame of the run and after the last (the app renders images
+  /// here; the engine knows nothing of rendering). `last` is true for the final frame.
   std::function<void(const Model&, const State&, const Workspace&, const std::string& out, bool last)> on_frame;
   /// The ranks sharing this simulation (domain decomposition, domain.h), or null. Every rank
   /// calls run() with the whole initial state and the same options; the root (rank 0) writes
   /// the results and returns with the whole final state, the others with their share.
   Domain* domain = nullptr;
+  /// With a domain: where this rank's particles go in a frame every rank writes together
+  /// (FrameShare; app/mpi_frames.h). Empty: the root gathers the whole state for each frame.
+  /// The whole state is still gathered once at the end, and for a frame on_frame is called with.
+  std::function<FrameShare(std::size_t owned)> share_frame;
 };
 
 struct RunSummary {
