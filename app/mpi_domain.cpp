@@ -22,6 +22,11 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kHistogramBins = 4096;
 constexpr double kImbalance = 1.10;  ///< rebalance when the fullest rank holds 10 % above the mean
+/// ... and when the ranks have waited for the fullest, since the last rebalance, at least this many
+/// steps' worth of the mean rank's work (the sum over the steps of most / mean - 1): what moving
+/// the cuts costs (histograms, all-to-all migration, new ghosts), in steps. Without it a stream
+/// that keeps moving (an inlet feeding one rank) had its cuts moved at nearly every rebuild.
+constexpr double kRebalanceAfterSteps = 20;
 
 void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(fmt::format("MPI error in {} (code {})", what, code));
@@ -610,8 +615,8 @@ class MpiDomain final : public Domain {
     for (int k = n - 2; k >= 0; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - box_min_);
   }
 
-  /// New cuts when the most loaded rank carries more than kImbalance times the mean work
-  /// (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
+  /// New cuts when the most loaded rank carries more than kImbalance times the mean work and the
+  /// waiting for it since the last rebalance adds up to kRebalanceAfterSteps (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
   /// history: in a dense bed the contacts, not the particles, cost the time); each cut axis gets
   /// its cuts at the quantiles of the work along it. Balanced by time (Balance::time), a rank's
   /// work is the time it computed since the last rebuild (its wall time less the time in
@@ -648,7 +653,14 @@ class MpiDomain final : public Domain {
     check(MPI_Allreduce(stats, most, 7, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
     const double total = sum(mine);
     if (balance_ == Balance::work ? total < size_ : !(total > 0)) return false;
-    if (most[0] <= kImbalance * total / size_) return false;
+    // The waiting since the last check, in steps of the mean rank's work: the same on every rank
+    // (from reduced values and step counts), so every rank decides alike, and with Balance::work
+    // reproducibly.
+    const std::int64_t steps = rebuilds_ + refreshes_;
+    waited_steps_ += std::max(0.0, most[0] / (total / size_) - 1.0) * static_cast<double>(steps - checked_at_step_);
+    checked_at_step_ = steps;
+    if (most[0] <= kImbalance * total / size_ || waited_steps_ < kRebalanceAfterSteps) return false;
+    waited_steps_ = 0;
     for (int a = 0; a < 3; ++a) {
       if (dims_[a] == 1) continue;
       const double lo = periodic_[a] ? low_[a] : -most[1 + 2 * a], hi = periodic_[a] ? low_[a] + period_[a] : most[2 + 2 * a];
@@ -752,6 +764,8 @@ class MpiDomain final : public Domain {
   std::vector<std::vector<double>> out_, in_;
   std::vector<MPI_Request> requests_;
   std::int64_t migrated_ = 0, rebalances_ = 0, rebuilds_ = 0, refreshes_ = 0, ghosts_ = 0;
+  std::int64_t checked_at_step_ = 0;  ///< the step of the last rebalance check
+  double waited_steps_ = 0;           ///< steps' worth of waiting for the fullest rank since the last rebalance
   std::int64_t migrations_near_ = 0, migrations_all_ = 0;  // rebuilds whose migration went to the neighbours, all to all
   bool neighbour_migration_ = true;
   Balance balance_ = Balance::work;

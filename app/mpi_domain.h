@@ -8,7 +8,9 @@
 // The cuts along each axis sit at quantiles of the work (a particle weighs one plus its
 // contacts; or, with Balance::time, each rank's measured computing time since the last rebuild,
 // shared among its particles by that weight), recomputed at a rebuild when the most loaded rank
-// carries more than 10 % above the mean. Time-balanced cuts depend on the machine's timing, so
+// carries more than 10 % above the mean and the ranks have, since the last rebalance, waited for
+// the most loaded one 20 steps' worth of the mean rank's work (a flow that keeps moving, an inlet
+// feeding one rank, would otherwise move the cuts at nearly every rebuild). Time-balanced cuts depend on the machine's timing, so
 // such runs are not reproducible bit for bit; the default is reproducible. The outer boxes of a non-periodic axis reach to infinity; along a periodic axis the last
 // box's upper neighbour is the first, seen one period on.
 //
