@@ -282,17 +282,19 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   if (domain) domain->distribute(state);
   prepare(stepped, state, work);
 
-  // The whole state for frames and checkpoints: the state itself, or (domain) the root's
-  // gathered copy with its lists rebuilt (and, for the caller at the end, a copy with this
-  // instant's contact forces).
+  // The whole state for results: the state itself, or (domain) the root's gathered copy with its
+  // lists rebuilt (and, for the caller at the end, a copy with this instant's contact forces),
+  // gathered for frames unless the ranks write them together, for rendered frames and at the end.
   std::optional<WholeState> whole;
   const State* results = &state;  // positions, counters, histories
   const Workspace* results_work = &work;
+  bool gathered = false;  // on every rank alike: whether gather_whole has run
   auto gather_whole = [&]() {
     if (!domain) return;
-    State gathered = domain->gather(state);
+    gathered = true;
+    State gathered_state = domain->gather(state);
     if (!writer) return;
-    whole = ready_for_results(model, std::move(gathered));
+    whole = ready_for_results(model, std::move(gathered_state));
     results = &whole->state, results_work = &whole->work;
   };
   // A row of scalars (collective under domain decomposition): each rank measures its own
@@ -514,6 +516,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   }
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
+  if (domain && !gathered) gather_whole();  // no step was left to run (a resumed run at its end)
   summary.steps = state.step - first_step;
   summary.events = events.fired();
   summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
