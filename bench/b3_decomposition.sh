@@ -3,19 +3,23 @@
 # split into slabs over 2 MPI ranks of 1 thread each, on this machine, alternating, REPS times.
 # Prints particle-steps/s, the speed-up of the split run over one thread, and rank 0's
 # communication figures; appends the csv lines to bench/results/b3_decomposition.csv with the machine.
+# SPLIT_OPTIONS go to the split runs alone and into the csv's last column: "--balance time" cuts
+# the slabs by measured computing time, "--frames DIR" writes a frame after each phase together
+# and gathered (bench/b3_domain.cpp), "--rank-grid 2x2x1" asks for a grid.
 #
-# Usage: sh bench/b3_decomposition.sh [BUILD_DIR] [N] [PHASE1_STEPS] [PHASE2_STEPS] [REPS]
+# Usage: sh bench/b3_decomposition.sh [BUILD_DIR] [N] [PHASE1_STEPS] [PHASE2_STEPS] [REPS] [SPLIT_OPTIONS]
 set -eu
 build=${1:-build}
 n=${2:-20000}
 s1=${3:-20000}
 s2=${4:-4000}
 reps=${5:-1}
+split_options=${6:-}
 bin="$build/bench/bench_b3_domain"
 [ -x "$bin" ] || { echo "no $bin: build with -DDEMDESIGN_MPI=ON (cmake --build $build --target bench_b3_domain)"; exit 2; }
 out=$(dirname "$0")/results/b3_decomposition.csv
 machine="$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //') x $(nproc)"
-[ -f "$out" ] || echo "date,machine,N,phase,steps,ranks,threads_per_rank,seconds,particle_steps_per_s,contacts_per_particle,bed_height_m" > "$out"
+[ -f "$out" ] || echo "date,machine,N,phase,steps,ranks,threads_per_rank,seconds,particle_steps_per_s,contacts_per_particle,bed_height_m,split_options" > "$out"
 log=$(mktemp)
 for rep in $(seq "$reps"); do
   for config in "1 1" "1 2" "2 1"; do
@@ -25,11 +29,12 @@ for rep in $(seq "$reps"); do
       OMP_NUM_THREADS=$2 "$bin" --n "$n" --threads "$2" --phase1-steps "$s1" --phase2-steps "$s2" | tee -a "$log"
     else
       mpirun --allow-run-as-root --oversubscribe -np "$1" -x OMP_NUM_THREADS="$2" "$bin" --n "$n" --threads "$2" \
-        --phase1-steps "$s1" --phase2-steps "$s2" | tee -a "$log"
+        --phase1-steps "$s1" --phase2-steps "$s2" $split_options | tee -a "$log"
     fi
   done
 done
-grep '^csv,[0-9]' "$log" | sed "s/^csv,/$(date -u +%Y-%m-%d),\"$machine\",/" >> "$out"
+grep '^csv,[0-9]' "$log" | awk -v opts="$split_options" -F, '{print $0 "," ($5 > 1 ? opts : "")}' |
+  sed "s/^csv,/$(date -u +%Y-%m-%d),\"$machine\",/" >> "$out"
 echo
 echo "N = $n: median particle-steps/s per configuration and phase (speed-up over 1 rank x 1 thread)"
 for phase in settle dense; do

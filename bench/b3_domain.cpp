@@ -5,10 +5,15 @@
 // communication time and volume per step (what the scaling model in the README is built from).
 //
 // Usage: [mpirun -np R] bench_b3_domain [--n N] [--threads T] [--phase1-steps S1] [--phase2-steps S2]
+//                                        [--rank-grid NXxNYxNZ] [--balance work|time] [--frames DIR]
 //   N as in B1 (20000, 100000, or 2000-4000000 for the 32-layer family); one "csv," line per phase.
+//   --frames DIR: after each phase (untimed in the rate) one particle frame into DIR, written by
+//   every rank together (parallel HDF5) and, for comparison, gathered on rank 0 and written by it
+//   alone; prints both times.
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +27,8 @@
 #include "core/step.h"
 #include "mpi_campaign.h"
 #include "mpi_domain.h"
+#include "mpi_frames.h"
+#include "output/results_hdf5.h"
 #include "statistics/diagnostics.h"
 
 namespace {
@@ -32,6 +39,9 @@ struct Options {
   long n = 20000;
   int threads = 0;
   long phase1 = -1, phase2 = -1;
+  std::array<int, 3> grid{0, 0, 0};
+  mpi::Balance balance = mpi::Balance::work;
+  std::string frames;
 };
 
 Options parse(int argc, char** argv) {
@@ -49,8 +59,24 @@ Options parse(int argc, char** argv) {
     else if (a == "--threads") o.threads = std::atoi(value());
     else if (a == "--phase1-steps") o.phase1 = std::atol(value());
     else if (a == "--phase2-steps") o.phase2 = std::atol(value());
-    else {
-      std::fprintf(stderr, "unknown option %s\nusage: [mpirun -np R] %s [--n N] [--threads T] [--phase1-steps S1] [--phase2-steps S2]\n",
+    else if (a == "--rank-grid") {
+      if (std::sscanf(value(), "%dx%dx%d", &o.grid[0], &o.grid[1], &o.grid[2]) != 3) {
+        std::fprintf(stderr, "--rank-grid: expected NXxNYxNZ, for example 2x2x1\n");
+        std::exit(2);
+      }
+    } else if (a == "--balance") {
+      const std::string v = value();
+      if (v != "work" && v != "time") {
+        std::fprintf(stderr, "--balance: work or time\n");
+        std::exit(2);
+      }
+      o.balance = v == "time" ? mpi::Balance::time : mpi::Balance::work;
+    } else if (a == "--frames") {
+      o.frames = value();
+    } else {
+      std::fprintf(stderr,
+                   "unknown option %s\nusage: [mpirun -np R] %s [--n N] [--threads T] [--phase1-steps S1] [--phase2-steps S2] "
+                   "[--rank-grid NXxNYxNZ] [--balance work|time] [--frames DIR]\n",
                    a.c_str(), argv[0]);
       std::exit(2);
     }
@@ -76,7 +102,11 @@ int main(int argc, char** argv) {
   dem::State state = dem::initial_state(model);
   const double total = static_cast<double>(state.size());
   std::string note = "one process";
-  std::unique_ptr<dem::Domain> domain = world.active() ? mpi::make_domain(model, state, &note) : nullptr;
+  std::unique_ptr<dem::Domain> domain = world.active() ? mpi::make_domain(model, state, &note, o.grid, true, o.balance) : nullptr;
+  if (world.active() && !domain) {
+    std::fprintf(stderr, "cannot split: %s\n", note.c_str());
+    return 2;
+  }
   const dem::Model& stepped = domain ? domain->local_model() : model;
   dem::Workspace work;
   work.domain = domain.get();
@@ -85,12 +115,52 @@ int main(int argc, char** argv) {
   if (world.rank == 0)
     fmt::print("B3 split box: B1 with N = {} on {} ranks x {} threads; {}\n", b.n(), world.size, omp_get_max_threads(), note);
 
+  // One frame of the state: by every rank together (a split run) or by the one process; then,
+  // split, the same gathered on rank 0 and written alone. Prints the seconds of each.
+  const auto share_frame = domain ? mpi::collective_frames() : nullptr;
+  const auto write_frames = [&](const char* name) {
+    if (o.frames.empty()) return;
+    const auto frame_of = [](const dem::State& s) {
+      dem::ParticleFrame f;
+      f.time = s.time, f.step = s.step, f.count = s.owned(), f.id = s.id.data();
+      f.x = s.x.data(), f.y = s.y.data(), f.z = s.z.data(), f.vx = s.vx.data(), f.vy = s.vy.data(), f.vz = s.vz.data();
+      f.wx = s.wx.data(), f.wy = s.wy.data(), f.wz = s.wz.data(), f.radius = s.radius.data(), f.material = s.material.data();
+      return f;
+    };
+    const auto seconds_since = [](auto start) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    if (domain) domain->any(false);
+    auto start = std::chrono::steady_clock::now();
+    dem::FrameWriter together(o.frames + "/" + name + "_together", {"beads"}, {});
+    if (domain) together.write_frame(frame_of(state), share_frame(state.owned()));
+    else together.write_frame(frame_of(state));
+    if (domain) domain->any(false);
+    const double written_together = seconds_since(start);
+    const double bytes = static_cast<double>(total) * (8 * 4 + 8 * 3 * 3 + 8 * 4 + 4 * 2);  // id, speed, radius, connectivity; 3 vectors; quaternion; 2 ints
+    if (!domain) {
+      fmt::print("  frame after {}: {:.3g} GB by one process in {:.3f} s\n", name, 1e-9 * bytes, written_together);
+      return;
+    }
+    start = std::chrono::steady_clock::now();
+    const dem::State gathered = domain->gather(state);
+    const double gathering = seconds_since(start);
+    if (world.rank == 0) {
+      dem::FrameWriter alone(o.frames + "/" + name + "_alone", {"beads"}, {});
+      alone.write_frame(frame_of(gathered));
+    }
+    domain->any(false);
+    const double gathered_and_written = seconds_since(start);
+    if (world.rank == 0)
+      fmt::print("  frame after {}: {:.3g} GB written together by {} ranks in {:.3f} s; gathered on rank 0 in {:.3f} s and written by it in {:.3f} s\n",
+                 name, 1e-9 * bytes, world.size, written_together, gathering, gathered_and_written - gathering);
+  };
+
   auto run_phase = [&](const char* name, std::int64_t steps) {
     if (domain) domain->any(false);  // start together
     const auto start = std::chrono::steady_clock::now();
     for (std::int64_t k = 0; k < steps; ++k) dem::step(stepped, state, work);
     if (domain) domain->any(false);  // the slowest rank sets the time
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    write_frames(name);
     // Outside the timed loop: the whole state on rank 0 for the physics check.
     dem::State gathered = domain ? domain->gather(state) : state;
     if (world.rank != 0) return;
