@@ -297,23 +297,40 @@ StoredFrame by_id(const StoredFrame& f) {
   return out;
 }
 
+/// The periodic gas, its initial state, the domain over the ranks and an empty scratch directory
+/// named for the test and the rank count (collective).
+struct SplitGas {
+  Model model;
+  State state;
+  std::unique_ptr<Domain> domain;
+  std::string note;
+  std::filesystem::path scratch;
+};
+SplitGas split_gas(const std::string& name) {
+  SplitGas gas;
+  gas.model = compile(parse_case_text(kPeriodicGas, "periodic_gas.yaml"));
+  gas.state = initial_state(gas.model);
+  gas.domain = mpi::make_domain(gas.model, gas.state, &gas.note);
+  if (!gas.domain) return gas;
+  gas.scratch = std::filesystem::temp_directory_path() / fmt::format("demdesign_{}_{}_ranks", name, gas.domain->ranks());
+  if (root()) std::filesystem::remove_all(gas.scratch);
+  gas.domain->any(false);  // the directory is clean before any rank writes
+  return gas;
+}
+
 TEST(DomainMpi, FramesWrittenTogetherEqualTheSerialFrameOfTheSameState) {
   // The periodic gas split over the ranks and stepped until particles have crossed the cuts: every
   // rank writes its own particles into one frame file (parallel HDF5, collective), and the root
   // writes the gathered state alone with the serial writer. Read back, the two hold the same
   // particles with the same values to the bit; only the order of the rows may differ.
   namespace fs = std::filesystem;
-  const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
-  const Model model = compile(spec);
-  State state = initial_state(model);
-  std::string note;
-  const std::unique_ptr<Domain> domain = mpi::make_domain(model, state, &note);
-  ASSERT_TRUE(domain) << note;
+  SplitGas gas = split_gas("frames_together");
+  ASSERT_TRUE(gas.domain) << gas.note;
   const auto share_frame = mpi::collective_frames();
   ASSERT_TRUE(share_frame) << "this MPI build writes frames together (parallel HDF5)";
-  const fs::path dir = fs::temp_directory_path() / fmt::format("demdesign_frames_together_{}_ranks", domain->ranks());
-  if (root()) fs::remove_all(dir);
-  domain->any(false);  // the directory is clean before any rank writes
+  const std::unique_ptr<Domain>& domain = gas.domain;
+  State& state = gas.state;
+  const fs::path& dir = gas.scratch;
 
   Workspace work;
   work.domain = domain.get();
@@ -349,15 +366,11 @@ TEST(DomainMpi, ASplitRunWritesItsFramesTogetherWithoutGathering) {
   // A whole run with files: the frames are written by every rank together. The XDMF lists each,
   // with every particle once, at the step and time the file says; the log tells how they were written.
   namespace fs = std::filesystem;
-  const CaseSpec spec = parse_case_text(kPeriodicGas, "periodic_gas.yaml");
-  const Model model = compile(spec);
-  State state = initial_state(model);
-  std::string note;
-  const std::unique_ptr<Domain> domain = mpi::make_domain(model, state, &note);
-  ASSERT_TRUE(domain) << note;
-  const fs::path dir = fs::temp_directory_path() / fmt::format("demdesign_split_run_frames_{}_ranks", domain->ranks());
-  if (root()) fs::remove_all(dir);
-  domain->any(false);
+  SplitGas gas = split_gas("split_run_frames");
+  ASSERT_TRUE(gas.domain) << gas.note;
+  const std::unique_ptr<Domain>& domain = gas.domain;
+  State& state = gas.state;
+  const fs::path& dir = gas.scratch;
   Workspace work;
   RunOptions options;
   options.progress = false;
@@ -366,7 +379,7 @@ TEST(DomainMpi, ASplitRunWritesItsFramesTogetherWithoutGathering) {
   options.domain = domain.get();
   options.share_frame = mpi::collective_frames();
   std::ostringstream log;
-  run(model, state, work, options, log);
+  run(gas.model, state, work, options, log);
   if (!root()) return;
   EXPECT_NE(log.str().find(fmt::format("written together by {} ranks", domain->ranks())), std::string::npos) << log.str();
   FrameWriter listed(dir.string(), {}, {});
