@@ -29,6 +29,7 @@
 #include "mpi_domain.h"
 #include "mpi_frames.h"
 #include "output/results_hdf5.h"
+#include "output/run.h"
 #include "statistics/diagnostics.h"
 
 namespace {
@@ -120,19 +121,16 @@ int main(int argc, char** argv) {
   const auto share_frame = domain ? mpi::collective_frames() : nullptr;
   const auto write_frames = [&](const char* name) {
     if (o.frames.empty()) return;
-    const auto frame_of = [](const dem::State& s) {
-      dem::ParticleFrame f;
-      f.time = s.time, f.step = s.step, f.count = s.owned(), f.id = s.id.data();
-      f.x = s.x.data(), f.y = s.y.data(), f.z = s.z.data(), f.vx = s.vx.data(), f.vy = s.vy.data(), f.vz = s.vz.data();
-      f.wx = s.wx.data(), f.wy = s.wy.data(), f.wz = s.wz.data(), f.radius = s.radius.data(), f.material = s.material.data();
-      return f;
-    };
     const auto seconds_since = [](auto start) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     if (domain) domain->any(false);
     auto start = std::chrono::steady_clock::now();
     dem::FrameWriter together(o.frames + "/" + name + "_together", {"beads"}, {});
-    if (domain) together.write_frame(frame_of(state), share_frame(state.owned()));
-    else together.write_frame(frame_of(state));
+    if (domain) {
+      const dem::FrameShare share = share_frame(state.owned());
+      dem::write_frame(together, state, &share);
+    } else {
+      dem::write_frame(together, state);
+    }
     if (domain) domain->any(false);
     const double written_together = seconds_since(start);
     const double bytes = static_cast<double>(total) * (8 * 4 + 8 * 3 * 3 + 8 * 4 + 4 * 2);  // id, speed, radius, connectivity; 3 vectors; quaternion; 2 ints
@@ -145,7 +143,7 @@ int main(int argc, char** argv) {
     const double gathering = seconds_since(start);
     if (world.rank == 0) {
       dem::FrameWriter alone(o.frames + "/" + name + "_alone", {"beads"}, {});
-      alone.write_frame(frame_of(gathered));
+      dem::write_frame(alone, gathered);
     }
     domain->any(false);
     const double gathered_and_written = seconds_since(start);

@@ -269,18 +269,6 @@ TEST(DomainMpi, GhostPassOnTwoThreadsSumsAsOnOne) {
   EXPECT_EQ(differ, 0u) << "particles whose state differs between one and two threads";
 }
 
-/// The state's own particles (no ghosts) as a frame's columns.
-ParticleFrame frame_of(const State& s) {
-  ParticleFrame f;
-  f.time = s.time, f.step = s.step, f.count = s.owned();
-  f.id = s.id.data();
-  f.x = s.x.data(), f.y = s.y.data(), f.z = s.z.data();
-  f.vx = s.vx.data(), f.vy = s.vy.data(), f.vz = s.vz.data();
-  f.wx = s.wx.data(), f.wy = s.wy.data(), f.wz = s.wz.data();
-  f.radius = s.radius.data(), f.material = s.material.data();
-  return f;
-}
-
 /// A frame's rows in the order of their particle ids.
 StoredFrame by_id(const StoredFrame& f) {
   std::vector<size_t> order(f.size());
@@ -338,11 +326,12 @@ TEST(DomainMpi, FramesWrittenTogetherEqualTheSerialFrameOfTheSameState) {
   prepare(domain->local_model(), state, work);
   for (int k = 0; k < 400; ++k) step(domain->local_model(), state, work);
   FrameWriter together((dir / "together").string(), {"beads"}, {});
-  together.write_frame(frame_of(state), share_frame(state.owned()));
+  const FrameShare share = share_frame(state.owned());
+  write_frame(together, state, &share);
   const State whole = domain->gather(state);
   if (!root()) return;
   FrameWriter alone((dir / "alone").string(), {"beads"}, {});
-  alone.write_frame(frame_of(whole));
+  write_frame(alone, whole);
 
   ASSERT_EQ(together.frames().size(), 1u);
   EXPECT_EQ(together.frames()[0].count, whole.size());

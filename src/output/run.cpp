@@ -143,29 +143,6 @@ FrameWriter make_frame_writer(const Model& model, const std::string& directory) 
                       {"time_step_s", fmt::format("{:.9g}", model.dt)}});
 }
 
-/// The state's particles (a split run's rank: its own, without the ghosts) as a frame, written by
-/// this process or, with `share`, by every rank together.
-void write_frame(FrameWriter& writer, const State& s, const FrameShare* share = nullptr) {
-  // Orientation per sphere: its body's, identity for free spheres.
-  const size_t n = s.owned();
-  std::vector<double> qw(n, 1.0), qx(n, 0.0), qy(n, 0.0), qz(n, 0.0);
-  for (size_t p = 0; p < n; ++p) {
-    const std::int32_t b = s.body[p];
-    if (b < 0) continue;
-    qw[p] = s.bodies.qw[b], qx[p] = s.bodies.qx[b], qy[p] = s.bodies.qy[b], qz[p] = s.bodies.qz[b];
-  }
-  ParticleFrame frame;
-  frame.time = s.time, frame.step = s.step, frame.count = n;
-  frame.id = s.id.data();
-  frame.x = s.x.data(), frame.y = s.y.data(), frame.z = s.z.data();
-  frame.vx = s.vx.data(), frame.vy = s.vy.data(), frame.vz = s.vz.data();
-  frame.wx = s.wx.data(), frame.wy = s.wy.data(), frame.wz = s.wz.data();
-  frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
-  frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
-  if (share) writer.write_frame(frame, *share);
-  else writer.write_frame(frame);
-}
-
 /// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
 void write_mesh_records(const Model& model, const State& s, const std::string& out) {
   std::vector<MeshFieldSet> sets;
@@ -201,6 +178,28 @@ void write_mesh_records(const Model& model, const State& s, const std::string& o
 }
 
 }  // namespace
+
+void write_frame(FrameWriter& writer, const State& s, const FrameShare* share) {
+  // Orientation per sphere: its body's, identity for free spheres.
+  const size_t n = s.owned();
+  std::vector<double> qw(n, 1.0), qx(n, 0.0), qy(n, 0.0), qz(n, 0.0);
+  for (size_t p = 0; p < n; ++p) {
+    const std::int32_t b = s.body[p];
+    if (b < 0) continue;
+    qw[p] = s.bodies.qw[b], qx[p] = s.bodies.qx[b], qy[p] = s.bodies.qy[b], qz[p] = s.bodies.qz[b];
+  }
+  ParticleFrame frame;
+  frame.time = s.time, frame.step = s.step, frame.count = n;
+  frame.id = s.id.data();
+  frame.x = s.x.data(), frame.y = s.y.data(), frame.z = s.z.data();
+  frame.vx = s.vx.data(), frame.vy = s.vy.data(), frame.vz = s.vz.data();
+  frame.wx = s.wx.data(), frame.wy = s.wy.data(), frame.wz = s.wz.data();
+  frame.radius = s.radius.data(), frame.material = s.material.data(), frame.clump = s.body.data();
+  frame.qw = qw.data(), frame.qx = qx.data(), frame.qy = qy.data(), frame.qz = qz.data();
+  if (share) writer.write_frame(frame, *share);
+  else writer.write_frame(frame);
+}
+
 
 void write_file_atomically(const std::string& path, const std::string& content) {
   const std::filesystem::path target(path);

@@ -58,6 +58,10 @@ void print_setup(const Model& model, const State& state, std::ostream& log);
 /// and summary lines. SIGINT and SIGTERM stop the run after the current step with a checkpoint.
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
 
+/// Writes the state's particles (a split run's rank: its own, without the ghosts) as a frame with
+/// their bodies' orientations: by this process, or with `share` by every rank together.
+void write_frame(FrameWriter& writer, const State& state, const FrameShare* share = nullptr);
+
 /// Writes `content` to `path` through a temporary file and a rename, so a reader never sees a
 /// half-written file. Creates the parent directory.
 void write_file_atomically(const std::string& path, const std::string& content);
