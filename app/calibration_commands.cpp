@@ -56,6 +56,8 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
   test_->add_option("--measurements", measurements_, "measurement file whose size, density and walls to use");
   test_->add_option("--png", png_, "render of the final state (default: test_NAME.png)");
   test_->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
+  test_->add_option("--rayleigh-fraction", rayleigh_fraction_, "time step as a fraction of the Rayleigh time (default: the lab tests' rule)")
+      ->check(CLI::Range(0.005, 0.4));
   for (CLI::App** cmd : {&compare_, &calibrate_, &diagnose_}) {
     const char* name = cmd == &compare_ ? "compare" : cmd == &calibrate_ ? "calibrate" : "diagnose";
     const char* what = cmd == &compare_ ? "simulate every experiment of a measurement file and compare (report in --out)"
@@ -139,6 +141,7 @@ int CalibrationCommands::run_test() {
   TestOptions options;
   options.seed = static_cast<std::uint64_t>(seed_);
   options.size_factor = size_factor_;
+  options.rayleigh_fraction = rayleigh_fraction_;
   options.threads = threads_;
   options.progress = true;
   const std::string png = png_.empty() ? fmt::format("test_{}.png", test_name_) : png_;

@@ -41,7 +41,7 @@ class CalibrationCommands {
   std::string budget_;
   std::string material_, measurements_, test_name_, out_ = "calibration", params_, png_, effects_, synthetic_from_;
   std::vector<std::string> set_;
-  double size_factor_ = 1.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
+  double size_factor_ = 1.0, rayleigh_fraction_ = 0.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
   double stiffness_check_ = 0;  ///< compare --stiffness-check: factor of the second comparison (0: none)
   int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
   bool no_store_ = false, no_renders_ = false, no_walls_first_ = false;

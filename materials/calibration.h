@@ -84,6 +84,7 @@ struct CalibrationOptions {
   /// arching limit scatters by 20 %). At most `replicas`: none are added.
   int most_replicas = 6;
   double size_factor = 1.0;     ///< passed to the virtual tests
+  double rayleigh_fraction = 0; ///< the virtual tests' time step (TestOptions); 0: their rule
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default (1 when parallel > 1)
   /// Simulations of a batch run at once in this process when no `batch` runner is set, each on
   /// its own thread with `threads` OpenMP threads (1 by default): the small apparatus of the lab

@@ -33,6 +33,7 @@ TestOptions test_options(const CalibrationOptions& options, std::uint64_t seed) 
   t.seed = seed;
   t.threads = options.threads;
   t.size_factor = options.size_factor;
+  t.rayleigh_fraction = options.rayleigh_fraction;
   if (options.on_final) t.on_final = options.on_final;
   return t;
 }

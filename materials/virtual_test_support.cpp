@@ -129,6 +129,8 @@ CaseSpec base_case(const MaterialModel& model, const TestOptions& options, const
   spec.simulation.mass_scaling = model.mass_scaling;
   spec.simulation.stiffness_scaling = model.stiffness_scaling;
   spec.simulation.duration = 1e9;  // the tests stop themselves
+  spec.simulation.rayleigh_fraction = options.rayleigh_fraction > 0 ? options.rayleigh_fraction : kLabRayleighFraction;
+  spec.simulation.steps_per_contact = kLabStepsPerContact;
   spec.output.directory = "";
   return spec;
 }

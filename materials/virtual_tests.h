@@ -63,8 +63,19 @@ struct SimulatedOutcome {
   std::vector<std::string> notes;  ///< e.g. "stress tensor agrees with the plate stress to 1.3 %"
 };
 
+/// The virtual tests' time step as a fraction of the Rayleigh time of the smallest particle
+/// (the drop test takes a tenth of it). The evidence for the value: docs/materials-and-calibration.md,
+/// "The lab tests' time step" (bench/lab_time_step.sh).
+inline constexpr double kLabRayleighFraction = 0.2;
+/// ... and at least the engine's safe minimum of steps in the shortest contact at the test's
+/// characteristic speed (the engine's own auto step keeps 20).
+inline constexpr double kLabStepsPerContact = kMinStepsPerContact;
+
 struct TestOptions {
   std::uint64_t seed = 1;     ///< packing replica: a different seed gives a different packing
+  /// Time step as a fraction of the Rayleigh time; 0: kLabRayleighFraction. Kept at least
+  /// kLabStepsPerContact steps per contact at the characteristic velocity.
+  double rayleigh_fraction = 0;
   int threads = 0;            ///< 0: OpenMP default
   double size_factor = 1.0;   ///< < 1 shrinks the apparatus (fewer particles) for fast screening; 1 = as measured
   bool progress = false;      ///< progress lines to stdout

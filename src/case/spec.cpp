@@ -31,6 +31,7 @@ SimulationSpec read_simulation(const YAML::Node& node, const std::string& file) 
   const YAML::Node step = map.node("time_step");
   if (step && !(step.IsScalar() && step.Scalar() == "auto")) s.time_step = map.number("time_step", 0.0, 1e-12, 1.0, "s");
   s.rayleigh_fraction = map.number("rayleigh_fraction", s.rayleigh_fraction, 0.01, 1.0);
+  s.steps_per_contact = map.number("steps_per_contact", s.steps_per_contact, kMinStepsPerContact, 1000.0);
   s.refuse_unsafe_step = map.string("unsafe_time_step", "refuse", {"refuse", "warn"}) == "refuse";
   s.characteristic_velocity = map.number("characteristic_velocity", 0.0, 0.0, 1e4, "m/s");
   s.gravity = map.vec3("gravity", s.gravity);

@@ -231,10 +231,16 @@ struct ParticleSetSpec {
   SourceLocation location;
 };
 
+/// Fewer steps than this in the shortest contact make a step unsafe (timestep.h).
+inline constexpr double kMinStepsPerContact = 8.0;
+
 struct SimulationSpec {
   double duration = 1.0;          // [s]
   double time_step = 0.0;         // [s]; 0: chosen by the advisor
   double rayleigh_fraction = 0.2; // auto step as a fraction of the Rayleigh time
+  /// The auto step also keeps at least this many steps in the shortest contact at the
+  /// characteristic velocity (the safety limit is 8).
+  double steps_per_contact = 20.0;
   bool refuse_unsafe_step = true; // false: warn and run
   double characteristic_velocity = 0.0;  // [m/s] impact speed for the contact-time check; 0: estimate
   Vec3 gravity{0, 0, -9.81};      // [m/s^2]

@@ -12,8 +12,6 @@ namespace dem {
 namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kMaxRayleighFraction = 0.4;
-constexpr double kMinStepsPerContact = 8.0;
-constexpr double kAutoStepsPerContact = 20.0;
 }  // namespace
 
 double rayleigh_time(double radius, double density, double youngs, double poisson) {
@@ -87,7 +85,7 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
 
   advice.user_given = sim.time_step > 0;
   advice.dt = advice.user_given ? sim.time_step
-                                : std::min(sim.rayleigh_fraction * advice.rayleigh_time, advice.contact_time / kAutoStepsPerContact);
+                                : std::min(sim.rayleigh_fraction * advice.rayleigh_time, advice.contact_time / sim.steps_per_contact);
   const double fraction = advice.dt / advice.rayleigh_time;
   const double steps_per_contact = advice.contact_time / advice.dt;
   advice.safe = (!hertz || fraction <= kMaxRayleighFraction) && steps_per_contact >= kMinStepsPerContact;

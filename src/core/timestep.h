@@ -14,8 +14,8 @@ double rayleigh_time(double radius, double density, double youngs, double poisso
 double hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed);
 
 /// The step to use and whether it is safe. Unsafe: above 40 % of the Rayleigh time, or fewer
-/// than 8 steps in the shortest contact. Automatic: `rayleigh_fraction` of the Rayleigh time,
-/// and at least 20 steps per contact.
+/// than kMinStepsPerContact steps in the shortest contact. Automatic: `rayleigh_fraction` of the
+/// Rayleigh time, and at least `steps_per_contact` (default 20) steps per contact.
 TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim);
 
 }  // namespace dem
