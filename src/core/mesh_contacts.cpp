@@ -201,6 +201,23 @@ void find_mesh_candidates(const Model& model, State& s, Workspace& work, double 
               }
               return k;
             });
+  // The candidates' distances at the build (Workspace::mesh_gap): a rebuild's work, read by the
+  // contact pass of every step until the next.
+  resize_discarding(work.mesh_gap, s.mesh_candidates.size());
+#pragma omp parallel for schedule(static) if (nl >= kParallelMin)
+  for (long p = 0; p < nl; ++p) {
+    for (std::int32_t q = s.candidate_begin[p]; q < s.candidate_begin[p + 1]; ++q) {
+      const std::int32_t m = s.mesh_candidates[q][0];
+      const TriangleSurface& surface = *model.meshes[m].surface;
+      const double d[3] = {s.x[p] - work.mesh_translation[m][0], s.y[p] - work.mesh_translation[m][1], s.z[p] - work.mesh_translation[m][2]};
+      double local[3];
+      mul_transposed(work.mesh_rotation[m], d, local);
+      const auto& tri = surface.triangles[s.mesh_candidates[q][1]];
+      work.mesh_gap[q] = std::sqrt(closest_point_on_triangle(local, surface.vertices[tri[0]].data(), surface.vertices[tri[1]].data(),
+                                                             surface.vertices[tri[2]].data())
+                                       .distance2);
+    }
+  }
 }
 
 /// One thread's scratch for the mesh contacts: the batch and the contacts of the last step.
@@ -208,6 +225,9 @@ struct MeshContactPass::Scratch {
   MeshBatch mb;
   std::vector<Candidate> list;
   std::vector<double> old_history;
+  /// [m] How far any mesh point has moved since the lists were built (infinite: a mesh switched
+  /// on since; no candidate is skipped by its distance at the build).
+  double meshes_moved = 0;
 };
 
 void prepare_mesh_contacts(const Model& model, State& s, Workspace& work) {
@@ -230,6 +250,7 @@ MeshContactPass::MeshContactPass(const Model& model, State& state, Workspace& wo
     : model_(model), s_(state), work_(work), scratch_(std::make_unique<Scratch>()) {
   scratch_->mb.b.count = 0;
   scratch_->old_history.resize(static_cast<size_t>(kSlots) * std::max(model.history_width, 1));
+  scratch_->meshes_moved = mesh_displacement_since_build(model, state, work.mesh_time);
 }
 
 MeshContactPass::~MeshContactPass() = default;
@@ -248,6 +269,7 @@ void MeshContactPass::run(long begin, long end) {
   std::vector<double>& old_history = scratch_->old_history;
   // Only the slots that had candidates or contacts when the lists were indexed (Workspace::mesh_rows).
   const std::vector<std::int32_t>& rows = work.mesh_rows;
+  const double* gaps = work.mesh_gap.size() == s.mesh_candidates.size() && s.x_built.size() >= s.owned() ? work.mesh_gap.data() : nullptr;
   for (auto row = std::lower_bound(rows.begin(), rows.end(), begin); row != rows.end() && *row < end; ++row) {
     const long p = *row;
     const std::int32_t first = s.candidate_begin[p], last = s.candidate_begin[p + 1];
@@ -265,6 +287,15 @@ void MeshContactPass::run(long begin, long end) {
     }
     if (mb.b.count + kSlots > kBatch) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
     const double radius = s.radius[p];
+    // Candidates farther from the sphere at the build than its reach plus how far it and the
+    // meshes have moved since cannot touch (the distance to a fixed triangle changes by at most
+    // the displacement): skipped unread. The margin of 1e-9 keeps rounding from skipping one
+    // that the exact test would take.
+    double beyond = std::numeric_limits<double>::infinity();
+    if (gaps && std::isfinite(scratch_->meshes_moved)) {
+      const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
+      beyond = (radius + range + std::sqrt(dx * dx + dy * dy + dz * dz) + scratch_->meshes_moved) * (1 + 1e-9);
+    }
     int count = 0;
     for (std::int32_t q = first; q < last;) {
       const std::int32_t m = s.mesh_candidates[q][0];
@@ -278,6 +309,7 @@ void MeshContactPass::run(long begin, long end) {
       list.clear();
       const double reach2 = (radius + range) * (radius + range);
       for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
+        if (gaps && gaps[q] > beyond) continue;
         const std::int32_t t = s.mesh_candidates[q][1];
         const auto& tri = surface.triangles[t];
         // The plane's distance bounds the triangle's from below: most candidates of a sphere

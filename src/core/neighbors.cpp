@@ -311,11 +311,6 @@ void drop_ghosts(State& s) {
   s.ghosts = 0;
 }
 
-void minimum_image(const Model& model, double d[3]) {
-  for (int a = 0; a < 3; ++a)
-    if (model.period[a] > 0) d[a] -= model.period[a] * std::nearbyint(d[a] / model.period[a]);
-}
-
 void index_contacts(const Model& model, const State& s, Workspace& work) {
   const size_t n = s.size();
   build_csr_of_rows(work.pair_begin, s.pairs.i, n);

@@ -6,6 +6,8 @@
 // slot by particle id.
 #pragma once
 
+#include <cmath>
+
 #include "core/model.h"
 #include "core/state.h"
 #include "core/workspace.h"
@@ -27,7 +29,15 @@ void rebuild_contacts(const Model& model, State& state, Workspace& work);
 /// Rebuilds the workspace's indexing of the state's contact lists without changing them (after
 /// a restart, so the run continues exactly as it would have).
 void index_contacts(const Model& model, const State& state, Workspace& work);
-/// Replaces d by its minimum image along the periodic axes.
-void minimum_image(const Model& model, double d[3]);
+/// Replaces d by its minimum image along the periodic axes. Inline, with the rounding only for
+/// the few pairs that reach across half a period (the same result bit for bit as rounding every
+/// pair: nearbyint of |d/L| <= 1/2 is zero): as a call to libm's nearbyint per listed pair it
+/// took 6.5 % of a periodic drum's time.
+inline void minimum_image(const Model& model, double d[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const double period = model.period[a];
+    if (period > 0 && std::abs(d[a]) > 0.5 * period) d[a] -= period * std::nearbyint(d[a] / period);
+  }
+}
 
 }  // namespace dem

@@ -86,6 +86,12 @@ struct Workspace {
   /// Owned slots with mesh candidates or mesh contacts when the lists were indexed, ascending:
   /// the others cannot touch a mesh before the next build (mesh_contacts.cpp).
   std::vector<std::int32_t> mesh_rows;
+  /// [m] Per mesh candidate (State::mesh_candidates): the distance from the sphere's centre to
+  /// the triangle when the lists were built. A candidate whose distance then exceeds the sphere's
+  /// reach by more than the sphere and the meshes have moved since cannot touch, and the contact
+  /// pass skips it without reading the triangle. Empty (a state restored from a checkpoint
+  /// before its first rebuild): every candidate is tested.
+  std::vector<double> mesh_gap;
   /// Slots per block of the force evaluation: every pair (i, j) has j in i's block or the next
   /// (forces.cpp).
   std::int32_t block = 64;
