@@ -21,7 +21,8 @@
 // (the filled height reached is noted). One run in two phases: the settle runs with the lift
 // motion parked (start 1e6 s); at rest the case is recompiled with the lift starting now and the
 // same state continues (the walls and particles are identical, so the state carries over). Caps:
-// settle, fall time + 3 s; heap, 2 s after the lift ends.
+// settle, fall time + 3 s; heap, 2 s after the lift ends. The lift takes its time step from its
+// own speeds (Runner::phase_speed), the pour from its impacts.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -136,6 +137,7 @@ SimulatedOutcome run_angle_of_repose_cylinder(const MaterialModel& model, const 
   const double lift_start = run.state.time;
   spec.meshes[0].motion.parts[0].start = lift_start;
   spec.meshes[0].motion.parts[0].stop = lift_start + (top + d50) / lift_speed;
+  spec.simulation.characteristic_velocity = run.phase_speed(0.0);  // the lift's own speeds, not the pour's
   run.restart(spec);
   const double lift_end = spec.meshes[0].motion.parts[0].stop;
   const bool rest = run.advance_until(

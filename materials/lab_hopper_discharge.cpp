@@ -15,6 +15,8 @@
 // fill height but never the orifice (the flow rate is set by the orifice in particle diameters;
 // the silo stays at least 2.5 orifices wide, the usual condition for a wall-free orifice).
 // Caps: settle, fall time + 3 s; discharge, three times Beverloo's estimate (C 0.58, k 1.5) + 1 s.
+// The discharge takes its time step from its own speeds (Runner::phase_speed), the pour from its
+// impacts.
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
@@ -47,7 +49,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   const double half = (radius - reach) / std::sqrt(2.0);
   const double column = count * size.mean_volume / (0.15 * 4 * half * half);
   const double z0 = reach + 0.002, z1 = z0 + column;
-  auto make_spec = [&](double open_at) {
+  auto make_spec = [&](double open_at, double speed) {
     CaseSpec spec = base_case(model, options, {wall_material}, "hopper_discharge");
     YAML::Node params;
     params["diameter"] = diameter;
@@ -64,6 +66,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
     equipment.location = setup.location;
     spec.equipment = equipment;
     spec.particles.push_back(particle_box(model, count, Vec3(-half, -half, z0), Vec3(half, half, z1)));
+    spec.simulation.characteristic_velocity = speed;
     const double side = radius + 2 * orifice + 0.1;
     spec.simulation.has_domain = true;
     spec.simulation.domain_min = Vec3(-side, -side, -std::max(0.1, diameter) - 0.05);
@@ -73,7 +76,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   };
 
   SimulatedOutcome out;
-  Runner run(make_spec(1e6));
+  Runner run(make_spec(1e6, 0.0));
   const std::int64_t particles = static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
   progress(options, fmt::format("hopper_discharge: {} particles, {:.3g} m silo, {:.3g} m orifice", particles, diameter, orifice));
   const double fall = std::sqrt(2 * z1 / 9.81);
@@ -81,9 +84,11 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   out.notes.push_back(fmt::format("{} at {:.2f} s; silo {:.3g} m wide, filled {:.3g} m", settled ? "settled" : "NOT settled (time cap)",
                                   run.state.time, diameter, fill));
 
-  // Open now; sample the discharged mass every millisecond.
+  // Open now; sample the discharged mass every millisecond. The discharge's step is set by its
+  // own speeds (a fall from the bed's top to the outlet), not by the pour's impacts from the
+  // column: with these beads 20 % of the Rayleigh time instead of 16 %.
   const double open_at = run.state.time;
-  run.restart(make_spec(open_at));
+  run.restart(make_spec(open_at, run.phase_speed(-0.02)));
   const double initial = run.particle_mass(), lost_before = run.state.lost_mass;
   auto discharged = [&] { return run.state.outlets[0].removed_mass + run.state.lost_mass - lost_before; };
   const double bulk_guess = 0.6 * model.particle.density * run.model.mass_scaling;

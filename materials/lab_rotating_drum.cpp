@@ -19,6 +19,12 @@
 // part of the drum; it collapses during the spin-up revolution. Clumps too long for the lattice
 // to hold the fill are poured by a packing inlet in the drum's inscribed square instead, and the
 // spin-up starts when they are in and have fallen.
+// Rejected: a shorter spin-up (a quarter revolution, then dense samples over half a revolution).
+// The bed does not reach a steady angle within the first revolutions: on the benchmark beads
+// (bench/lab/beads_plain.yaml, 160 mm drum at 10 rpm, six packings, 2026-12-06) the mean angle
+// per quarter revolution fell from 24.4 deg (0.25-0.5) to 23.0 deg (1.75-2), so the same runs
+// read 0.70 +- 0.18 deg steeper over 0.25-0.75 than over the second revolution. The window of
+// the protocol is part of what the observable means (LIGGGHTS' deck samples the same one).
 #include <fmt/format.h>
 
 #include <algorithm>

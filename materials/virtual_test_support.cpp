@@ -212,6 +212,16 @@ bool Runner::advance_until(const std::function<bool()>& done, double until, doub
   return done();
 }
 
+double Runner::phase_speed(double lowest) const {
+  const double g = std::sqrt(model.gravity[0] * model.gravity[0] + model.gravity[1] * model.gravity[1] + model.gravity[2] * model.gravity[2]);
+  double most = 0;
+  for (std::size_t p = 0; p < state.size(); ++p) {
+    const double v2 = state.vx[p] * state.vx[p] + state.vy[p] * state.vy[p] + state.vz[p] * state.vz[p];
+    most = std::max(most, v2 + 2 * g * std::max(0.0, state.z[p] - lowest));
+  }
+  return std::sqrt(most);
+}
+
 double Runner::mean_speed(const std::function<bool(std::size_t)>& keep) const {
   double sum = 0;
   std::size_t n = 0;

@@ -91,6 +91,11 @@ struct Runner {
   /// Steps until `done()` (checked every `check_every` [s]) or until state.time reaches `until`;
   /// returns true when done() held.
   bool advance_until(const std::function<bool()>& done, double until, double check_every = 0.005);
+  /// The impact speed [m/s] a phase starting from the present state can reach at most: a sphere's
+  /// present speed and a free fall from its height down to `lowest` [m], sqrt(v^2 + 2 g h), the
+  /// largest over the spheres. A phase that starts from a settled bed takes its time step from
+  /// this (SimulationSpec::characteristic_velocity), not from the pour that made the bed.
+  double phase_speed(double lowest) const;
   /// Mean speed [m/s] of the spheres whose slot passes `keep` (all when empty); 0 when none.
   double mean_speed(const std::function<bool(std::size_t)>& keep = {}) const;
   double particle_mass() const;  ///< [kg] total
