@@ -18,6 +18,7 @@
 #include "calibrated_material.h"
 #include "calibration.h"
 #include "calibration_report.h"
+#include "cli_checks.h"
 #include "html.h"
 #include "material_model.h"
 #include "measurements.h"
@@ -50,14 +51,15 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
   test_->add_option("material", material_, "material file (YAML)")->required();
   test_->add_option("--test", test_name_, "drop_rebound, bulk_density, angle_of_repose_cylinder, rotating_drum, hopper_discharge, direct_shear")->required();
   test_->add_option("--set", set_, "set-up value KEY=VALUE (SI units; repeat)");
-  test_->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] for a fast look");
-  test_->add_option("--seed", seed_, "packing seed");
-  test_->add_option("--threads", threads_, "OpenMP threads");
+  test_->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] for a fast look")->check(number_in(0, 1, "", true));
+  test_->add_option("--seed", seed_, "packing seed")->check(whole_in(0, 2147483647));
+  test_->add_option("--threads", threads_, "OpenMP threads")->check(whole_in(1, 1024));
   test_->add_option("--measurements", measurements_, "measurement file whose size, density and walls to use");
   test_->add_option("--png", png_, "render of the final state (default: test_NAME.png)");
-  test_->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
+  test_->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)")
+      ->check(number_in(1e-9, 1e3));
   test_->add_option("--rayleigh-fraction", rayleigh_fraction_, "time step as a fraction of the Rayleigh time (default: the lab tests' rule)")
-      ->check(CLI::Range(0.005, 0.4));
+      ->check(number_in(0.005, 0.4));
   for (CLI::App** cmd : {&compare_, &calibrate_, &diagnose_}) {
     const char* name = cmd == &compare_ ? "compare" : cmd == &calibrate_ ? "calibrate" : "diagnose";
     const char* what = cmd == &compare_ ? "simulate every experiment of a measurement file and compare (report in --out)"
@@ -66,21 +68,24 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
     *cmd = app.add_subcommand(name, what);
     (*cmd)->add_option("material", material_, "material file (YAML)")->required();
     (*cmd)->add_option("measurements", measurements_, "measurement file (YAML)")->required();
-    (*cmd)->add_option("--replicas", replicas_, "packings per experiment (simulation noise)");
-    (*cmd)->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] (fewer particles)");
-    (*cmd)->add_option("--threads", threads_, "OpenMP threads of each simulation (default: 1 when simulations run in parallel)");
-    (*cmd)->add_option("--parallel", parallel_, "simulations run at once in this process, each on its own core (default: the cores; under mpirun the ranks share them instead)");
-    (*cmd)->add_option("--seed", seed_, "first packing seed");
+    (*cmd)->add_option("--replicas", replicas_, "packings per experiment (simulation noise)")->check(whole_in(1, 100));
+    (*cmd)->add_option("--size-factor", size_factor_, "shrink the apparatus (0, 1] (fewer particles)")->check(number_in(0, 1, "", true));
+    (*cmd)->add_option("--threads", threads_, "OpenMP threads of each simulation (default: 1 when simulations run in parallel)")->check(whole_in(1, 1024));
+    (*cmd)->add_option("--parallel", parallel_, "simulations run at once in this process, each on its own core (default: the cores; under mpirun the ranks share them instead)")
+        ->check(whole_in(1, 1024));
+    (*cmd)->add_option("--seed", seed_, "first packing seed")->check(whole_in(0, 2147483647));
     (*cmd)->add_option("--out", out_, "output folder (report, plots, ledger.yaml)");
     (*cmd)->add_flag("--quiet", quiet_, "no progress lines");
     (*cmd)->add_flag("--no-renders", no_renders_, "no renders of the final states in the report");
     (*cmd)->add_flag("--no-store", no_store_,
                      "run every simulation again: neither take outcomes from OUT/simulations/ (kept there as each simulation finishes) nor keep new ones");
-    (*cmd)->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)");
+    (*cmd)->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)")
+        ->check(number_in(1e-9, 1e3));
     if (cmd != &compare_) {
       (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
-      (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)");
-      (*cmd)->add_option("--design-factor", design_factor_, "design points per round = max(b+1, ceil(factor b)+2), b quadratic coefficients");
+      (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)")->check(whole_in(1, 10));
+      (*cmd)->add_option("--design-factor", design_factor_, "design points per round = max(b+1, ceil(factor b)+2), b quadratic coefficients")
+          ->check(number_in(0, 100, "", true));
       (*cmd)->add_flag("--no-walls-first", no_walls_first_,
                        "leave each wall pair's restitution as the material gives it, instead of fitting it first to the drop tests on that wall");
       (*cmd)->add_option("--budget", budget_,
@@ -89,17 +94,17 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
     }
     if (cmd == &diagnose_) {
       (*cmd)->add_option("--effects", effects_, "effects to consider, comma separated (default: every effect the material lacks)");
-      (*cmd)->add_option("--confirm", confirm_, "leading candidates confirmed by recalibration");
+      (*cmd)->add_option("--confirm", confirm_, "leading candidates confirmed by recalibration")->check(whole_in(0, 20));
     }
     if (cmd == &compare_) {
       (*cmd)->add_option("--synthetic-from", synthetic_from_,
                          "instead of comparing: simulate this TRUTH material on every experiment of MEASUREMENTS, add Gaussian noise of "
                          "each observation's sigma and write OUT/synthetic_measurements.yaml (synthetic data)");
-      (*cmd)->add_option("--noise-seed", noise_seed_, "seed of the added measurement noise (--synthetic-from)");
+      (*cmd)->add_option("--noise-seed", noise_seed_, "seed of the added measurement noise (--synthetic-from)")->check(whole_in(0, 2147483647));
       (*cmd)->add_option("--stiffness-check", stiffness_check_,
                          "compare again with the particles this much stiffer and say for each observable whether the stiffness "
                          "(--stiffness-scaling) is high enough for it (OUT/stiffness_check.csv)")
-          ->check(CLI::Range(1.01, 1e4));
+          ->check(number_in(1.01, 1e4));
     }
   }
 }
@@ -166,6 +171,11 @@ int CalibrationCommands::run_measured(const std::string& command) {
     for (const std::string& w : measured.warnings) std::cout << "warning: " << w << std::endl;
   apply_measured(model, measured);
   model.stiffness_scaling = stiffness_scaling_;
+  {  // every experiment's set-up checked before the first simulation
+    TestOptions check;
+    check.size_factor = size_factor_;
+    check_experiments(model, measured, check);
+  }
   // Parameters fitted at one stiffness need not hold at another.
   if (const auto& record = model.particle.calibration; record && mpi::world().rank == 0) {
     const double ratio = stiffness_scaling_ / record->stiffness_scaling;
@@ -369,6 +379,11 @@ int CalibrationCommands::write_synthetic() {
   const MeasurementSet measured = read_measurements(measurements_);
   apply_measured(truth, measured);
   truth.stiffness_scaling = stiffness_scaling_;
+  {
+    TestOptions check;
+    check.size_factor = size_factor_;
+    check_experiments(truth, measured, check);
+  }
   std::ifstream in(measurements_);
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
@@ -21,7 +22,9 @@
 #include "base/allocator.h"
 #include "calibration_commands.h"
 #include "case/spec.h"
+#include "case/yaml_check.h"
 #include "case_keys.h"
+#include "cli_checks.h"
 #include "core/model.h"
 #include "core/particles.h"
 #include "equipment.h"
@@ -54,6 +57,7 @@ struct RunArgs {
   std::string rank_grid;  ///< "NXxNYxNZ": the grid of boxes under mpirun (empty: chosen)
   std::string balance = "work";  ///< under mpirun: what the cuts balance, work or time
   bool report = true;
+  std::string command_line;  ///< as typed, for the run record
 };
 
 /// The case file as YAML, with file:line errors.
@@ -177,6 +181,12 @@ int run_case(const RunArgs& args) {
     root = dem::app::variant_case(root, plan, static_cast<size_t>(args.variant));
     case_text = fmt::format("# {} of {}: {}\n", plan.name(args.variant), args.case_path, plan.label(args.variant)) + YAML::Dump(root) + "\n";
   }
+  // The record is the case as run: a duration given on the command line is written into it.
+  if (args.duration > 0) {
+    const std::string header = case_text.starts_with("# ") && args.variant >= 0 ? case_text.substr(0, case_text.find('\n') + 1) : "";
+    root["simulation"]["duration"] = args.duration;
+    case_text = header + fmt::format("# {} as run with --duration {:g}\n", args.case_path, args.duration) + YAML::Dump(root) + "\n";
+  }
   dem::CaseSpec spec = dem::parse_case_node(root, args.case_path);
   dem::equipment::expand_equipment(spec);
   const dem::Model model = compile_case(spec);
@@ -213,6 +223,7 @@ int run_case(const RunArgs& args) {
   options.output_directory = args.out;
   options.progress = !args.quiet;
   options.resume = args.resume;
+  options.command_line = args.command_line;
   // A split run's ranks write each frame together, with no gather (parallel HDF5).
   if (domain) options.share_frame = dem::app::mpi::collective_frames();
   // Images of the flow: every render_every-th frame, and always the last (run.h).
@@ -313,9 +324,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(0, 1);
   RunArgs args;
   auto add_run_options = [&](CLI::App* cmd) {
-    cmd->add_option("--duration", args.duration, "simulated time [s], overrides the case");
-    cmd->add_option("--max-steps", args.max_steps, "stop after this many steps (shortened run)");
-    cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)");
+    cmd->add_option("--duration", args.duration, "simulated time [s], overrides the case")->check(dem::app::number_in(0, 1e6, "s", true));
+    cmd->add_option("--max-steps", args.max_steps, "stop after this many steps (shortened run)")->check(dem::app::whole_in(1, 1e15));
+    cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)")->check(dem::app::whole_in(1, 1024));
     cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
     cmd->add_flag("--quiet", args.quiet, "no progress lines");
     cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
@@ -345,15 +356,22 @@ int main(int argc, char** argv) {
   dem::app::ImageOptions render_options;
   CLI::App* render_cmd = app.add_subcommand("render", "render saved frames of a run to PNG (headless)");
   render_cmd->add_option("results", render_out, "output folder of a run")->required();
-  render_cmd->add_option("--frame", render_frame, "frame index, last or all");
+  render_cmd->add_option("--frame", render_frame, "frame index, last or all")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return text == "last" || text == "all" || dem::app::whole_in(0, 1e9)(text).empty()
+                       ? std::string()
+                       : fmt::format("'{}' is not a frame; valid: a frame index (0, 1, ...), last or all", text);
+          },
+          "INDEX|last|all"));
   render_cmd->add_option("--color-by", render_options.colour, "speed, radius or material")
       ->check(CLI::IsMember({"speed", "radius", "material"}));
   render_cmd->add_option("--camera", render_options.camera, "side, front, top or iso")
       ->check(CLI::IsMember({"side", "front", "top", "iso"}));
   bool render_video = false;
   render_cmd->add_flag("--video", render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
-  render_cmd->add_option("--width", render_options.width, "[px]");
-  render_cmd->add_option("--height", render_options.height, "[px]");
+  render_cmd->add_option("--width", render_options.width, "[px]")->check(dem::app::whole_in(16, 8192));
+  render_cmd->add_option("--height", render_options.height, "[px]")->check(dem::app::whole_in(16, 8192));
   CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
   CLI::App* materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
   bool keys_markdown = false;
@@ -374,7 +392,25 @@ int main(int argc, char** argv) {
     dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
   });
 
-  CLI11_PARSE(app, argc, argv);
+  // A first word that is neither an option, a command nor a file is most likely a misspelt
+  // command (CLI11 would take it for the case file and then complain about the next word).
+  if (argc > 1 && argv[1][0] != '-' && !std::filesystem::exists(argv[1])) {
+    std::vector<std::string> commands;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) commands.push_back(sub->get_name());
+    if (std::find(commands.begin(), commands.end(), argv[1]) == commands.end()) {
+      const std::string hint = dem::nearest_word(argv[1], commands);
+      std::cerr << fmt::format("error: '{}' is neither a command{} nor a case file; commands: {} (or give a case file to run)\n", argv[1],
+                               hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), fmt::join(commands, ", "));
+      return 2;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end with 0; a bad command line with 2, as every other bad input.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  for (int k = 0; k < argc; ++k) args.command_line += (k ? " " : "") + std::string(argv[k]);
   try {
     if (calibration.parsed()) return calibration.run();  // compare, calibrate, diagnose: every rank; test: rank 0
     // Commands that are not campaigns run on rank 0; a case decides in run_case (a sweep uses every rank).

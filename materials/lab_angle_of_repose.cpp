@@ -95,6 +95,8 @@ SimulatedOutcome run_angle_of_repose_cylinder(const MaterialModel& model, const 
   if (radius < 2 * reach)
     read.fail("cylinder_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than two particles across; make it at least {:g} m",
                                                diameter / scale, scale, 4 * reach / scale));
+  read.finish();
+  if (options.validate_only) return {};
 
   CaseSpec spec = base_case(model, options, {base, side}, "angle_of_repose_cylinder");
   PlaneWallSpec plate;

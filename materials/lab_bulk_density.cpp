@@ -33,6 +33,8 @@ SimulatedOutcome run_bulk_density(const MaterialModel& model, const TestSetup& s
   if (radius < 2 * reach)
     read.fail("cup_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than two particles across; make it at least {:g} m",
                                           diameter / scale, scale, 4 * reach / scale));
+  read.finish();
+  if (options.validate_only) return {};
 
   CaseSpec spec = base_case(model, options, {base, side}, "bulk_density");
   const int around = segments_around(radius, 0.5 * size.d50);

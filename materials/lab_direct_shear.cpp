@@ -36,23 +36,13 @@
 #include "core/step.h"
 #include "core/workspace.h"
 #include "statistics/stress.h"
+#include "virtual_test_support.h"
 
 namespace dem::materials {
 
 namespace {
 
 constexpr double kTargetInertialNumber = 8e-4;
-
-double required(const TestSetup& setup, const std::string& key, double min, double max, const std::string& unit) {
-  const auto it = setup.numbers.find(key);
-  if (it == setup.numbers.end())
-    throw CaseError(fmt::format("{}: direct_shear: setup key '{}' is missing; give it in {} (valid: {:g} to {:g})",
-                                setup.location.str(), key, unit, min, max));
-  if (!(it->second >= min && it->second <= max))
-    throw CaseError(fmt::format("{}: direct_shear: setup.{} = {:g} {} is out of range; valid: {:g} to {:g} {}",
-                                setup.location.str(), key, it->second, unit, min, max, unit));
-  return it->second;
-}
 
 /// d50 by mass and the mean particle volume, from reproducible draws.
 struct Sizes {
@@ -196,15 +186,17 @@ struct Run {
 
 SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup& setup, const TestOptions& options) {
   const auto clock = std::chrono::steady_clock::now();
-  const double length = required(setup, "cell_length", 1e-4, 10.0, "m");
-  const double width = required(setup, "cell_width", 1e-4, 10.0, "m");
-  const double preshear = required(setup, "preshear_stress", 1.0, 1e8, "Pa");
-  const double normal = required(setup, "normal_stress", 1.0, 1e8, "Pa");
-  const double speed = required(setup, "shear_velocity", 1e-9, 10.0, "m/s");
+  const detail::SetupReader read(material, setup);
+  const double length = read.number("cell_length", 1e-4, 10.0, "m");
+  const double width = read.number("cell_width", 1e-4, 10.0, "m");
+  const double preshear = read.number("preshear_stress", 1.0, 1e8, "Pa");
+  const double normal = read.number("normal_stress", 1.0, 1e8, "Pa");
+  const double speed = read.number("shear_velocity", 1e-9, 10.0, "m/s");
   if (normal > preshear)
-    throw CaseError(fmt::format("{}: direct_shear: setup.normal_stress = {:g} Pa exceeds preshear_stress = {:g} Pa; a "
-                                "yield locus point is sheared at or below its pre-shear stress",
-                                setup.location.str(), normal, preshear));
+    read.fail("normal_stress", fmt::format("{:g} Pa exceeds preshear_stress = {:g} Pa; a yield locus point is sheared at or below its "
+                                           "pre-shear stress", normal, preshear));
+  read.finish();
+  if (options.validate_only) return {};
   const Sizes sizes = sizes_of(material);
   const double d50 = sizes.d50;
 

@@ -20,6 +20,8 @@ SimulatedOutcome run_drop_rebound(const MaterialModel& model, const TestSetup& s
   const double height = read.number("drop_height", 1e-4, 100.0, "m");
   const double angle_deg = read.number("impact_angle_deg", 0.0, 0.0, 85.0, "deg");
   const std::string plate = read.wall("plate");
+  read.finish();
+  if (options.validate_only) return {};
   const SizeFigures size = size_figures(model);
 
   CaseSpec spec = base_case(model, options, {plate}, "drop_rebound");

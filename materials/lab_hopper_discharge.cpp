@@ -38,6 +38,8 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   const double orifice = read.number("orifice_diameter", 0.005, 0.8 * silo_given, "m");
   const double fill_given = read.number("fill_height", 1e-3, 50.0, "m");
   const std::string wall_material = read.wall("wall");
+  read.finish();
+  if (options.validate_only) return {};
   const SizeFigures size = size_figures(model);
   const double d50 = size.d50, reach = 0.5 * size.largest * size.bounding_factor;
   const double diameter = std::max(scale * silo_given, std::min(silo_given, 2.5 * orifice));
@@ -86,7 +88,7 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
 
   // Open now; sample the discharged mass every millisecond. The discharge's step is set by its
   // own speeds (a fall from the bed's top to the outlet), not by the pour's impacts from the
-  // column: with these beads 20 % of the Rayleigh time instead of 16 %.
+  // column, which hold the pour's step below the Rayleigh rule where the contact time binds.
   const double open_at = run.state.time;
   run.restart(make_spec(open_at, run.phase_speed(-0.02)));
   const double initial = run.particle_mass(), lost_before = run.state.lost_mass;

@@ -88,6 +88,8 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   if (radius < 3 * spacing)
     read.fail("drum_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than six particles across; make it at least {:g} m",
                                            diameter / scale, scale, 6 * spacing / scale));
+  read.finish();
+  if (options.validate_only) return {};
 
   CaseSpec spec = base_case(model, options, {wall_material}, "rotating_drum");
   // The drum about the y axis: built about z, turned by 90 deg about x (z -> y).

@@ -78,8 +78,10 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
   if (std::find(tests.begin(), tests.end(), test) == tests.end())
     map.fail("test", fmt::format("'{}' is not a test{}; valid: {}", test, did_you_mean(test, tests), join(tests)));
   e.setup.test = test;
+  e.setup.id = e.id;
   e.setup.location = e.location;
-  // Set-up: numbers and words; which keys a test needs is checked by the test itself.
+  // Set-up: numbers and words; which keys a test needs is checked by the test itself
+  // (check_experiments, before anything is simulated).
   const YAML::Node setup = map.node("setup");
   if (!setup) map.fail("setup", fmt::format("missing: the set-up of the {} test, {{key: value, ...}}", test));
   MapReader s(setup, file, map.key_path("setup"));
@@ -112,6 +114,12 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
     MapReader o(observed, file, map.key_path("observed"));
     o.keys_are_names("OBSERVABLE");
     for (const std::string& key : o.keys()) {
+      if (key == "outcome")
+        o.fail(key, outcome_names(test).empty()
+                        ? fmt::format("{} has no outcomes; its observables: {}", test, join(observables))
+                        : fmt::format("an outcome is not an observation: write `outcome: {}` beside `observed:` (at the experiment's level, "
+                                      "as `id` and `setup`), not under it; outcomes of {}: {}",
+                                      outcome_names(test).front(), test, join(outcome_names(test))));
       if (std::find(observables.begin(), observables.end(), key) == observables.end())
         o.fail(key, fmt::format("'{}' is not an observable of {}{}; valid: {}", key, test, did_you_mean(key, observables), join(observables)));
       MapReader v(o.node(key), file, o.key_path(key));
@@ -136,8 +144,9 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
     const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
     const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
     if ((no_heap || no_flow) && e.outcome.empty())
-      e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; write it as `outcome: {}` (and leave out the value), "
-                                       "so it is compared as an outcome, not as a number with sigma {:g}",
+      e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; write it as `outcome: {}` beside `observed:` (at the "
+                                       "experiment's level, and leave out the value), so it is compared as an outcome, not as a number "
+                                       "with sigma {:g}",
                                        obs.location.str(), key, obs.value, no_heap ? "no heap formed" : "the orifice arched",
                                        no_heap ? "no_heap" : "blocked", obs.sigma));
   }
@@ -190,6 +199,12 @@ MeasurementSet parse_measurements(const std::string& text, const std::string& na
   } catch (const YAML::Exception& e) {
     throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
   }
+}
+
+void check_experiments(const MaterialModel& model, const MeasurementSet& set, const TestOptions& options) {
+  TestOptions check = options;
+  check.validate_only = true, check.progress = false, check.on_final = nullptr;
+  for (const Experiment& e : set.experiments) run_virtual_test(model, e.setup, check);
 }
 
 MeasurementSet read_measurements(const std::string& path) {

@@ -53,6 +53,11 @@ struct MeasurementSet {
   std::vector<std::string> warnings;
 };
 
+/// Checks every experiment's set-up against its test before anything is simulated: unknown keys
+/// (with the nearest valid one), values out of range, an apparatus too small for the particles.
+/// Throws CaseError naming the file, the line and the experiment's id.
+void check_experiments(const MaterialModel& model, const MeasurementSet& set, const TestOptions& options);
+
 /// Reads a measurement file; throws CaseError naming file, line and key.
 MeasurementSet read_measurements(const std::string& path);
 MeasurementSet parse_measurements(const std::string& text, const std::string& name);

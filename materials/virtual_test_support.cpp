@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "bodies/clump_geometry.h"
+#include "case/yaml_check.h"
 #include "core/particles.h"
 #include "core/step.h"
 
@@ -22,10 +23,24 @@ constexpr double kPi = std::numbers::pi;
 // ---- set-up reading ----------------------------------------------------------------------
 
 void SetupReader::fail(const std::string& key, const std::string& message) const {
-  throw CaseError(fmt::format("{}: {}.setup.{}: {}", setup_.location.str(), setup_.test, key, message));
+  const std::string experiment = setup_.id.empty() ? "" : fmt::format("experiment '{}': ", setup_.id);
+  throw CaseError(fmt::format("{}: {}{}.setup.{}: {}", setup_.location.str(), experiment, setup_.test, key, message));
+}
+
+void SetupReader::finish() const {
+  std::vector<std::string> given;
+  for (const auto& [key, value] : setup_.numbers) given.push_back(key);
+  for (const auto& [key, value] : setup_.words) given.push_back(key);
+  for (const std::string& key : given) {
+    if (std::find(asked_.begin(), asked_.end(), key) != asked_.end()) continue;
+    const std::string hint = nearest_word(key, asked_);
+    fail(key, fmt::format("not a set-up key of {}{}; valid: {}", setup_.test, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
+                          fmt::join(asked_, ", ")));
+  }
 }
 
 double SetupReader::number(const std::string& key, double min, double max, const std::string& unit) const {
+  asked_.push_back(key);
   const auto it = setup_.numbers.find(key);
   if (it == setup_.numbers.end())
     fail(key, fmt::format("missing; the {} test needs it [{}], valid {:g} to {:g}", setup_.test, unit, min, max));
@@ -33,6 +48,7 @@ double SetupReader::number(const std::string& key, double min, double max, const
 }
 
 double SetupReader::number(const std::string& key, double fallback, double min, double max, const std::string& unit) const {
+  if (std::find(asked_.begin(), asked_.end(), key) == asked_.end()) asked_.push_back(key);
   const auto it = setup_.numbers.find(key);
   const double value = it == setup_.numbers.end() ? fallback : it->second;
   if (!(value >= min && value <= max)) fail(key, fmt::format("{:g} {} is out of range; valid {:g} to {:g}", value, unit, min, max));
@@ -40,6 +56,7 @@ double SetupReader::number(const std::string& key, double fallback, double min, 
 }
 
 std::string SetupReader::word(const std::string& key, const std::string& fallback, const std::vector<std::string>& valid) const {
+  asked_.push_back(key);
   const auto it = setup_.words.find(key);
   const std::string value = it == setup_.words.end() ? fallback : it->second;
   if (std::find(valid.begin(), valid.end(), value) == valid.end()) fail(key, fmt::format("'{}' is not valid; valid: {}", value, fmt::join(valid, ", ")));
@@ -47,6 +64,8 @@ std::string SetupReader::word(const std::string& key, const std::string& fallbac
 }
 
 std::string SetupReader::wall(const std::string& key, const std::string& fallback_key) const {
+  for (const std::string& k : {key, fallback_key})
+    if (!k.empty() && std::find(asked_.begin(), asked_.end(), k) == asked_.end()) asked_.push_back(k);
   std::vector<std::string> names;
   for (const MaterialSpec& w : model_.walls) names.push_back(w.name);
   auto it = setup_.words.find(key);

@@ -35,10 +35,14 @@ class SetupReader {
   /// else the only wall material of the model; otherwise a CaseError listing the model's walls.
   std::string wall(const std::string& key, const std::string& fallback_key = "") const;
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  /// Refuses a set-up key the test did not ask for (a misspelt optional key would otherwise be
+  /// ignored), with the nearest valid key. Called once every key is read.
+  void finish() const;
 
  private:
   const MaterialModel& model_;
   const TestSetup& setup_;
+  mutable std::vector<std::string> asked_;  ///< the keys read, in order
 };
 
 /// The particle material's name in the test cases: model.name, or "particle".

@@ -58,7 +58,7 @@ SimulatedOutcome run_virtual_test(const MaterialModel& model, const TestSetup& s
   const TestEntry* e = find(setup.test);
   if (!e) throw CaseError(fmt::format("{}: test: unknown test '{}'; valid: {}", setup.location.str(), setup.test, fmt::join(test_names(), ", ")));
   if (!(options.size_factor > 0 && options.size_factor <= 1))
-    throw CaseError(fmt::format("{}: size_factor {:g} is out of range; valid: above 0, at most 1", setup.location.str(), options.size_factor));
+    throw CaseError(fmt::format("size factor {:g} is out of range; valid: above 0, at most 1 (--size-factor)", options.size_factor));
   // `threads` is this thread's OpenMP setting for the test's duration, given back afterwards:
   // the engine's parallel regions read it (omp_get_max_threads), not the compiled model.
   const int before = omp_get_max_threads();

@@ -45,6 +45,7 @@ struct MaterialModel {
 /// stresses in Pa, speeds in m/s, angles in deg) and words (wall material names, `ends`).
 struct TestSetup {
   std::string test;  ///< drop_rebound, bulk_density, angle_of_repose_cylinder, rotating_drum, hopper_discharge, direct_shear
+  std::string id;    ///< the experiment's id in its measurement file (errors name it); may be empty
   std::map<std::string, double> numbers;
   std::map<std::string, std::string> words;
   SourceLocation location;  ///< of the experiment in the measurement file, for errors
@@ -79,6 +80,9 @@ struct TestOptions {
   int threads = 0;            ///< 0: OpenMP default
   double size_factor = 1.0;   ///< < 1 shrinks the apparatus (fewer particles) for fast screening; 1 = as measured
   bool progress = false;      ///< progress lines to stdout
+  /// Read and check the set-up (keys, ranges, what the apparatus can hold) and return before
+  /// simulating anything: a measurement file is checked whole before its first simulation.
+  bool validate_only = false;
   /// Called with the final state of the test (the app renders it); may be empty.
   std::function<void(const Model&, const State&)> on_final;
 };

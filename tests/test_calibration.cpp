@@ -149,7 +149,13 @@ TEST(Measurements, TheCrossEngineSetsReadAndSayHowTheyWereMade) {
     MaterialModel model = start;
     apply_measured(model, m);
     EXPECT_DOUBLE_EQ(get_parameter(model, "youngs_modulus"), 5e6) << path;
+    EXPECT_NO_THROW(check_experiments(model, m, {})) << path;  // every set-up key known, every value in range
   }
+  // The worked example's file, against the dry beads it starts from.
+  MaterialModel dry = read_material_model(kMaterials + "/glass_beads.yaml");
+  const MeasurementSet wet = read_measurements(std::string(DEMDESIGN_SOURCE_DIR) + "/cases/calibration/wet_glass_beads_measurements.yaml");
+  apply_measured(dry, wet);
+  EXPECT_NO_THROW(check_experiments(dry, wet, {}));
 }
 
 TEST(Measurements, ErrorsNameFileLineKeyAndWhatIsValid) {

@@ -97,6 +97,80 @@ TEST(VirtualTests, MissingOrBadSetupIsACaseErrorAtTheExperiment) {
                CaseError);
 }
 
+// A measurement file is checked whole before its first simulation: a misspelt optional key (which
+// would silently be its default: a normal impact instead of an oblique one), a value out of range
+// and an apparatus the particles do not fit are errors naming the file, line, experiment and key,
+// found before anything runs rather than minutes into a comparison.
+TEST(VirtualTests, AMeasurementFileIsCheckedWholeBeforeAnySimulation) {
+  const MaterialModel m = beads(0.5, 0.1);
+  const std::string head = R"(particles:
+  diameter: {distribution: normal, mean: 0.005, std: 0.0003}
+  density: 2600
+walls:
+  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800}
+experiments:
+  - id: drop_1
+    test: drop_rebound
+    setup: {drop_height: 0.1, plate: steel}
+    observed:
+      restitution: {value: 0.5, sigma: 0.02}
+)";
+  auto error_of = [&](const std::string& tail) {
+    try {
+      check_experiments(m, parse_measurements(head + tail, "m.yaml"), {});
+    } catch (const CaseError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string e = error_of(R"(  - id: drop_oblique
+    test: drop_rebound
+    setup: {drop_height: 0.1, impact_angel_deg: 30, plate: steel}
+    observed:
+      restitution: {value: 0.5, sigma: 0.02}
+)");
+  EXPECT_NE(e.find("m.yaml:12:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("experiment 'drop_oblique'"), std::string::npos) << e;
+  EXPECT_NE(e.find("impact_angel_deg"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'impact_angle_deg'"), std::string::npos) << e;
+  e = error_of(R"(  - id: silo_wide
+    test: hopper_discharge
+    setup: {silo_diameter: 0.1, orifice_diameter: 0.12, fill_height: 0.1, wall: steel}
+    outcome: blocked
+)");
+  EXPECT_NE(e.find("experiment 'silo_wide'"), std::string::npos) << e;
+  EXPECT_NE(e.find("orifice_diameter"), std::string::npos) << e;
+  e = error_of(R"(  - id: drum_backwards
+    test: rotating_drum
+    setup: {drum_diameter: 0.2, drum_depth: 0.05, fill_fraction: 0.35, rpm: -20, ends: periodic, wall: steel}
+    observed:
+      dynamic_angle_deg: {value: 30, sigma: 1}
+)");
+  EXPECT_NE(e.find("experiment 'drum_backwards'"), std::string::npos) << e;
+  EXPECT_NE(e.find("rpm"), std::string::npos) << e;
+  e = error_of(R"(  - id: tiny_cup
+    test: bulk_density
+    setup: {cup_diameter: 0.008, cup_height: 0.05, base: steel}
+    observed:
+      bulk_density: {value: 1500, sigma: 20}
+)");
+  EXPECT_NE(e.find("experiment 'tiny_cup'"), std::string::npos) << e;
+  EXPECT_NE(e.find("fewer than two particles across"), std::string::npos) << e;
+  // An outcome written under `observed:` is told where it goes.
+  try {
+    parse_measurements(head + R"(  - id: silo
+    test: hopper_discharge
+    setup: {silo_diameter: 0.1, orifice_diameter: 0.012, fill_height: 0.1, wall: steel}
+    observed:
+      outcome: blocked
+)", "m.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const CaseError& err) {
+    EXPECT_NE(std::string(err.what()).find("beside `observed:`"), std::string::npos) << err.what();
+  }
+  EXPECT_EQ(error_of(""), "");
+}
+
 // The restitution damping gives exactly e for a binary normal collision (validation CL-2), so
 // the drop's sqrt(apex/drop) equals the pair's restitution within 2 %. Gravity acting during the
 // contact takes g t_c from the rebound speed: the particle is stiff here (E = 0.5 GPa, t_c = 0.09 ms,

@@ -115,12 +115,25 @@ std::vector<Scalars> read_scalars(const Model& model, const std::string& path, d
   return rows;
 }
 
-/// The run's set-up as YAML, so every result can be traced to its inputs.
-std::string run_info(const Model& model) {
-  std::string out = fmt::format(
-      "software: demdesign {}\ncase: {}\nmodel_hash: {:016x}\ntime_step_s: {:.9g}\nmass_scaling: {:g}\n"
+/// A YAML double-quoted scalar of `text`.
+std::string yaml_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+/// The run's set-up as YAML, so every result can be traced to its inputs (the command line that
+/// started it included).
+std::string run_info(const Model& model, const RunOptions& options) {
+  std::string out = fmt::format("software: demdesign {}\ncase: {}\n", DEMDESIGN_VERSION, model.source);
+  if (!options.command_line.empty()) out += fmt::format("command_line: {}\n", yaml_quoted(options.command_line));
+  out += fmt::format(
+      "model_hash: {:016x}\ntime_step_s: {:.9g}\nmass_scaling: {:g}\n"
       "stiffness_scaling: {:g}\nrayleigh_time_s: {:.6g}\ncontact_time_s: {:.6g}\ncontact_law:\n",
-      DEMDESIGN_VERSION, model.source, model.hash, model.dt, model.mass_scaling, model.stiffness_scaling,
+      model.hash, model.dt, model.mass_scaling, model.stiffness_scaling,
       model.advice.rayleigh_time, model.advice.contact_time);
   for (const ActiveEffect& e : model.effects)
     out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", kStageKeys[static_cast<int>(e.spec->stage)],
@@ -255,6 +268,9 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   summary.output_directory = options.output_directory.empty() ? model.output.directory : options.output_directory;
   const std::string out = summary.output_directory;
   const double duration = options.duration >= 0 ? options.duration : model.duration;
+  if (!(duration >= 0) || duration / model.dt > 1e15)
+    throw CaseError(fmt::format("duration {:g} s is not a time this run can reach ({:.3g} steps of {:.3g} s); valid: 0 to 1e6 s", duration,
+                                duration / model.dt, model.dt));
   const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
   // Under domain decomposition every rank steps its share with the domain's model; the ranks
   // write each frame together (options.share_frame) or the root gathers the whole state for it,
@@ -342,7 +358,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     frame_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
   };
   if (options.write_files && (writer || collective)) {
-    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model));
+    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model, options));
     frames.emplace(make_frame_writer(model, out));
     if (options.resume && writer) frames->adopt_existing();
     else if (!options.resume) write_frame_now(*results);
@@ -541,7 +557,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     write_tables();
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
     write_file_atomically(out + "/run_info.yaml",
-                          run_info(model) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
+                          run_info(model, options) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
                                                         "  state_hash: {:016x}\n",
                                                         state.step >= last_step ? "true" : "false", state.time, state.step,
                                                         final_state.size(), state_hash(final_state, model.history_width)));

@@ -26,6 +26,7 @@ struct RunOptions {
   bool write_files = true;
   bool progress = true;
   bool resume = false;            ///< continue from OUT's checkpoint (load_resumable, checkpoint.h)
+  std::string command_line;       ///< the command that started the run, kept in run_info.yaml
   /// Called after a particle frame is written, with the whole state: after every
   /// model.output.render_every-th frame of the run and after the last (the app renders images
   /// here; the engine knows nothing of rendering). `last` is true for the final frame.
