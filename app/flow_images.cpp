@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <limits>
 
 #include "render/render.h"
@@ -75,13 +76,44 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
   // Planes as squares around the particles' extent (an infinite plane cannot be drawn).
   std::vector<std::vector<std::array<double, 3>>> plane_vertices;
   std::vector<std::array<std::int32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
+  // Round walls as triangles: the rings of vertices and the triangles between them.
+  std::vector<std::vector<std::array<double, 3>>> round_vertices;
+  std::vector<std::array<std::int32_t, 3>> round_triangles;
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   const double half = 0.6 * (hi - lo).maxCoeff() + 1e-3;
   for (size_t w = 0; w < model.planes.size(); ++w) {
     const PlaneWall& wall = model.planes[w];
-    if (wall.cylinder) continue;
     const Eigen::Vector3d n(wall.normal[0], wall.normal[1], wall.normal[2]);
     const Eigen::Vector3d at(s.walls.px[w], s.walls.py[w], s.walls.pz[w]);
+    if (wall.shape != PlaneWall::Shape::plane) {
+      // A cylinder over the particles' extent along its axis (an infinite one cannot be drawn);
+      // a tube over its length; a disc as its ring.
+      const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+      const int around = 96;
+      double from = 0, to = wall.length;
+      if (wall.shape == PlaneWall::Shape::cylinder) {
+        const double a0 = (lo - at).dot(n), a1 = (hi - at).dot(n);
+        from = std::min(a0, a1) - 0.1 * wall.radius, to = std::max(a0, a1) + 0.1 * wall.radius;
+      }
+      std::vector<std::array<double, 3>> ring;
+      for (int k = 0; k < around; ++k) {
+        const double angle = 2 * std::numbers::pi * k / around;
+        const Eigen::Vector3d radial = std::cos(angle) * u + std::sin(angle) * v;
+        const bool disc = wall.shape == PlaneWall::Shape::disc;
+        for (int end = 0; end < 2; ++end) {
+          const Eigen::Vector3d c = disc ? Eigen::Vector3d(at + (end ? wall.radius : wall.hole) * radial)
+                                         : Eigen::Vector3d(at + (end ? to : from) * n + wall.radius * radial);
+          ring.push_back({c.x(), c.y(), c.z()});
+        }
+      }
+      if (round_triangles.empty())
+        for (std::int32_t k = 0; k < around; ++k) {
+          const std::int32_t a = 2 * k, b = 2 * ((k + 1) % around);
+          round_triangles.push_back({a, b, a + 1}), round_triangles.push_back({b, b + 1, a + 1});
+        }
+      round_vertices.push_back(std::move(ring));
+      continue;
+    }
     const Eigen::Vector3d foot = centre - (centre - at).dot(n) * n;
     const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
     std::vector<std::array<double, 3>> corners;
@@ -90,6 +122,14 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
       corners.push_back({c.x(), c.y(), c.z()});
     }
     plane_vertices.push_back(corners);
+  }
+  for (const auto& ring : round_vertices) {
+    render::MeshLayer layer;
+    layer.vertices = ring;
+    layer.triangles = round_triangles;
+    layer.cutaway = true;
+    layer.opacity = 0.35f;
+    frame.meshes.push_back(layer);
   }
   for (const auto& corners : plane_vertices) {
     render::MeshLayer layer;

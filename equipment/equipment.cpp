@@ -181,6 +181,11 @@ void expand_equipment(CaseSpec& spec) {
     m.location = equipment.location;
     spec.meshes.push_back(std::move(m));
   }
+  for (PlaneWallSpec& p : made.planes) {
+    if (!names.insert(p.name).second) clash("wall", p.name);
+    p.location = equipment.location;
+    spec.planes.push_back(std::move(p));
+  }
   names.clear();
   for (const OutletSpec& o : spec.outlets) names.insert(o.name);
   for (OutletSpec& o : made.outlets) {

@@ -36,6 +36,7 @@ struct Port {
 /// What a generator produces.
 struct Generated {
   std::vector<MeshWallSpec> meshes;   ///< inline triangles [m], with motion / surface velocity
+  std::vector<PlaneWallSpec> planes;  ///< exact walls (planes, cylinders) where triangles are not needed
   std::vector<Port> ports;            ///< feed points for inlets
   std::vector<OutletSpec> outlets;    ///< the intended outlets (material leaving elsewhere is spillage)
   std::vector<SensorSpec> sensors;    ///< flow planes and boxes the report uses

@@ -9,12 +9,15 @@
 // Flag `slipping` when the particles within one diameter of the drum wall move along it at less
 // than half the wall speed on average (the bed slides as a block instead of being carried up).
 //
-// Set-up decisions: the drum is a static inline mesh (tube, and end discs for `walls`) whose
-// surface moves as a rotation about the axis (SurfaceVelocitySpec rotation). A cylinder turning
-// about its own axis occupies the same space at every instant, so only the contact velocity
-// changes; a rotating Motion was rejected because it makes the contact lists rebuild as the
-// facets move, for the same physics. Facets are at most d50/2 long, so the wall velocity leaves
-// the facet plane by at most 1.5 %. Periodic: the tube reaches two diameters beyond the period.
+// Set-up decisions: the drum is an exact cylinder wall about the axis whose surface turns at
+// the drum's speed (PlaneWallSpec::spin), closed by two turning end plates for `walls`. A
+// cylinder turning about its own axis occupies the same space at every instant, so only the
+// contact velocity changes. Rejected: a rotating Motion of a mesh (the contact lists rebuild as
+// the facets move, for the same physics); a static tube mesh with a rotating surface velocity
+// (the protocol's first form, and LIGGGHTS' in calibration/liggghts/, whose primitive cylinder
+// gives no wall velocity): facets d50/2 long put 6 to 8 triangles near each sphere of the wall
+// layer, a sixth of the test's time, where the exact wall is one contact; and its wall velocity
+// leaves the facet plane by up to 1.5 %.
 // The fill is a jittered cubic lattice (spacing 1.05 largest bounding diameters) in the lowest
 // part of the drum; it collapses during the spin-up revolution. Clumps too long for the lattice
 // to hold the fill are poured by a packing inlet in the drum's inscribed square instead, and the
@@ -92,17 +95,19 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   if (options.validate_only) return {};
 
   CaseSpec spec = base_case(model, options, {wall_material}, "rotating_drum");
-  // The drum about the y axis: built about z, turned by 90 deg about x (z -> y).
-  const int around = segments_around(radius, 0.5 * d50);
-  const double reach = periodic ? 2 * spacing : 0.0;
-  Mesh drum;
-  drum.tube(radius, -0.5 * depth - reach, 0.5 * depth + reach, around, std::max(d50, depth / 4));
-  if (!periodic) drum.disc(radius, -0.5 * depth, around, true), drum.disc(radius, 0.5 * depth, around, false);
-  MeshWallSpec wall = drum.wall("drum", wall_material);
-  wall.rotate_deg = Vec3(90, 0, 0);
-  wall.surface.kind = SurfaceVelocitySpec::Kind::rotation;
-  wall.surface.axis = Vec3(0, 1, 0), wall.surface.point = Vec3::Zero(), wall.surface.angular_speed = omega;
-  spec.meshes.push_back(wall);
+  // The drum about the y axis, its surface turning at omega about +y (v = omega y x r); an end
+  // plate turns about its own normal, so the back one (normal -y) at -omega.
+  PlaneWallSpec shell;
+  shell.name = "drum", shell.material = wall_material;
+  shell.shape = PlaneWallSpec::Shape::cylinder, shell.radius = radius, shell.point = Vec3::Zero(), shell.normal = Vec3(0, 1, 0), shell.spin = omega;
+  spec.planes.push_back(shell);
+  if (!periodic)
+    for (const double side : {-1.0, 1.0}) {
+      PlaneWallSpec end;
+      end.name = side < 0 ? "front" : "back", end.material = wall_material;
+      end.point = Vec3(0, 0.5 * side * depth, 0), end.normal = Vec3(0, -side, 0), end.spin = -side * omega;
+      spec.planes.push_back(end);
+    }
   spec.simulation.has_domain = true;
   spec.simulation.domain_min = Vec3(-radius - 0.01, -0.5 * depth - (periodic ? 0.0 : 0.01), -radius - 0.01);
   spec.simulation.domain_max = Vec3(radius + 0.01, 0.5 * depth + (periodic ? 0.0 : 0.01), radius + 0.01);

@@ -127,7 +127,7 @@ TEST(DirectShear, MissingSetupKeyNamesIt) {
     FAIL();
   } catch (const CaseError& e) {
     EXPECT_NE(std::string(e.what()).find("test_direct_shear"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("'shear_velocity' is missing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("direct_shear.setup.shear_velocity: missing"), std::string::npos) << e.what();
   }
 }
 

@@ -242,7 +242,7 @@ BedLoads settle_in_cylinder(bool faceted, std::uint64_t seed) {
   } else {
     PlaneWallSpec side;
     side.name = "side";
-    side.cylinder = true;
+    side.shape = PlaneWallSpec::Shape::cylinder;
     side.radius = 0.025;
     side.normal = Vec3(0, 0, 1);
     side.material = "steel";

@@ -121,8 +121,16 @@ struct PlaneWallSpec {
   ServoSpec servo;
   std::string material;
   SourceLocation location;
-  bool cylinder = false;  ///< inside of a cylinder (axis through point along normal)
-  double radius = 0;      // [m] cylinder
+  /// plane: one-sided, infinite; cylinder: its inside, infinite (axis through point along
+  /// normal); disc: a flat ring (radius, hole_radius) about point, touched from both sides;
+  /// tube: a cylinder's surface from point along the axis for `length`, touched from both sides.
+  enum class Shape { plane, cylinder, disc, tube } shape = Shape::plane;
+  double radius = 0;       // [m] cylinder, tube; disc: outer radius
+  double hole_radius = 0;  // [m] disc: inner radius (0: a full disc)
+  double length = 0;       // [m] tube
+  /// [rad/s] The surface turns about the line through `point` along `normal` (a cylinder's axis):
+  /// a drum's shell and ends. The wall stays where it is; only the contact velocity changes.
+  double spin = 0;
 };
 
 /// How the surface of a static wall moves (conveyor belts, pulleys): it changes the contact

@@ -109,9 +109,10 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
   w.location = map.location();
   w.name = map.string("name", fmt::format("wall{}", index));
   w.material = map.required_string("material", "name one of the case's materials");
-  const YAML::Node plane = map.node("plane"), cylinder = map.node("cylinder");
-  if (!plane == !cylinder)
-    map.fail("plane", "give one of plane: {point, normal} or cylinder: {point, axis, radius} (particles inside); "
+  const YAML::Node plane = map.node("plane"), cylinder = map.node("cylinder"), disc = map.node("disc"), tube = map.node("tube");
+  if (int(bool(plane)) + int(bool(cylinder)) + int(bool(disc)) + int(bool(tube)) != 1)
+    map.fail("plane", "give one of plane: {point, normal}, cylinder: {point, axis, radius} (particles inside), "
+                      "disc: {point, normal, radius, hole_radius} or tube: {point, axis, radius, length} (both sides); "
                       "CAD walls go under `meshes:`");
   if (plane) {
     MapReader p(plane, file, map.key_path("plane"));
@@ -120,19 +121,32 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
     if (w.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
     w.normal.normalize();
     p.finish();
+  } else if (disc) {
+    MapReader c(disc, file, map.key_path("disc"));
+    w.shape = PlaneWallSpec::Shape::disc;
+    w.point = c.vec3("point", w.point);
+    w.normal = c.vec3("normal", w.normal);
+    if (w.normal.norm() < 1e-12) c.fail("normal", "must not be zero");
+    w.normal.normalize();
+    w.radius = c.required_number("radius", 1e-6, 1e4, "m");
+    w.hole_radius = c.number("hole_radius", 0.0, 0.0, 1e4, "m");
+    if (w.hole_radius >= w.radius) c.fail("hole_radius", fmt::format("{:g} m is not inside the radius {:g} m", w.hole_radius, w.radius));
+    c.finish();
   } else {
-    MapReader c(cylinder, file, map.key_path("cylinder"));
-    w.cylinder = true;
+    MapReader c(cylinder ? cylinder : tube, file, map.key_path(cylinder ? "cylinder" : "tube"));
+    w.shape = cylinder ? PlaneWallSpec::Shape::cylinder : PlaneWallSpec::Shape::tube;
     w.point = c.vec3("point", w.point);
     w.normal = c.vec3("axis", w.normal);
     if (w.normal.norm() < 1e-12) c.fail("axis", "must not be zero");
     w.normal.normalize();
     w.radius = c.required_number("radius", 1e-6, 1e4, "m");
+    if (tube) w.length = c.required_number("length", 1e-6, 1e4, "m");
     c.finish();
   }
   w.velocity = map.vec3("velocity", w.velocity);
+  w.spin = map.number("spin", 0.0, -1e4, 1e4, "rad/s");
   if (const YAML::Node servo = map.node("servo")) {
-    if (w.cylinder) map.fail("servo", "only plane walls can be servo-controlled");
+    if (w.shape != PlaneWallSpec::Shape::plane) map.fail("servo", "only plane walls can be servo-controlled");
     MapReader sv(servo, file, map.key_path("servo"));
     w.has_servo = true;
     w.servo.target_stress = sv.required_number("target_stress", 1e-6, 1e12, "Pa");
@@ -140,6 +154,7 @@ PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t 
     w.servo.max_speed = sv.number("max_speed", 0.0, 0.0, 1e3, "m/s");
     sv.finish();
     if (std::abs(w.velocity.dot(w.normal)) > 0) map.fail("velocity", "a servo wall sets its own normal speed; give only a tangential velocity");
+    if (w.spin != 0) map.fail("spin", "a servo wall cannot also turn; give one of them");
   }
   map.finish();
   return w;

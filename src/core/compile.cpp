@@ -237,8 +237,11 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     PlaneWall wall{w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
                    {w.velocity.x(), w.velocity.y(), w.velocity.z()},
                    material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))};
-    wall.cylinder = w.cylinder;
+    wall.shape = w.shape;
     wall.radius = w.radius;
+    wall.hole = w.hole_radius;
+    wall.length = w.length;
+    wall.spin = w.spin;
     wall.servo = w.has_servo;
     wall.target_stress = w.servo.target_stress;
     wall.servo_area = w.servo.area;
@@ -340,8 +343,8 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
         throw CaseError(fmt::format("{}: {}.attach_to: no wall named '{}'{}; particles glue to a plane wall under `walls:`",
                                     p.location.str(), key, p.attach_to,
                                     hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
-      if (model.planes[source.attached].cylinder)
-        throw CaseError(fmt::format("{}: {}.attach_to: '{}' is a cylinder; particles glue only to plane walls",
+      if (model.planes[source.attached].shape != PlaneWall::Shape::plane)
+        throw CaseError(fmt::format("{}: {}.attach_to: '{}' is not a plane; particles glue only to plane walls",
                                     p.location.str(), key, p.attach_to));
       if (source.clump >= 0)
         throw CaseError(fmt::format("{}: {}.attach_to: glued particles must be spheres (drop `clump`)", p.location.str(), key));
@@ -488,6 +491,12 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   for (const PlaneWall& w : model.planes) {
     h = fnv1a(w.point.data(), sizeof w.point, h);
     h = fnv1a(w.normal.data(), sizeof w.normal, h);
+    // (What older versions hashed stays as it was, so their checkpoints still resume.)
+    if (w.shape == PlaneWall::Shape::disc || w.shape == PlaneWall::Shape::tube) {
+      const double shape[4] = {static_cast<double>(w.shape), w.radius, w.hole, w.length};
+      h = fnv1a(shape, sizeof shape, h);
+    }
+    if (w.spin != 0) h = fnv1a(&w.spin, sizeof w.spin, h);
   }
   model.hash = h;
   return model;

@@ -314,10 +314,17 @@ void wall_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
       continue;
     }
     const int c = b.count;
-    // Contact-point velocity of i: v_i + w_i x (-dist n); the wall's surface velocity.
-    const double rx = s.vx[i] - dist * (s.wy[i] * nz - s.wz[i] * ny) - s.walls.vx[w];
-    const double ry = s.vy[i] - dist * (s.wz[i] * nx - s.wx[i] * nz) - s.walls.vy[w];
-    const double rz = s.vz[i] - dist * (s.wx[i] * ny - s.wy[i] * nx) - s.walls.vz[w];
+    // Contact-point velocity of i: v_i + w_i x (-dist n); the wall's surface velocity, its
+    // translation and, for a turning surface, spin a x (contact point - point), a the axis.
+    double sx = s.walls.vx[w], sy = s.walls.vy[w], sz = s.walls.vz[w];
+    if (wall.spin != 0) {
+      const double cx = x[0] - dist * nx - at[0], cy = x[1] - dist * ny - at[1], cz = x[2] - dist * nz - at[2];
+      const double* a = wall.normal.data();
+      sx += wall.spin * (a[1] * cz - a[2] * cy), sy += wall.spin * (a[2] * cx - a[0] * cz), sz += wall.spin * (a[0] * cy - a[1] * cx);
+    }
+    const double rx = s.vx[i] - dist * (s.wy[i] * nz - s.wz[i] * ny) - sx;
+    const double ry = s.vy[i] - dist * (s.wz[i] * nx - s.wx[i] * nz) - sy;
+    const double rz = s.vz[i] - dist * (s.wx[i] * ny - s.wy[i] * nx) - sz;
     const double vn = rx * nx + ry * ny + rz * nz;
     b.nx[c] = nx, b.ny[c] = ny, b.nz[c] = nz, b.vn[c] = vn;
     b.vtx[c] = rx - vn * nx, b.vty[c] = ry - vn * ny, b.vtz[c] = rz - vn * nz;

@@ -3,6 +3,7 @@
 // simulation only reads it. Everything that changes is in State (state.h).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -33,35 +34,71 @@ struct ActiveEffect {
   std::array<std::uint8_t, 4> options{};  ///< chosen value index per OptionSpec
 };
 
-/// Analytic wall: an infinite plane (particles live on the side the normal points to) or the
-/// inside of an infinite cylinder (axis through `point` along `normal`, radius `radius`).
-/// Where it is now is State.
+/// Analytic wall (PlaneWallSpec::Shape): an infinite plane (particles live on the side the normal
+/// points to), the inside of an infinite cylinder (axis through `point` along `normal`, radius
+/// `radius`), a flat disc or ring about `point` in the plane normal to `normal`, or a tube (a
+/// cylinder's surface from `point` along `normal` for `length`); discs and tubes are touched
+/// from both sides and have edges. Where it is now is State.
 struct PlaneWall {
+  using Shape = PlaneWallSpec::Shape;
   std::string name;
   std::array<double, 3> point;     // [m] at t = 0
-  std::array<double, 3> normal;    // unit; a cylinder's axis
+  std::array<double, 3> normal;    // unit; a cylinder's or tube's axis
   std::array<double, 3> velocity;  // [m/s] set velocity (a servo adds its normal speed)
   int material;
-  bool cylinder = false;
-  double radius = 0;  // [m] cylinder
+  Shape shape = Shape::plane;
+  double radius = 0;  // [m] cylinder, tube; disc: outer radius
+  double hole = 0;    // [m] disc: inner radius
+  double length = 0;  // [m] tube
+  double spin = 0;    // [rad/s] surface turning about the line through point along normal
   bool servo = false;
   double target_stress = 0;  // [Pa]
   double servo_area = 0;     // [m^2]
   double servo_max_speed = 0;  // [m/s]
+
+  bool round() const { return shape == Shape::cylinder || shape == Shape::tube; }
 
   /// Distance [m] from the surface to x on the particles' side, and the unit normal there
   /// (from the surface towards x); `at` is where the wall's point is now.
   double distance(const double at[3], const double x[3], double n[3]) const {
     const double d[3] = {x[0] - at[0], x[1] - at[1], x[2] - at[2]};
     const double along = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
-    if (!cylinder) {
+    if (shape == Shape::plane) {
       n[0] = normal[0], n[1] = normal[1], n[2] = normal[2];
       return along;
     }
     const double r[3] = {d[0] - along * normal[0], d[1] - along * normal[1], d[2] - along * normal[2]};
     const double rho = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    for (int a = 0; a < 3; ++a) n[a] = rho > 0 ? -r[a] / rho : 0.0;
-    return radius - rho;
+    if (shape == Shape::cylinder) {
+      for (int a = 0; a < 3; ++a) n[a] = rho > 0 ? -r[a] / rho : 0.0;
+      return radius - rho;
+    }
+    // Disc and tube: the nearest point c of the surface (relative to `at`), then x - c.
+    double u[3];  // unit radial direction (any one normal to the axis on the axis itself)
+    if (rho > 0) {
+      for (int a = 0; a < 3; ++a) u[a] = r[a] / rho;
+    } else {
+      const double e[3] = {std::abs(normal[0]) < 0.9 ? 1.0 : 0.0, std::abs(normal[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+      const double k = e[0] * normal[0] + e[1] * normal[1];
+      double norm = 0;
+      for (int a = 0; a < 3; ++a) u[a] = e[a] - k * normal[a], norm += u[a] * u[a];
+      for (double& v : u) v /= std::sqrt(norm);
+    }
+    double c_along, c_radius;
+    if (shape == Shape::disc) {
+      c_along = 0, c_radius = std::clamp(rho, hole, radius);
+    } else {
+      c_along = std::clamp(along, 0.0, length), c_radius = radius;
+    }
+    double e[3], dist2 = 0;
+    for (int a = 0; a < 3; ++a) e[a] = d[a] - c_along * normal[a] - c_radius * u[a], dist2 += e[a] * e[a];
+    const double dist = std::sqrt(dist2);
+    if (dist > 0) {
+      for (int a = 0; a < 3; ++a) n[a] = e[a] / dist;
+    } else {
+      for (int a = 0; a < 3; ++a) n[a] = shape == Shape::disc ? normal[a] : -u[a];
+    }
+    return dist;
   }
 };
 

@@ -396,7 +396,18 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, do
     }
   }
   if (moved) return true;
-  // Meshes move too: each side may use half the skin.
+  // Walls move too: each side may use half the skin. A plane only by its motion along its normal,
+  // an infinite cylinder across its axis (the rest slides the surface within itself).
+  if (work.plane_built.size() == model.planes.size())
+    for (size_t w = 0; w < model.planes.size(); ++w) {
+      const PlaneWall& wall = model.planes[w];
+      double d[3] = {s.walls.px[w] - work.plane_built[w][0], s.walls.py[w] - work.plane_built[w][1], s.walls.pz[w] - work.plane_built[w][2]};
+      const double along = d[0] * wall.normal[0] + d[1] * wall.normal[1] + d[2] * wall.normal[2];
+      if (wall.shape == PlaneWall::Shape::plane) d[0] = along, d[1] = d[2] = 0;
+      if (wall.shape == PlaneWall::Shape::cylinder)
+        for (int a = 0; a < 3; ++a) d[a] -= along * wall.normal[a];
+      if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0.25 * model.skin * model.skin) return true;
+    }
   return !model.meshes.empty() && mesh_displacement_since_build(model, s, work.mesh_time) > 0.5 * model.skin;
 }
 
@@ -565,6 +576,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   const long all = static_cast<long>(n);
 #pragma omp parallel for schedule(static) if (all >= kParallelMin)
   for (long p = 0; p < all; ++p) s.x_built[p] = s.x[p], s.y_built[p] = s.y[p], s.z_built[p] = s.z[p];
+  work.plane_built.resize(model.planes.size());
+  for (size_t w = 0; w < model.planes.size(); ++w) work.plane_built[w] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]};
   index_contacts(model, s, work);
   ++work.rebuilds;
 }

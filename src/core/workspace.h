@@ -86,6 +86,10 @@ struct Workspace {
   /// Owned slots with mesh candidates or mesh contacts when the lists were indexed, ascending:
   /// the others cannot touch a mesh before the next build (mesh_contacts.cpp).
   std::vector<std::int32_t> mesh_rows;
+  /// [m] Where each plane wall's point was when the lists were built (State::walls), for the
+  /// rebuild test of moving walls. Empty (a state restored from a checkpoint before its first
+  /// rebuild): not tested.
+  std::vector<std::array<double, 3>> plane_built;
   /// [m] Per mesh candidate (State::mesh_candidates): the distance from the sphere's centre to
   /// the triangle when the lists were built. A candidate whose distance then exceeds the sphere's
   /// reach by more than the sphere and the meshes have moved since cannot touch, and the contact
