@@ -287,6 +287,13 @@ int CalibrationCommands::run_measured(const std::string& command) {
         for (const auto& a : c.adds) k.push_back(a.key);
         entries.push_back(ledger_entry(c.fit.fitted, c.fit.after, "+ " + c.name, k));
       }
+    // The verdict goes on the version it judges: the best candidate's, else the model as it is.
+    LedgerEntry* judged = &entries[1];
+    for (LedgerEntry& e : entries)
+      if (!diagnosis.best.empty() && e.label == "+ " + diagnosis.best) judged = &e;
+    judged->verdict = verdict_words(diagnosis.grade) + (diagnosis.best.empty() ? "" : ": " + diagnosis.best) +
+                      (diagnosis.confirm_next.empty() ? "" : "; confirm next: " + diagnosis.confirm_next);
+    std::cout << "verdict: " << judged->verdict << "\n";
     input.ledger = append_ledger(ledger_path, model.name, entries);
   }
   if (input.ledger.empty()) input.ledger = read_ledger(ledger_path);
@@ -304,9 +311,12 @@ int CalibrationCommands::run_measured(const std::string& command) {
   if (command != "compare") {
     const CalibrationResult* fit = command == "calibrate" ? &calibration : &diagnosis.base;
     std::string note;
-    if (command == "diagnose")
+    if (command == "diagnose") {
       for (const auto& c : diagnosis.candidates)
         if (c.name == diagnosis.recommended && c.confirmed) fit = &c.fit, note = "with " + c.name + ", the effect it recommended";
+      if (diagnosis.grade == Verdict::improves)
+        note = fmt::format("without {}, which improves the fit but does not explain it (the diagnosis' verdict)", diagnosis.best);
+    }
     const std::string path = (fs::path(out_) / (fs::path(material_).stem().string() + "_calibrated.yaml")).string();
     try {
       write_calibrated_material(path, *fit, {command, measurements_, html::now_text().substr(0, 10), note});

@@ -211,28 +211,36 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
     h += "</table>\n";
   }
   if (in.diagnosis) {
+    const materials::Diagnosis& d = *in.diagnosis;
     h += "<h2>Diagnosis</h2>\n";
-    for (const auto& w : in.diagnosis->words) h += "<p><b>" + esc(w) + "</b></p>\n";
-    h += "<table>" + row({"candidate", "adds", "explains", "confirmed chi&sup2;/n", "BIC", "&Delta;BIC", "what it adds"}, true);
-    h += row({"(model as it is)", "", "", num(in.diagnosis->base.after.chi2_per_n(), 3), num(in.diagnosis->base_bic, 4), "0", ""});
-    for (const auto& c : in.diagnosis->candidates) {
+    const bool sure = d.grade == materials::Verdict::missing || d.grade == materials::Verdict::nothing_missing || d.grade == materials::Verdict::parameter;
+    h += fmt::format("<div class=\"banner {}\">Verdict: <b>{}</b>{}</div>\n", sure ? "good" : "warn", esc(materials::verdict_words(d.grade)),
+                     d.best.empty() ? "" : " &mdash; best candidate " + esc(d.best));
+    for (const auto& w : d.words) h += "<p><b>" + esc(w) + "</b></p>\n";
+    h += "<table>" + row({"candidate", "adds", "explains", "ranked by", "confirmed chi&sup2;/n", "BIC", "&Delta;BIC", "what it adds"}, true);
+    h += row({"(model as it is)", "", "", "", num(d.base.after.chi2_per_n(), 3), num(d.base_bic, 4), "0", ""});
+    for (const auto& c : d.candidates) {
       std::string adds;
       for (const auto& a : c.adds) adds += (adds.empty() ? "" : ", ") + esc(a.key);
-      h += row({esc(c.name) + "<br><small>" + esc(c.title) + "</small>", adds, fmt::format("{:.0f} %", 100 * c.explained), c.confirmed ? num(c.fit.after.chi2_per_n(), 3) : "&ndash;",
-                c.confirmed ? num(c.bic, 4) : "&ndash;", c.confirmed ? num(c.delta_bic, 3) : "&ndash;", esc(c.description)});
+      h += row({esc(c.name) + "<br><small>" + esc(c.title) + "</small>", adds, fmt::format("{:.0f} %", 100 * c.explained), esc(c.ranked_why),
+                c.confirmed ? num(c.fit.after.chi2_per_n(), 3) : "&ndash;", c.confirmed ? num(c.bic, 4) : "&ndash;",
+                c.confirmed ? num(c.delta_bic, 3) : "&ndash;", esc(c.description)});
     }
-    for (const auto& [rival, found] : in.diagnosis->separators) {
+    h += "</table>\n<p class=\"note\">explains: fraction of the calibrated model's chi&sup2; the screen expects the effect to remove after a "
+         "short recalibration: a least-squares multiple of its signature (made orthogonal to what the fitted parameters can do) where its two "
+         "strengths agree, else its own runs' chi&sup2;. BIC = chi&sup2; + k ln n. An effect is named as missing when, added and recalibrated, "
+         "it lowers BIC by more than the margin, fits within the noise (chi&sup2;/n at most 1.5, or the 95 % point of chi&sup2; for few "
+         "terms) and beats every other confirmed candidate by the margin; one that lowers BIC but still misfits improves the fit without "
+         "explaining it and is not named.</p>\n";
+    for (const auto& [rival, found] : d.separators) {
       if (found.empty()) continue;
-      h += fmt::format("<h3>Experiments that would tell {} from {}</h3>\n<table>", esc(in.diagnosis->recommended), esc(rival)) +
-           row({"experiment", "observable", esc(in.diagnosis->recommended) + " predicts", esc(rival) + " predicts", "&sigma;", "apart [&sigma;]"}, true);
+      h += fmt::format("<h3>Experiments that would tell {} from {}</h3>\n<table>", esc(d.best), esc(rival)) +
+           row({"experiment", "observable", esc(d.best) + " predicts", esc(rival) + " predicts", "&sigma;", "apart [&sigma;]"}, true);
       for (const auto& x : found)
         h += row({esc(x.id), esc(x.observable), num(x.predicted_a), num(x.predicted_b), num(x.sigma, 2), fmt::format("{:.1f}", x.separation)});
       h += "</table>\n<p class=\"note\">Both fitted models simulated on variants of the file's experiments and on standard set-ups of the tests "
            "it lacks; &sigma; is a lab's repeatability with both simulations' standard errors.</p>\n";
     }
-    h += "</table>\n<p class=\"note\">explains: fraction of the calibrated model's chi&sup2; that a least-squares multiple of the effect's signature "
-         "(made orthogonal to what the fitted parameters can do) removes. BIC = chi&sup2; + k ln n; an effect is recommended when it lowers BIC by "
-         "more than the margin and the model without it does not already fit within the noise (chi&sup2;/n &le; 1.5).</p>\n";
     h += comparison_section(in.diagnosis->base.before, "The starting model", dir, "start");
     h += calibration_section(in.diagnosis->base, dir, "base", "The model as it is, calibrated");
     for (const auto& c : in.diagnosis->candidates)

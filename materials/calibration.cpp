@@ -9,6 +9,7 @@
 #include <nlopt.hpp>
 
 #include <algorithm>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -240,6 +241,50 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 
 }  // namespace
 
+/// Where a fitted value of a dry bulk solid usually lies, when the material file states none
+/// (`plausible:`): sliding friction between particles or against a wall liner 0.1-0.7, restitution
+/// 0.1-0.95, rolling friction (a stand-in for shape) 0-0.4, the span of calibrated values surveyed
+/// by Coetzee (2017, Powder Technology 310:104) for dry granular materials. A value outside, or
+/// one that runs to the edge of its tunable range, is most often the fit absorbing physics the
+/// model lacks (friction raised to 0.8 for missing rolling resistance or cohesion).
+std::optional<std::pair<double, double>> plausible_range(const MaterialModel& model, const std::string& key) {
+  if (const auto it = model.particle.plausible.find(key); it != model.particle.plausible.end()) return it->second;
+  const std::string base = key.substr(key.rfind('.') + 1);
+  if (const auto it = model.particle.plausible.find(base); it != model.particle.plausible.end()) return it->second;
+  if (base == "friction") return std::pair{0.1, 0.7};
+  if (base == "restitution") return std::pair{0.1, 0.95};
+  if (base == "rolling_friction") return std::pair{0.0, 0.4};
+  return std::nullopt;
+}
+
+std::vector<std::string> implausible_fits(const MaterialModel& model, const std::vector<FitParameter>& parameters, const std::vector<double>& values,
+                                          const std::vector<double>& sigma, std::vector<std::string>& words) {
+  std::vector<std::string> keys, said;
+  for (size_t i = 0; i < parameters.size() && i < values.size(); ++i) {
+    const FitParameter& p = parameters[i];
+    const double v = values[i], span = p.highest() - p.lowest();
+    const auto plausible = plausible_range(model, p.key);
+    // Out by more than twice the fitted value's standard error: a truth at the range's edge is not named.
+    const double err = i < sigma.size() && std::isfinite(sigma[i]) ? 2 * sigma[i] : 0.0;
+    const bool out = plausible && (v + err < plausible->first || v - err > plausible->second);
+    // An edge of the range the fit may use; a strength at zero (an effect switched off) is none.
+    const bool low = span > 0 && v - p.lowest() < 0.02 * span && p.lowest() != 0, high = span > 0 && p.highest() - v < 0.02 * span;
+    if (!out && !low && !high) continue;
+    keys.push_back(p.key);
+    const bool own = model.particle.plausible.count(p.key) || model.particle.plausible.count(p.key.substr(p.key.rfind('.') + 1));
+    said.push_back(fmt::format("{} = {:.3g}{}{}", p.key, v,
+                               out ? fmt::format(", outside {:g} to {:g} ({})", plausible->first, plausible->second,
+                                                 own ? "the material file's plausible range" : "what dry bulk solids usually show")
+                                   : "",
+                               low || high ? fmt::format(", at the edge of its range [{:g}, {:g}]", p.lowest(), p.highest()) : ""));
+  }
+  if (!said.empty())
+    words.push_back(fmt::format("Implausible fit: {}. A fitted value out of its plausible range, or run to the edge of its own, is most often "
+                                "the fit absorbing physics the model lacks (diagnose names candidates); check it before designing with it.",
+                                join(said, "; ")));
+  return keys;
+}
+
 CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
                             const CalibrationOptions& given, const Comparison* before, const EarlierPoints& earlier) {
   const Clock::time_point t0 = Clock::now();
@@ -281,6 +326,13 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; "));
     if (options.progress) options.progress(budget_words);
     if (command.outermost()) detail::CommandProgress::shared().plan_remaining(n * detail::calibration_passes(options, p));
+  } else if (command.outermost() && options.progress) {
+    // Without a budget the whole plan, at what the first comparison's simulations cost.
+    CalibrationOptions unlimited = options;
+    unlimited.budget_seconds = 1e12;
+    const BudgetPlan plan = plan_within_budget(unlimited, result.before, p, 0, 0, seconds_since(t0));
+    options.progress(fmt::format("calibrate: the first comparison took {}; the calibration will take about {} more (give --budget to fit it "
+                                 "into less)", detail::duration_text(seconds_since(t0)), detail::duration_text(plan.seconds)));
   }
   std::vector<Term> numeric;
   for (const Term& t : result.before.terms)
@@ -583,6 +635,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                        "differently (Fig. 5: two tests whose contours cross).",
                                        join(result.unidentified), result.condition));
   else result.words.push_back(fmt::format("All parameters are identified (condition number {:.3g}).", result.condition));
+  result.implausible = implausible_fits(model, parameters, result.value, result.sigma, result.words);
   for (size_t t = 0; t < names.size(); ++t)
     if (result.surrogate.fit_rms[t] > 1.0)
       result.words.push_back(fmt::format("The surrogate of {} misses its design points by {:.1f} sigma RMS: it is not quadratic over the box.", names[t],

@@ -38,6 +38,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -301,6 +302,9 @@ struct CalibrationResult {
   std::vector<std::vector<double>> eigenvectors;    ///< [k] = direction of eigenvalues[k]
   double condition = 0;                             ///< largest / smallest eigenvalue
   std::vector<std::string> unidentified;            ///< keys the data do not pin down
+  /// Keys whose fitted value lies outside its plausible range (plausible_range) or at the edge
+  /// of its own: most often the fit absorbing physics the model lacks.
+  std::vector<std::string> implausible;
   std::vector<std::string> words;
   Surrogate surrogate;                              ///< of the last round
   double surrogate_chi2 = 0;                        ///< at the optimum
@@ -329,6 +333,15 @@ struct EarlierPoints {
   std::vector<SimulatedPoint> known;
 };
 
+/// Where a fitted value of `key` plausibly lies for this material: its file's `plausible:` range,
+/// else that of dry bulk solids for friction, restitution and rolling friction; none otherwise.
+std::optional<std::pair<double, double>> plausible_range(const MaterialModel& model, const std::string& key);
+/// Keys of the values out of their plausible range by more than twice their standard error
+/// (`sigma`, same order; empty: none known) or at the edge of their tunable range, with the words
+/// saying so appended to `words`.
+std::vector<std::string> implausible_fits(const MaterialModel& model, const std::vector<FitParameter>& parameters, const std::vector<double>& values,
+                                          const std::vector<double>& sigma, std::vector<std::string>& words);
+
 /// Fits `parameters` (empty: the model's tunable ranges). `before`: an existing comparison of
 /// `model` (its simulation noise is reused); nullptr: compared first.
 CalibrationResult calibrate(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
@@ -352,6 +365,17 @@ struct CandidateResult {
   /// Cosine of the signatures at the two strengths (made orthogonal to the fitted parameters): near 1
   /// when the effect acts linearly, low when the screen cannot be trusted for it.
   double agreement = 1;
+  /// Whether the screen's linear share can rank it: its two strengths agree (agreement >= 0.5)
+  /// and no outcome (arching, no heap, slipping) flips between the model as it is and its two
+  /// strengths. An unstable candidate is ranked by the chi^2 of the runs themselves instead.
+  bool stable = true;
+  /// chi^2 the screen expects of the candidate after a short recalibration: the fitted parameters
+  /// moved linearly to take up what they can (the surrogate's directions), its own strength on
+  /// the line through its two signature runs (stable) or at the better of the two (unstable).
+  double screen_chi2 = 0;
+  double expected_gain = 0;          ///< expected BIC gain: base chi^2 - screen_chi2 - (added parameters) ln n
+  double cost = 0;                   ///< [s] what its signature simulations took (wall seconds, one core each)
+  std::string ranked_why;            ///< why it stands where it is in the ranking
   bool confirmed = false;
   CalibrationResult fit;             ///< when confirmed
   double chi2 = 0, bic = 0, delta_bic = 0;  ///< confirmed: after recalibration; delta = base BIC - this BIC
@@ -370,11 +394,29 @@ struct Separator {
   std::string words;
 };
 
+/// How sure a diagnosis is (Diagnosis::grade).
+enum class Verdict {
+  nothing_missing,  ///< the model as it is fits within the noise
+  missing,          ///< an effect added and recalibrated fits within the noise and beats every confirmed rival by the BIC margin
+  cannot_tell,      ///< two confirmed effects fit within the noise and the data cannot tell them apart (a separating experiment is named)
+  improves,         ///< the best effect lowers BIC by the margin but the model with it still misfits: not named as missing
+  parameter,        ///< a wall parameter the fit left out explains the misfit: not missing physics
+  none_found,       ///< the model misfits and no candidate lowers BIC by the margin
+};
+/// "nothing missing", "missing", "cannot tell", "improves, not explained", "a parameter", "no effect found".
+std::string verdict_words(Verdict v);
+
 struct Diagnosis {
   CalibrationResult base;
   double base_bic = 0;
   std::vector<CandidateResult> candidates;  ///< ranked: confirmed by BIC, then by explained fraction
-  std::string recommended;                  ///< candidate name, "" for none
+  Verdict grade = Verdict::none_found;
+  std::string best;                         ///< the confirmed candidate of lowest BIC, whatever the grade ("" for none)
+  /// The candidate named as missing (grades missing, cannot_tell) or the parameter (grade
+  /// parameter); "" otherwise: an effect that improves the fit without explaining it is not.
+  std::string recommended;
+  std::vector<std::string> unexplained;     ///< improves: the terms the best model still misses by more than 2 sigma
+  std::string confirm_next;                 ///< improves: the unconfirmed candidate to recalibrate next ("" for none)
   std::vector<std::string> rivals;          ///< confirmed candidates the data cannot tell from the recommended one
   /// Per rival: the experiments that would tell it from the recommended candidate, best first.
   std::map<std::string, std::vector<Separator>> separators;
@@ -402,6 +444,12 @@ BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double p
 /// BIC = chi^2 + k ln n.
 double bic(double chi2, int k, int n);
 
+/// The chi^2/n at or below which a model of k fitted parameters fits n terms within the noise:
+/// options.fits_within_noise, or the 95 % point of chi^2 with n - k degrees of freedom over n
+/// where that is higher (8 terms and 2 parameters: 1.57); fits_within_noise <= 0: itself (no model
+/// fits, every candidate is screened and confirmed).
+double noise_line(const CalibrationOptions& options, int n, int k);
+
 Diagnosis diagnose(const MaterialModel& model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
                    const CalibrationOptions& options);
 
@@ -417,6 +465,9 @@ struct LedgerEntry {
   std::map<std::string, double> residuals;        ///< term name -> normalised residual
   double chi2 = 0;
   int n = 0;
+  /// The diagnosis' verdict on this version, where one was made ("missing: epsd ...",
+  /// "improves, not explained: jkr ..."; Verdict): "" for none.
+  std::string verdict;
   double chi2_per_n() const { return n > 0 ? chi2 / n : 0.0; }
 };
 

@@ -60,6 +60,7 @@ std::vector<LedgerEntry> read_ledger(const std::string& path) {
         for (const auto& kv : v["residuals"]) e.residuals[kv.first.as<std::string>()] = kv.second.as<double>();
       e.chi2 = v["chi2"].as<double>(0);
       e.n = v["n"].as<int>(0);
+      e.verdict = v["verdict"].as<std::string>("");
       out.push_back(std::move(e));
     }
   } catch (const YAML::Exception& error) {
@@ -87,6 +88,7 @@ std::vector<LedgerEntry> append_ledger(const std::string& path, const std::strin
     out << YAML::EndMap;
     out << YAML::Key << "chi2" << YAML::Value << e.chi2 << YAML::Key << "n" << YAML::Value << e.n;
     out << YAML::Key << "chi2_per_n" << YAML::Value << e.chi2_per_n();
+    if (!e.verdict.empty()) out << YAML::Key << "verdict" << YAML::Value << e.verdict;
     out << YAML::Key << "residuals" << YAML::Value << YAML::BeginMap;
     for (const auto& [k, v] : e.residuals) out << YAML::Key << k << YAML::Value << v;
     out << YAML::EndMap << YAML::EndMap;

@@ -134,21 +134,36 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
     }
     o.finish();
   }
+  // `outcome: none` says that a value which looks like an outcome (below) is meant as a number.
+  bool as_number = false;
   if (map.has("outcome")) {
-    const std::vector<std::string> outcomes = outcome_names(test);
+    std::vector<std::string> outcomes = outcome_names(test);
     if (outcomes.empty()) map.fail("outcome", fmt::format("{} has no outcomes; remove the key", test));
+    outcomes.push_back("none");
     e.outcome = map.string("outcome", "", outcomes);
+    as_number = e.outcome == "none";
+    if (as_number) e.outcome.clear();
   }
-  // An outcome written as a number: no heap measured as an angle of 0, an arch as no flow.
-  for (const auto& [key, obs] : e.observed) {
+  // An outcome written as a number, as a lab writes it: no heap as an angle of 0, an arch as no
+  // flow, a bed that slides without an avalanche as a drum angle of 0. It is compared as the
+  // outcome it means, with a warning, unless the file says `outcome: none`.
+  for (auto it = e.observed.begin(); it != e.observed.end() && e.outcome.empty() && !as_number;) {
+    const auto& [key, obs] = *it;
     const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
     const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
-    if ((no_heap || no_flow) && e.outcome.empty())
-      e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; write it as `outcome: {}` beside `observed:` (at the "
-                                       "experiment's level, and leave out the value), so it is compared as an outcome, not as a number "
-                                       "with sigma {:g}",
-                                       obs.location.str(), key, obs.value, no_heap ? "no heap formed" : "the orifice arched",
-                                       no_heap ? "no_heap" : "blocked", obs.sigma));
+    const bool no_avalanche = test == "rotating_drum" && key == "dynamic_angle_deg" && std::abs(obs.value) < 1.0;
+    if (!(no_heap || no_flow || no_avalanche)) {
+      ++it;
+      continue;
+    }
+    e.outcome = no_heap ? "no_heap" : no_flow ? "blocked" : "slipping";
+    e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; compared as `outcome: {}`, not as a number with sigma {:g}. "
+                                     "Write `outcome: {}` beside `observed:` (at the experiment's level) and leave out the value to say "
+                                     "so, or `outcome: none` to compare the number",
+                                     obs.location.str(), key, obs.value,
+                                     no_heap ? "no heap formed" : no_flow ? "the orifice arched" : "the bed slid without avalanching",
+                                     e.outcome, obs.sigma, e.outcome));
+    it = e.observed.erase(it);
   }
   if (e.observed.empty() && e.outcome.empty())
     map.fail("observed", fmt::format("missing: what was observed, e.g. {{{}: {{value: V, sigma: S}}}}{}", observables.front(),

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include "analytic_lab.h"
 #include "calibration.h"
@@ -120,8 +121,27 @@ experiments:
 )";
   const MeasurementSet with_zero = parse_measurements(zero, "m.yaml");
   ASSERT_EQ(with_zero.warnings.size(), 1u);
-  EXPECT_NE(with_zero.warnings[0].find("outcome: no_heap"), std::string::npos) << with_zero.warnings[0];
+  EXPECT_NE(with_zero.warnings[0].find("compared as `outcome: no_heap`"), std::string::npos) << with_zero.warnings[0];
+  EXPECT_NE(with_zero.warnings[0].find("beside `observed:`"), std::string::npos) << with_zero.warnings[0];
   EXPECT_EQ(with_zero.warnings[0].rfind("m.yaml:20:", 0), 0u) << with_zero.warnings[0];
+  // ... and compared as that outcome, the value left out.
+  EXPECT_EQ(with_zero.experiments.back().outcome, "no_heap");
+  EXPECT_TRUE(with_zero.experiments.back().observed.empty());
+  // `outcome: none` keeps the number as a number, without a warning.
+  std::string as_number = zero;
+  as_number.replace(as_number.find("    observed:\n      angle_deg: {value: 0"), 4, "    outcome: none\n    ");
+  const MeasurementSet kept = parse_measurements(as_number, "m.yaml");
+  EXPECT_TRUE(kept.warnings.empty());
+  EXPECT_EQ(kept.experiments.back().outcome, "");
+  EXPECT_DOUBLE_EQ(kept.experiments.back().observed.at("angle_deg").value, 0.0);
+  // A mass flow of 0 reads as an arch, a drum angle of 0 as a bed that slid.
+  for (const auto& [test, setup, key, outcome] : {std::tuple{"hopper_discharge", "{silo_diameter: 0.1, orifice_diameter: 0.012, fill_height: 0.1, wall: steel}", "mass_flow_rate", "blocked"},
+                                                  std::tuple{"rotating_drum", "{drum_diameter: 0.2, drum_depth: 0.05, fill_fraction: 0.35, rpm: 20, wall: steel}", "dynamic_angle_deg", "slipping"}}) {
+    const MeasurementSet read = parse_measurements(text + fmt::format("  - id: x\n    test: {}\n    setup: {}\n    observed:\n      {}: {{value: 0, sigma: 0.01}}\n",
+                                                                       test, setup, key), "m.yaml");
+    EXPECT_EQ(read.experiments.back().outcome, outcome) << test;
+    EXPECT_EQ(read.warnings.size(), 1u) << test;
+  }
   EXPECT_TRUE(m.warnings.empty());
   // A misspelt measured key still names the nearest valid one.
   const std::string bad = std::string(text).replace(text.find("poisson_ratio: 0.25"), 19, "poison_ratio: 0.25");

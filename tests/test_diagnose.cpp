@@ -45,6 +45,8 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   ASSERT_FALSE(d.candidates.empty());
   EXPECT_EQ(d.candidates.front().name, "epsd") << d.words.front();
   EXPECT_EQ(d.recommended, "epsd") << d.words.front();
+  EXPECT_EQ(d.grade, Verdict::missing) << d.words.front();
+  EXPECT_EQ(d.words.front().rfind("Missing: epsd", 0), 0u) << d.words.front();
   EXPECT_LT(d.candidates.front().fit.after.chi2_per_n(), 2.0);
   EXPECT_GT(d.candidates.front().explained, 0.5);
   // The report: self-contained HTML with the diagnosis, contour maps and the ledger.
@@ -58,7 +60,7 @@ TEST(Diagnose, AnalyticHiddenRollingResistanceIsNamedFirst) {
   const std::string html = report::write_calibration_report(in, dir);
   std::ifstream file(html);
   const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("Most likely missing: epsd"), std::string::npos);
+  EXPECT_NE(text.find("Missing: epsd"), std::string::npos);
   EXPECT_NE(text.find("Error ledger"), std::string::npos);
   EXPECT_EQ(text.find("http"), std::string::npos);
   // Per experiment, the observable that drives its misfit.
@@ -147,8 +149,9 @@ TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
   ASSERT_EQ(d.rivals.size(), 1u);
   EXPECT_EQ(d.rivals.front(), d.candidates[1].name);
   bool words = false;
-  for (const std::string& w : d.words) words = words || w.find("These data do not tell " + d.recommended + " from " + d.rivals.front()) == 0;
+  for (const std::string& w : d.words) words = words || w.find("Cannot tell " + d.recommended + " from " + d.rivals.front()) == 0;
   EXPECT_TRUE(words);
+  EXPECT_EQ(d.grade, Verdict::cannot_tell);
   // The experiment it names separates them: simulated with the truth (bridges, which neither
   // candidate is), its outcome lies at least 2 sigma nearer one prediction than the other, so the
   // measurement decides between the two (here it also rejects both: the diagnosis is run again
@@ -211,6 +214,7 @@ TEST(Diagnose, AnalyticControlGetsNoRecommendation) {
   const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
   EXPECT_LT(d.base.after.chi2_per_n(), 1.5);
   EXPECT_EQ(d.recommended, "");
+  EXPECT_EQ(d.grade, Verdict::nothing_missing);
   EXPECT_NE(d.words.front().find("No effect recommended"), std::string::npos);
   // A model that fits gets no signature screen: nothing it found could be recommended.
   EXPECT_TRUE(d.candidates.empty());

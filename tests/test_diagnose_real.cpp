@@ -184,7 +184,9 @@ TEST(DiagnoseReal, HiddenLiquidBridgesWithVirtualTests) {
   // apart (the diagnosis then says so and names what to measure). Runs on 2026-12-01:
   // bridges first by 0.9 in BIC over clump shape; with the neighbour lists following the drift (which
   // changed the bulk-density pours' last bits), JKR first by 2.5 over the bridges, under the
-  // rival margin. Earlier builds: bridges first, JKR second by more than 5.
+  // rival margin. Earlier builds: bridges first, JKR second by more than 5. 2026-12-06 (signatures screened
+  // whole when the calibrated residual lies along friction's direction): clump shape first by 0.1 over
+  // the bridges, both named, a drum at 20 rpm proposed that puts them 9.3 sigma apart.
   const auto bridges = std::find_if(d.candidates.begin(), d.candidates.end(), [](const CandidateResult& c) { return c.name == "liquid_bridge"; });
   ASSERT_NE(bridges, d.candidates.end());
   const bool first = bridges == d.candidates.begin();

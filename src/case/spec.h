@@ -70,6 +70,9 @@ struct MaterialSpec {
   std::string description;
   std::map<std::string, std::string> sources;   ///< key -> where its value comes from
   std::map<std::string, std::pair<double, double>> tunable;  ///< key -> [min, max] for calibration
+  /// key -> [min, max] a fitted value of this material plausibly lies in (its class's, with the
+  /// source under `sources:`); a calibration names a value outside as a sign of missing physics.
+  std::map<std::string, std::pair<double, double>> plausible;
   std::optional<CalibrationRecord> calibration;  ///< when the library file is a calibrated material
 };
 

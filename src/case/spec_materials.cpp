@@ -144,15 +144,17 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
     s.keys_are_names("PARAMETER");
     for (const std::string& key : s.keys()) lib.material.sources[key] = s.string(key, "");
   }
-  if (const YAML::Node tunable = file_map.node("tunable")) {
-    MapReader t(tunable, lib.file, "tunable");
+  for (const char* section : {"tunable", "plausible"}) {
+    const YAML::Node ranges = file_map.node(section);
+    if (!ranges) continue;
+    MapReader t(ranges, lib.file, section);
     t.keys_are_names("PARAMETER");
     for (const std::string& key : t.keys()) {
       const YAML::Node range = t.node(key);
       if (!range.IsSequence() || range.size() != 2) t.fail(key, "must be a range [min, max]");
       const double lo = MapReader::finite_number(range[0], t, key), hi = MapReader::finite_number(range[1], t, key);
       if (!(lo < hi)) t.fail(key, "needs min < max");
-      lib.material.tunable[key] = {lo, hi};
+      (std::string(section) == "tunable" ? lib.material.tunable : lib.material.plausible)[key] = {lo, hi};
     }
   }
   if (const YAML::Node walls = file_map.node("walls")) {
