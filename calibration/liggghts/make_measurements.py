@@ -469,14 +469,17 @@ def test_hopper_discharge(args, mat, setup, folder):
     cell = min(d50, 2 * math.pi * R / around)
     silo = Stl("silo")
     silo.disc(R, 0.0, around, r_in=hole, cell=cell)
-    silo.tube(R, 0.0, height, around, max(cell, 2 * math.pi * R / around))
+    primitive = getattr(args, "primitive_walls", False)  # the wall as LIGGGHTS' exact zcylinder
+    if not primitive:
+        silo.tube(R, 0.0, height, around, max(cell, 2 * math.pi * R / around))
     silo.write(os.path.join(folder, "silo.stl"))
     gate = Stl("gate")
     gate.disc(hole + max(0.005, 0.1 * orifice), -0.001, around)
     gate.write(os.path.join(folder, "gate.stl"))
     log, elapsed = run_liggghts(args, folder, "hopper_discharge.in",
                                 dict(mat.liggghts_vars(), silo_diameter=diameter, orifice_diameter=orifice, fill_height=fill,
-                                     silo_stl="silo.stl", gate_stl="gate.stl", out="discharge.txt"), "hopper")
+                                     silo_stl="silo.stl", gate_stl="gate.stl", silo_primitive=int(primitive),
+                                     out="discharge.txt"), "hopper")
     settled = result_lines(log, "settled")[-1]
     m0 = float(settled["mass"])
     rows = read_columns(os.path.join(folder, "discharge.txt"))  # time since opening, remaining mass
