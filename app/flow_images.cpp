@@ -123,22 +123,17 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
     }
     plane_vertices.push_back(corners);
   }
-  for (const auto& ring : round_vertices) {
+  // Exact walls drawn as translucent, cut-away layers.
+  const auto add_wall = [&](const auto& vertices, const auto& triangles) {
     render::MeshLayer layer;
-    layer.vertices = ring;
-    layer.triangles = round_triangles;
+    layer.vertices = vertices;
+    layer.triangles = triangles;
     layer.cutaway = true;
     layer.opacity = 0.35f;
-    frame.meshes.push_back(layer);
-  }
-  for (const auto& corners : plane_vertices) {
-    render::MeshLayer layer;
-    layer.vertices = corners;
-    layer.triangles = quad;
-    layer.cutaway = true;
-    layer.opacity = 0.35f;
-    frame.meshes.push_back(layer);
-  }
+    frame.meshes.push_back(std::move(layer));
+  };
+  for (const auto& ring : round_vertices) add_wall(ring, round_triangles);
+  for (const auto& corners : plane_vertices) add_wall(corners, quad);
   frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
   frame.caption = fmt::format("{}   t = {:.3f} s   {} particles", model.title.empty() ? model.source : model.title, s.time, s.size());
   render::render_png(frame, path);
