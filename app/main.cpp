@@ -17,7 +17,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include "base/allocator.h"
 #include "calibration_commands.h"
@@ -53,6 +55,7 @@ struct RunArgs {
   std::string out;
   bool quiet = false;
   bool resume = false;
+  bool overwrite = false;  ///< replace the results of an earlier run in OUT (only the files runs wrote)
   long variant = -1;  ///< run this variant of the case's sweep (the sweep runner's children)
   std::string rank_grid;  ///< "NXxNYxNZ": the grid of boxes under mpirun (empty: chosen)
   std::string balance = "work";  ///< under mpirun: what the cuts balance, work or time
@@ -189,6 +192,21 @@ int run_case(const RunArgs& args) {
   }
   dem::CaseSpec spec = dem::parse_case_node(root, args.case_path);
   dem::equipment::expand_equipment(spec);
+  // The output folder before the case is compiled: refused when it holds another run's results
+  // (without --resume or --overwrite) or a file of the run's names that no run wrote, and locked
+  // while this run writes it (output/run_folder.h). What this program writes there after the run
+  // (the case as run, equipment meshes, renders, the report) is guarded as the run's own.
+  const std::vector<std::string> caller_outputs = {"case.yaml",           "meshes/*.stl",       "renders/frame_*.png",
+                                                   "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
+                                                   "report/*.csv",        "report/*.png",       "report/plots/*.png",
+                                                   "report/plots/*.gp",   "report/plots/*.tsv"};
+  std::shared_ptr<dem::RunFolder> folder;
+  if (dem::app::mpi::world().rank == 0) {
+    std::vector<std::string> names = dem::run_output_names();
+    names.insert(names.end(), caller_outputs.begin(), caller_outputs.end());
+    const dem::FolderUse use = args.resume ? dem::FolderUse::resume : args.overwrite ? dem::FolderUse::overwrite : dem::FolderUse::fresh;
+    folder = std::make_shared<dem::RunFolder>(!args.out.empty() ? args.out : spec.output.directory, use, names, std::cout);
+  }
   const dem::Model model = compile_case(spec);
   const int threads = args.threads > 0 ? args.threads : model.threads;
   if (threads > 0) omp_set_num_threads(threads);
@@ -223,6 +241,9 @@ int run_case(const RunArgs& args) {
   options.output_directory = args.out;
   options.progress = !args.quiet;
   options.resume = args.resume;
+  options.overwrite = args.overwrite;
+  options.caller_outputs = caller_outputs;
+  options.folder = folder;
   options.command_line = args.command_line;
   // A split run's ranks write each frame together, with no gather (parallel HDF5).
   if (domain) options.share_frame = dem::app::mpi::collective_frames();
@@ -234,7 +255,7 @@ int run_case(const RunArgs& args) {
     if (last) std::cout << fmt::format("  rendered {}\n", path);
   };
   const dem::RunSummary summary = dem::run(model, state, work, options, log);
-  if (world.rank != 0) return 0;
+  if (world.rank != 0 || summary.already_complete) return 0;
   const std::string out = summary.output_directory;
   dem::write_file_atomically(out + "/case.yaml", case_text);
   if (spec.equipment) {
@@ -335,7 +356,10 @@ int main(int argc, char** argv) {
     cmd->add_option("--balance", args.balance,
                     "under mpirun: what the cuts balance: work (particles and contacts, reproducible) or time (each rank's measured computing time)")
         ->check(CLI::IsMember({"work", "time"}));
-    cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
+    CLI::Option* resume = cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
+    cmd->add_flag("--overwrite", args.overwrite,
+                  "replace the results of an earlier run in OUT: removes the files runs wrote there (run_files.txt), nothing else")
+        ->excludes(resume);
   };
   app.add_option("case", args.case_path, "case file (YAML) to run");
   add_run_options(&app);

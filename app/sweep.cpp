@@ -227,12 +227,13 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
   bool exhausted = false;
   size_t done = 0;
   double busy_seconds = 0;
-  // Starts variant k as `demdesign run CASE --variant k` in its folder.
+  // Starts variant k as `demdesign run CASE --variant k` in its folder. The sweep owns its variants'
+  // folders: a sweep run again replaces what its variants wrote there (--overwrite).
   const auto start_variant = [&](size_t k) {
     const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
     fs::create_directories(dir);
     std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
-                                     "--threads", std::to_string(threads), "--quiet"};
+                                     "--threads", std::to_string(threads), "--quiet", "--overwrite"};
     if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
     if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
     std::vector<char*> argv;

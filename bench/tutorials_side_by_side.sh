@@ -29,7 +29,7 @@ echo "commit $COMMIT, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg); dem
 # side TUTORIAL T0 T1: both codes, then the figures averaged over [T0, T1] s
 side() {
   start=$(date +%s)
-  "$ROOT/$BUILD/app/demdesign" "$ROOT/cases/liggghts_$1.yaml" --threads 1 --no-report --quiet --out "$WORK/$1_demdesign" > "$WORK/$1_dem.log" 2>&1 ||
+  "$ROOT/$BUILD/app/demdesign" "$ROOT/cases/liggghts_$1.yaml" --threads 1 --no-report --quiet --overwrite --out "$WORK/$1_demdesign" > "$WORK/$1_dem.log" 2>&1 ||
     { tail -20 "$WORK/$1_dem.log"; exit 1; }
   mid=$(date +%s)
   (cd "$WORK" && liggghts -in "$HERE/liggghts/$1.in" -var dir "$TUTORIALS/$1" -log none -echo none > "$1_lig.txt" 2>&1) ||
@@ -47,7 +47,7 @@ replicas() {
   for seed in $SEEDS; do
     sed "s/^  seed: 1$/  seed: $seed/" "$ROOT/cases/liggghts_$1.yaml" > "$WORK/$1_$seed.yaml"
     t0=$(date +%s)
-    "$ROOT/$BUILD/app/demdesign" "$WORK/$1_$seed.yaml" --threads 1 --no-report --quiet --out "$WORK/$1_dem_$seed" > "$WORK/$1_dem.log" 2>&1 ||
+    "$ROOT/$BUILD/app/demdesign" "$WORK/$1_$seed.yaml" --threads 1 --no-report --quiet --overwrite --out "$WORK/$1_dem_$seed" > "$WORK/$1_dem.log" 2>&1 ||
       { tail -20 "$WORK/$1_dem.log"; exit 1; }
     t1=$(date +%s); dem_time=$((dem_time + t1 - t0))
     # LIGGGHTS seeds must be primes above 10000: the seed-th prime after the deck's own

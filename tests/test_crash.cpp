@@ -325,6 +325,36 @@ pid_t start_ranks(int ranks, const std::vector<std::string>& args, const fs::pat
   return pid;
 }
 
+/// Kills a job started by start_ranks() as a batch system or the OOM killer would: mpirun's
+/// process group and every rank it started (Open MPI puts its ranks in process groups of their
+/// own, so they outlive a killed mpirun and go on writing OUT). Returns whether mpirun was running.
+bool kill_job(pid_t pid, const fs::path& out) {
+  const bool running = ::kill(-pid, SIGKILL) == 0;
+  std::vector<pid_t> ranks;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(entry.path() / "cmdline", std::ios::binary);
+    std::vector<std::string> argv;
+    for (std::string arg; std::getline(in, arg, '\0');) argv.push_back(arg);
+    if (!argv.empty() && argv[0] == DEMDESIGN_BINARY && std::find(argv.begin(), argv.end(), out.string()) != argv.end())
+      ranks.push_back(static_cast<pid_t>(std::stol(name)));
+  }
+  for (const pid_t rank : ranks) ::kill(rank, SIGKILL);
+  // A killed process closes its files (and so releases its lock on OUT) before it disappears.
+  for (const pid_t rank : ranks)
+    for (int i = 0; i < 1000 && ::kill(rank, 0) == 0; ++i) {
+      std::ifstream status("/proc/" + std::to_string(rank) + "/status");
+      std::string line;
+      bool zombie = false;
+      while (std::getline(status, line))
+        if (line.rfind("State:", 0) == 0) zombie = line.find('Z') != std::string::npos;
+      if (zombie) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  return running;
+}
+
 /// The last row of OUT/scalars.csv by column name.
 std::map<std::string, double> last_scalars(const fs::path& out) {
   std::istringstream in(read_text(out / "scalars.csv"));
@@ -382,7 +412,7 @@ TEST(KillAndResume, SplitRunKilledOnFourRanksResumesOnFourAndOnTwo) {
       std::this_thread::sleep_for(1ms);
     }
     std::this_thread::sleep_for(std::chrono::duration<double>(part_of_interval * interval));
-    const bool running = ::kill(-pid, SIGKILL) == 0;
+    const bool running = kill_job(pid, out);
     const int status = wait_exit(pid);
     EXPECT_TRUE(running && status == 128 + SIGKILL) << "the run ended before the kill: " << read_text(kScratch / "split_trial.log");
     auto args = run_args(c, out);

@@ -17,7 +17,10 @@ namespace dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
+/// Version 7: magic, model hash, run id, the State as version 6 (visit).
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '7'};
+/// Version 6 has no run id (read as 0).
+constexpr char kMagic6[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
 /// A rank's share: magic, model hash, step, rank, ranks, count, then `count` doubles.
 constexpr char kShareMagic[8] = {'D', 'E', 'M', 'S', 'H', 'A', 'R', '1'};
 /// Version 5 lacks State::lists_drift_velocity: read as zero, which is always a valid drift
@@ -96,7 +99,7 @@ struct Reader {
 
 }  // namespace
 
-void save_checkpoint(const std::string& path, const Model& model, const State& state) {
+void save_checkpoint(const std::string& path, const Model& model, const State& state, std::uint64_t run_id) {
   const std::filesystem::path target(path);
   if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
   const std::string temporary = path + ".part";
@@ -105,6 +108,7 @@ void save_checkpoint(const std::string& path, const Model& model, const State& s
     out.write(kMagic, sizeof kMagic);
     Writer writer{out};
     writer(model.hash);
+    writer(run_id);
     visit(writer, state);
     out.flush();
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write the checkpoint (disk full?)", temporary));
@@ -112,13 +116,16 @@ void save_checkpoint(const std::string& path, const Model& model, const State& s
   std::filesystem::rename(temporary, target);
 }
 
-State load_checkpoint(const std::string& path, const Model& model) {
+State load_checkpoint(const std::string& path, const Model& model, std::uint64_t* run_id) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(fmt::format("{}: no checkpoint to resume from", path));
   Reader reader{in, path, static_cast<std::uint64_t>(std::filesystem::file_size(path))};
   char magic[sizeof kMagic];
   reader.read(magic, sizeof magic);
-  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0 ? 6 : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5 : 0;
+  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0     ? 7
+                      : std::memcmp(magic, kMagic6, sizeof kMagic6) == 0 ? 6
+                      : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5
+                                                                         : 0;
   if (version == 0) throw std::runtime_error(fmt::format("{}: not a demdesign checkpoint of this version", path));
   std::uint64_t hash = 0;
   reader(hash);
@@ -126,8 +133,11 @@ State load_checkpoint(const std::string& path, const Model& model) {
     throw std::runtime_error(fmt::format("{}: the checkpoint belongs to a different model (the case's physics changed "
                                          "since it was written); run without --resume to start again",
                                          path));
+  std::uint64_t written_by = 0;
+  if (version >= 7) reader(written_by);
+  if (run_id) *run_id = written_by;
   State state;
-  visit(reader, state, version);
+  visit(reader, state, std::min(version, 6));
   return state;
 }
 
@@ -202,8 +212,8 @@ void save_checkpoint_share(const std::string& directory, const Model& model, std
   fs::rename(temporary, target);
 }
 
-void commit_checkpoint_shares(const std::string& directory, const Model& model, const State& like) {
-  save_checkpoint((fs::path(directory) / "checkpoint.ranks.bin").string(), model, shared_part(like));
+void commit_checkpoint_shares(const std::string& directory, const Model& model, const State& like, std::uint64_t run_id) {
+  save_checkpoint((fs::path(directory) / "checkpoint.ranks.bin").string(), model, shared_part(like), run_id);
   std::error_code error;
   fs::remove(fs::path(directory) / "checkpoint.bin", error);
   std::vector<fs::path> stale;
@@ -214,21 +224,22 @@ void commit_checkpoint_shares(const std::string& directory, const Model& model, 
   for (const fs::path& p : stale) fs::remove(p, error);
 }
 
-void save_whole_checkpoint(const std::string& directory, const Model& model, const State& state) {
-  save_checkpoint((fs::path(directory) / "checkpoint.bin").string(), model, state);
+void save_whole_checkpoint(const std::string& directory, const Model& model, const State& state, std::uint64_t run_id) {
+  save_checkpoint((fs::path(directory) / "checkpoint.bin").string(), model, state, run_id);
   std::error_code error;
   fs::remove(fs::path(directory) / "checkpoint.ranks.bin", error);
   fs::remove_all(shares_directory(directory), error);
 }
 
-State load_resumable(const std::string& directory, const Model& model, std::string* from) {
+State load_resumable(const std::string& directory, const Model& model, std::string* from, std::uint64_t* run_id) {
   const fs::path whole_path = fs::path(directory) / "checkpoint.bin", ranks_path = fs::path(directory) / "checkpoint.ranks.bin";
   const bool whole_exists = fs::exists(whole_path), ranks_exist = fs::exists(ranks_path);
   if (!whole_exists && !ranks_exist) throw std::runtime_error(fmt::format("{}: no checkpoint to resume from", whole_path.string()));
   std::optional<State> whole;
-  if (whole_exists) whole = load_checkpoint(whole_path.string(), model);
+  std::uint64_t whole_run = 0, ranks_run = 0;
+  if (whole_exists) whole = load_checkpoint(whole_path.string(), model, &whole_run);
   if (ranks_exist) {
-    const State like = load_checkpoint(ranks_path.string(), model);
+    const State like = load_checkpoint(ranks_path.string(), model, &ranks_run);
     if (!whole || like.step > whole->step) {
       const fs::path shares = shares_directory(directory);
       const int ranks = share_count(shares, like.step);
@@ -237,10 +248,12 @@ State load_resumable(const std::string& directory, const Model& model, std::stri
       std::vector<std::vector<double>> parts;
       for (int rank = 0; rank < ranks; ++rank) parts.push_back(load_share(shares / share_name(like.step, rank, ranks), model, like.step, rank, ranks));
       if (from) *from = fmt::format("{} and the shares of {} ranks in {}", ranks_path.string(), ranks, shares.string());
+      if (run_id) *run_id = ranks_run;
       return merge_shares(like, parts, model.history_width);
     }
   }
   if (from) *from = whole_path.string();
+  if (run_id) *run_id = whole_run;
   return std::move(*whole);
 }
 

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -127,8 +129,8 @@ std::string yaml_quoted(const std::string& text) {
 
 /// The run's set-up as YAML, so every result can be traced to its inputs (the command line that
 /// started it included).
-std::string run_info(const Model& model, const RunOptions& options) {
-  std::string out = fmt::format("software: demdesign {}\ncase: {}\n", DEMDESIGN_VERSION, model.source);
+std::string run_info(const Model& model, const RunOptions& options, std::uint64_t run_id) {
+  std::string out = fmt::format("software: demdesign {}\ncase: {}\nrun_id: {:016x}\n", DEMDESIGN_VERSION, model.source, run_id);
   if (!options.command_line.empty()) out += fmt::format("command_line: {}\n", yaml_quoted(options.command_line));
   out += fmt::format(
       "model_hash: {:016x}\ntime_step_s: {:.9g}\nmass_scaling: {:g}\n"
@@ -143,6 +145,34 @@ std::string run_info(const Model& model, const RunOptions& options) {
     out += fmt::format("  {}: {{density: {:.9g}, youngs_modulus: {:.9g}, poisson_ratio: {:g}}}\n", m.name, m.density,
                        m.youngs_modulus, m.poisson_ratio);
   return out;
+}
+
+/// A run id as the messages name it.
+std::string run_id_text(std::uint64_t run_id) {
+  return run_id ? fmt::format("run id {:016x}", run_id) : "a version that did not record run ids";
+}
+
+/// Why the checkpoint `from`, written by the run `checkpoint_run` at `state`, does not belong to
+/// the results beside it in `out`; empty when it does. Checkpoints and run_info.yaml of versions
+/// before run ids (both 0) belong together when the rows reach the checkpoint's time.
+std::string foreign_checkpoint(const Model& model, const std::string& out, const std::string& from, std::uint64_t checkpoint_run,
+                               const State& state, std::int64_t rows_every) {
+  const std::string instead = "add --overwrite instead of --resume to start the run again, or resume in the folder the checkpoint was written in";
+  const RunRecord record = read_run_record(out);
+  if (!record.exists)
+    return fmt::format("{}: no run_info.yaml beside it, so nothing tells which run's results it continues; resuming could splice two "
+                       "runs' rows: {}", from, instead);
+  if (checkpoint_run != record.run_id)
+    return fmt::format("{}: the checkpoint belongs to another run ({}) than the results beside it ({}/run_info.yaml: {}); resuming "
+                       "would splice the two runs' rows: {}", from, run_id_text(checkpoint_run), out, run_id_text(record.run_id), instead);
+  if (checkpoint_run == 0) {
+    const std::vector<Scalars> rows = read_scalars(model, out + "/scalars.csv", std::numeric_limits<double>::infinity());
+    const double reached = rows.empty() ? -std::numeric_limits<double>::infinity() : rows.back().time;
+    if (reached < state.time - static_cast<double>(rows_every) * model.dt * (1 + 1e-9) - 1e-12)
+      return fmt::format("{}: the rows beside it ({}/scalars.csv) {}, before the checkpoint's t = {:.6g} s: they are another run's; {}",
+                         from, out, rows.empty() ? "are missing" : fmt::format("end at t = {:.6g} s", reached), state.time, instead);
+  }
+  return "";
 }
 
 FrameWriter make_frame_writer(const Model& model, const std::string& directory) {
@@ -280,10 +310,50 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const bool collective = domain != nullptr && static_cast<bool>(options.share_frame);
   const Model& stepped = domain ? domain->local_model() : model;
   work.domain = domain;
+  // A refusal on the root stops every rank (the others would wait for it forever).
+  const auto stop_if_refused = [&](const std::string& refused) {
+    if (domain ? domain->any(!refused.empty()) : !refused.empty())
+      throw CaseError(!refused.empty() ? refused : "rank 0 refused the output folder (its message is on standard error)");
+  };
+  // The output folder, claimed by the process that writes the results: refused when it holds
+  // another run's results (unless resumed or overwritten) or a file of the run's names that no
+  // run wrote; locked until the caller lets go of the summary (run_folder.h).
+  if (options.write_files) {
+    std::string refused;
+    if (writer && options.folder) {
+      summary.folder = options.folder;
+    } else if (writer) {
+      try {
+        std::vector<std::string> names = run_output_names();
+        names.insert(names.end(), options.caller_outputs.begin(), options.caller_outputs.end());
+        const FolderUse use = options.resume ? FolderUse::resume : options.overwrite ? FolderUse::overwrite : FolderUse::fresh;
+        summary.folder = std::make_shared<RunFolder>(out, use, names, log);
+      } catch (const std::exception& e) {
+        refused = e.what();
+      }
+    }
+    stop_if_refused(refused);
+  }
 
+  // The run's id, in run_info.yaml and every checkpoint: a new one, or the resumed run's.
+  std::uint64_t run_id = options.resume ? 0 : new_run_id();
   if (options.resume) {
+    // A run that reached its end has nothing to resume: it is said, not rewound to its last checkpoint.
+    const RunRecord record = writer ? read_run_record(out) : RunRecord{};
+    bool complete = writer && record.completed && record.step >= end_step;
+    if (domain) complete = domain->any(complete);
+    if (complete) {
+      if (writer)
+        fmt::print(log, "  {}: the run is complete (t = {:.6g} s, step {}; run_info.yaml): nothing to resume. To run it again from the "
+                        "start, use --overwrite instead of --resume\n", out, record.time, record.step);
+      summary.already_complete = true;
+      return summary;
+    }
     std::string from;
-    state = load_resumable(out, model, &from);
+    state = load_resumable(out, model, &from, &run_id);
+    // The checkpoint must belong to the rows beside it, or the resumed run would splice two runs.
+    const std::int64_t rows_every = model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, end_step / 200);
+    stop_if_refused(writer ? foreign_checkpoint(model, out, from, run_id, state, rows_every) : "");
     if (writer) summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
     if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", from, state.time, state.step);
   }
@@ -357,8 +427,20 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     }
     frame_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
   };
+  // Just before the first write: an earlier run's files go (overwrite) and the folder is listed.
+  if (options.write_files) {
+    std::string failed;
+    if (writer) {
+      try {
+        summary.folder->begin(log);
+      } catch (const std::exception& e) {
+        failed = e.what();
+      }
+    }
+    stop_if_refused(failed);
+  }
   if (options.write_files && (writer || collective)) {
-    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model, options));
+    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model, options, run_id));
     frames.emplace(make_frame_writer(model, out));
     if (options.resume && writer) frames->adopt_existing();
     else if (!options.resume) write_frame_now(*results);
@@ -503,11 +585,11 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
         throw std::runtime_error(failed.empty() ? fmt::format("t = {:.6g} s: another rank could not write its checkpoint share (its log says why)", state.time)
                                                 : failed);
       if (writer) {
-        commit_checkpoint_shares(out, model, state);
+        commit_checkpoint_shares(out, model, state, run_id);
         write_tables();
       }
     } else if (checkpoint_due && writer) {
-      save_whole_checkpoint(out, model, *results);
+      save_whole_checkpoint(out, model, *results, run_id);
       write_tables();
     }
     if (stopping) {
@@ -557,7 +639,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     write_tables();
     // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
     write_file_atomically(out + "/run_info.yaml",
-                          run_info(model, options) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
+                          run_info(model, options, run_id) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
                                                         "  state_hash: {:016x}\n",
                                                         state.step >= last_step ? "true" : "false", state.time, state.step,
                                                         final_state.size(), state_hash(final_state, model.history_width)));

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "core/state.h"
 #include "core/workspace.h"
 #include "output/results_hdf5.h"
+#include "output/run_folder.h"
 #include "statistics/diagnostics.h"
 #include "statistics/events.h"
 
@@ -26,6 +28,15 @@ struct RunOptions {
   bool write_files = true;
   bool progress = true;
   bool resume = false;            ///< continue from OUT's checkpoint (load_resumable, checkpoint.h)
+  /// Replace the results of an earlier run in OUT (only the files runs wrote there, run_folder.h);
+  /// without it (or resume) a folder holding another run's results is refused.
+  bool overwrite = false;
+  /// Names the caller writes into OUT after the run (run_output_names() has the engine's): they
+  /// are guarded, listed and removed for overwrite as the run's own.
+  std::vector<std::string> caller_outputs;
+  /// OUT claimed by the caller (on the root): run() then claims nothing itself. A program claims
+  /// the folder before it compiles the case, so that a refusal comes before any work.
+  std::shared_ptr<RunFolder> folder;
   std::string command_line;       ///< the command that started the run, kept in run_info.yaml
   /// Called after a particle frame is written, with the whole state: after every
   /// model.output.render_every-th frame of the run and after the last (the app renders images
@@ -48,14 +59,23 @@ struct RunSummary {
   std::vector<Scalars> scalars;
   std::vector<RunEvent> events;  ///< first arrivals at outlets and plane sensors, first loss (events.h)
   std::string output_directory;
+  /// The output folder claimed for the run (locked, run_folder.h) while the summary or a copy of
+  /// this pointer lives: the caller writes its own files into it (caller_outputs) before letting go.
+  std::shared_ptr<RunFolder> folder;
+  /// A resumed run that had already reached its end: nothing was run, the state is as given.
+  bool already_complete = false;
 };
 
 /// Prints the model's set-up (effects, time-step advice, notes) to `log`.
 void print_setup(const Model& model, const State& state, std::ostream& log);
 
-/// Runs from the state as it is (prepare() is called here) to the model's end time. With
+/// Runs from the state as it is (prepare() is called here) to the model's end time. Writing files,
+/// it first claims OUT (RunFolder: refused when it holds another run's results unless resume or
+/// overwrite, or a file of the run's names that no run wrote; locked while the run writes). With
 /// options.resume the state is replaced by OUT's checkpoint (checkpoint.bin, or under domain
-/// decomposition every rank's share, checkpoint.h). `log` gets the set-up, progress
+/// decomposition every rank's share, checkpoint.h), which must belong to the run whose results
+/// lie beside it (the run id in the checkpoint and in run_info.yaml); a run that had reached its
+/// end is not run again (already_complete). `log` gets the set-up, progress
 /// and summary lines. SIGINT and SIGTERM stop the run after the current step with a checkpoint.
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log);
 
