@@ -84,8 +84,9 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   progress(options, fmt::format("hopper_discharge: {} particles, {:.3g} m silo, {:.3g} m orifice", particles, diameter, orifice));
   const double fall = std::sqrt(2 * z1 / 9.81);
   const bool settled = run.advance_until([&] { return run.state.time > fall && run.mean_speed() < 1e-3; }, fall + 3.0);
-  out.notes.push_back(fmt::format("{} at {:.2f} s; silo {:.3g} m wide, filled {:.3g} m", settled ? "settled" : "NOT settled (time cap)",
-                                  run.state.time, diameter, fill));
+  const double settle_wall = clock.seconds();
+  out.notes.push_back(fmt::format("{} at {:.2f} s ({:.1f} s of wall time); silo {:.3g} m wide, filled {:.3g} m",
+                                  settled ? "settled" : "NOT settled (time cap)", run.state.time, settle_wall, diameter, fill));
 
   // Open now; sample the discharged mass every millisecond. The discharge's step is set by its
   // own speeds (a fall from the bed's top to the outlet), not by the pour's impacts from the
@@ -120,6 +121,8 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
   } else {
     out.observables["mass_flow_rate"] = fit_line(t, m).second / run.model.mass_scaling;
     out.notes.push_back(fmt::format("20-70 % discharged in {:.3f} s", t.back() - t.front()));
+  out.notes.push_back(fmt::format("discharge {:.2f} s ({:.1f} s of wall time, time step {:.3g} s)", run.state.time - open_at,
+                                  clock.seconds() - settle_wall, run.model.dt));
   }
   finish(out, run, clock, particles, options);
   return out;
