@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "calibration.h"
 #include "case/spec.h"
@@ -75,6 +76,26 @@ particles:
   EXPECT_DOUBLE_EQ(model.pair_param(0, 0, "dashpot_coefficient"), 0.01);
   // A second registration of the same name is refused.
   EXPECT_THROW(register_effect(e), std::invalid_argument);
+  // A normal law that does not say how long its contacts last is refused: the time step could not
+  // resolve them. The shipped laws say it: Hertz's impact time (Johnson 1985) and the linear
+  // spring's half period.
+  static const EffectSpec silent_normal{.stage = Stage::normal, .name = "silent_normal", .kernel = e->kernel};
+  try {
+    register_effect(&silent_normal);
+    ADD_FAILURE() << "a normal law without contact_time was registered";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("must give its contact_time"), std::string::npos) << error.what();
+  }
+  for (const EffectSpec* table_row : effect_table())
+    if (table_row->stage == Stage::normal) EXPECT_NE(table_row->contact_time, nullptr) << table_row->name;
+  const EffectSpec* hertz = find_effect(Stage::normal, "hertz");
+  const EffectSpec* linear = find_effect(Stage::normal, "linear");
+  ASSERT_TRUE(hertz && hertz->contact_time && linear && linear->contact_time);
+  const double row[1] = {1e7}, spring[3] = {1000.0, 1.0, 2.0 / 7.0};
+  EXPECT_DOUBLE_EQ(hertz->contact_time(row, nullptr, 1e-3, 1e-3, 1.0), hertz_contact_time(1e-3, 1e-3, 1e7, 1.0));
+  EXPECT_NEAR(linear->contact_time(row, spring, 1e-3, 1e-3, 1.0), 3.14159265 * std::sqrt(1e-3 / 1000.0), 1e-9);
+  EXPECT_TRUE(hertz->rayleigh_binds);
+  EXPECT_FALSE(linear->rayleigh_binds);
 }
 
 TEST(ContributorEffect, DiagnoseProposesItAndCalibrationFindsItsStrength) {

@@ -196,7 +196,19 @@ struct EffectSpec {
   bool reads_spin = false;
   /// Set when a diagnosis may propose this effect for a material that lacks it.
   const CandidateSpec* candidate = nullptr;
+  /// Normal laws (required of them): the duration [s] of an undamped binary impact of effective
+  /// mass `m_eff` [kg] and radius `r_eff` [m] at `speed` [m/s], from the pair's row (`row[0]`, its
+  /// effective Young's modulus [Pa]) and this effect's parameters (`params`): what the time step
+  /// must resolve (core/timestep.cpp).
+  double (*contact_time)(const double* row, const double* params, double m_eff, double r_eff, double speed) = nullptr;
+  /// Normal laws whose stiffness comes from the elastic moduli (Hertz): the Rayleigh time limits
+  /// the step. A spring of a given stiffness does not bind to it.
+  bool rayleigh_binds = false;
 };
+
+/// Duration [s] of an undamped Hertz impact, 2.8683 (m*^2 / (R* E*^2 v))^(1/5) (Johnson 1985),
+/// of effective mass [kg], radius [m] and Young's modulus [Pa] at impact speed [m/s].
+double hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed);
 
 /// Every effect: the rows of src/contact/effect_table.cpp, then any registered by register_effect.
 std::span<const EffectSpec* const> effect_table();

@@ -69,6 +69,8 @@ const ParamSpec* find_param(std::string_view key) {
 }
 
 void register_effect(const EffectSpec* effect) {
+  if (effect->stage == Stage::normal && !effect->contact_time)
+    throw std::invalid_argument(fmt::format("effect '{}': a normal law must give its contact_time (the time step resolves it)", effect->name));
   if (find_effect(effect->stage, effect->name))
     throw std::invalid_argument(fmt::format("effect '{}': the {} stage already has an effect of that name", effect->name,
                                             kStageKeys[static_cast<int>(effect->stage)]));

@@ -19,10 +19,6 @@ double rayleigh_time(double radius, double density, double youngs, double poisso
   return kPi * radius * std::sqrt(density / shear) / (0.1631 * poisson + 0.8766);
 }
 
-double hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed) {
-  return 2.8683 * std::pow(m_eff * m_eff / (r_eff * youngs_eff * youngs_eff * speed), 0.2);
-}
-
 TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
   TimeStepAdvice advice;
   // Characteristic impact speed: given, or the largest of initial speeds and a free fall over
@@ -48,7 +44,10 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
   // Shortest Rayleigh time and contact time over the particle materials and their partners.
   advice.rayleigh_time = std::numeric_limits<double>::infinity();
   advice.contact_time = std::numeric_limits<double>::infinity();
-  const bool hertz = !model.effects.empty() && model.effects.front().spec->name == "hertz";
+  // The normal law (the first effect) says how long a contact lasts and whether the Rayleigh
+  // time binds the step (contact/effect.h).
+  const ActiveEffect& normal = model.effects.front();
+  const bool rayleigh_binds = normal.spec->rayleigh_binds;
   struct Kind { int material; double diameter; };
   std::vector<Kind> kinds;
   for (const ParticleSource& s : model.sources) kinds.push_back({s.material, s.spec.diameter.smallest()});
@@ -68,18 +67,7 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
     for (auto [other, wall] : partners) {
       const double m_eff = wall ? mass : 0.5 * mass, r_eff = wall ? radius : 0.5 * radius;
       const double* row = model.pair_row(model.pair_type(s.material, other));
-      double t;
-      if (hertz) {
-        t = hertz_contact_time(m_eff, r_eff, row[0], speed);
-      } else {  // linear: undamped period of the spring with the stiffness the kernel uses
-        double k = row[model.effects.front().param_offset];
-        if (k <= 0) {
-          const double v = row[model.effects.front().param_offset + 1];
-          k = 16.0 / 15.0 * std::sqrt(r_eff) * row[0] * std::pow(15.0 * m_eff * v * v / (16.0 * std::sqrt(r_eff) * row[0]), 0.2);
-        }
-        t = kPi * std::sqrt(m_eff / k);
-      }
-      advice.contact_time = std::min(advice.contact_time, t);
+      advice.contact_time = std::min(advice.contact_time, normal.spec->contact_time(row, row + normal.param_offset, m_eff, r_eff, speed));
     }
   }
 
@@ -88,11 +76,12 @@ TimeStepAdvice advise_time_step(const Model& model, const SimulationSpec& sim) {
                                 : std::min(sim.rayleigh_fraction * advice.rayleigh_time, advice.contact_time / sim.steps_per_contact);
   const double fraction = advice.dt / advice.rayleigh_time;
   const double steps_per_contact = advice.contact_time / advice.dt;
-  advice.safe = (!hertz || fraction <= kMaxRayleighFraction) && steps_per_contact >= kMinStepsPerContact;
+  advice.safe = (!rayleigh_binds || fraction <= kMaxRayleighFraction) && steps_per_contact >= kMinStepsPerContact;
   advice.report = fmt::format(
       "  time step {:.4g} s ({}): {:.1f} % of the Rayleigh time {:.4g} s{}, {:.1f} steps per contact of {:.4g} s at "
       "{:.3g} m/s (limits: {:.0f} %, {:.0f} steps)",
-      advice.dt, advice.user_given ? "given" : "auto", 100 * fraction, advice.rayleigh_time, hertz ? "" : " (not binding for a linear law)",
+      advice.dt, advice.user_given ? "given" : "auto", 100 * fraction, advice.rayleigh_time,
+      rayleigh_binds ? "" : fmt::format(" (not binding for the {} law)", normal.spec->name),
       steps_per_contact, advice.contact_time, speed, 100 * kMaxRayleighFraction, kMinStepsPerContact);
   return advice;
 }

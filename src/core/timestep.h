@@ -10,8 +10,7 @@ namespace dem {
 /// (Li, Xu & Thornton 2005 approximation of the Rayleigh root) [s].
 double rayleigh_time(double radius, double density, double youngs, double poisson);
 
-/// Hertz contact duration 2.8683 (m*^2 / (R* E*^2 v))^(1/5) [s] (Johnson 1985, validation CL-1).
-double hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed);
+// hertz_contact_time(): contact/effect.h, beside the normal laws that give their contact times.
 
 /// The step to use and whether it is safe. Unsafe: above 40 % of the Rayleigh time, or fewer
 /// than kMinStepsPerContact steps in the shortest contact. Automatic: `rayleigh_fraction` of the

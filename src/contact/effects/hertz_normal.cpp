@@ -28,6 +28,10 @@ DEM_KERNEL void hertz_kernel(const EffectContext& ctx, ContactBatch& b) {
   }
 }
 
+double hertz_time(const double* row, const double*, double m_eff, double r_eff, double speed) {
+  return hertz_contact_time(m_eff, r_eff, row[0], speed);
+}
+
 }  // namespace
 
 extern const EffectSpec hertz_normal{
@@ -43,6 +47,12 @@ extern const EffectSpec hertz_normal{
     .derived_count = 0,
     .derive = nullptr,
     .requires_normal = "",
+    .contact_time = hertz_time,
+    .rayleigh_binds = true,
 };
 
 }  // namespace dem::effects
+
+double dem::hertz_contact_time(double m_eff, double r_eff, double youngs_eff, double speed) {
+  return 2.8683 * std::pow(m_eff * m_eff / (r_eff * youngs_eff * youngs_eff * speed), 0.2);
+}

@@ -6,6 +6,7 @@
 // oscillation periods of a solid sphere equal (Schaefer, Dippel & Wolf 1996).
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "contact/effects/effects.h"
 
@@ -23,16 +24,17 @@ constexpr ParamSpec kParams[] = {
      "kt / kn"},
 };
 
+/// The stiffness [N/m]: given, or derived from the moduli at the characteristic velocity.
+double stiffness_of(double given, double youngs, double v, double m_eff, double r_eff) {
+  if (given > 0.0) return given;
+  const double sqrt_r = std::sqrt(r_eff);
+  return 16.0 / 15.0 * sqrt_r * youngs * std::pow(15.0 * m_eff * v * v / (16.0 * sqrt_r * youngs), 0.2);
+}
+
 void linear_kernel(const EffectContext& ctx, ContactBatch& b) {
   for (int c = 0; c < b.count; ++c) {
-    double stiffness = ctx.param(b, c, kStiffness);
-    if (stiffness <= 0.0) {
-      const double youngs = ctx.youngs_eff(b, c);
-      const double v = ctx.param(b, c, kCharacteristicVelocity);
-      const double sqrt_r = std::sqrt(b.r_eff[c]);
-      stiffness = 16.0 / 15.0 * sqrt_r * youngs *
-                  std::pow(15.0 * b.m_eff[c] * v * v / (16.0 * sqrt_r * youngs), 0.2);
-    }
+    const double stiffness = stiffness_of(ctx.param(b, c, kStiffness), ctx.youngs_eff(b, c), ctx.param(b, c, kCharacteristicVelocity),
+                                          b.m_eff[c], b.r_eff[c]);
     const double overlap = std::max(b.overlap[c], 0.0);
     b.kn[c] = stiffness;
     b.kt[c] = stiffness * ctx.param(b, c, kTangentialRatio);
@@ -42,6 +44,11 @@ void linear_kernel(const EffectContext& ctx, ContactBatch& b) {
     b.fn_elastic[c] = stiffness * overlap;
     b.fn[c] = b.fn_elastic[c];
   }
+}
+
+/// Half the undamped period of the spring the kernel uses.
+double linear_time(const double* row, const double* params, double m_eff, double r_eff, double) {
+  return std::numbers::pi * std::sqrt(m_eff / stiffness_of(params[kStiffness], row[0], params[kCharacteristicVelocity], m_eff, r_eff));
 }
 
 }  // namespace
@@ -59,6 +66,8 @@ extern const EffectSpec linear_normal{
     .derived_count = 0,
     .derive = nullptr,
     .requires_normal = "",
+    .contact_time = linear_time,
+    .rayleigh_binds = false,
 };
 
 }  // namespace dem::effects
