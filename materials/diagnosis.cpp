@@ -148,6 +148,7 @@ class DiagnosisRun {
   std::map<std::string, Comparison> at_start_;     ///< each candidate's comparison at its start values
   std::vector<std::string> left_out_;              ///< candidates whose simulations could not run
   std::vector<std::string> undecided_, nonlinear_, unconfirmed_;
+  std::string screen_leader_;  ///< the screen's first: the candidates are ranked again by their fits later
   bool screen_silent_ = false;
   std::string implausible_;                        ///< the plain fit's values out of the plausible
 
@@ -431,6 +432,7 @@ void DiagnosisRun::confirm_leaders() {
   screen_silent_ = choice.screen_silent;
   std::vector<size_t> confirming = choice.confirming;
   undecided_ = choice.undecided, nonlinear_ = choice.nonlinear;
+  screen_leader_ = d_.candidates.empty() ? "" : d_.candidates.front().name;
   std::stable_sort(confirming.begin(), confirming.end(), [&](size_t a, size_t b) {
     const CandidateResult &x = d_.candidates[a], &y = d_.candidates[b];
     if (x.stable != y.stable) return x.stable;
@@ -675,7 +677,7 @@ void DiagnosisRun::describe_candidates() {
     if (!undecided_.empty())
       d_.words.push_back(fmt::format("The signature screen cannot tell {} from {} (their signatures explain within {:.0f} % of each other, at its "
                                      "noise): each was recalibrated.",
-                                     d_.candidates.empty() ? "" : d_.candidates.front().name, join(undecided_, ", "), 100 * options_.screen_margin));
+                                     screen_leader_, join(undecided_, ", "), 100 * options_.screen_margin));
     if (!nonlinear_.empty())
       d_.words.push_back(fmt::format("The signature of {} changes shape between its two strengths (the linear screen cannot be trusted for it): "
                                      "recalibrated.", join(nonlinear_, ", ")));
