@@ -8,6 +8,7 @@
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 #include <utility>
 
@@ -273,6 +275,62 @@ void refuse_impossible_counts(const std::string& path) {
                                                        " bytes; the file is damaged, re-export it");
 }
 
+/// Checks an STL file's completeness before assimp reads it: assimp reads a file cut between two
+/// facets (a copy or a download that stopped) as the facets before the cut, a mesh with a hole
+/// and no word. Binary: 84 bytes of header and count, then 50 bytes a facet; fewer bytes than the
+/// count needs is a cut. ASCII ("solid" first, and not a binary file of the right size that
+/// happens to begin so): every `facet` closed by `endfacet` with three `vertex` lines, and the
+/// last word `endsolid` (with its name).
+void check_stl_file(const std::string& path) {
+  const auto bytes = std::uintmax_t(std::filesystem::file_size(path));
+  std::ifstream in(path, std::ios::binary);
+  char head[84] = {};
+  in.read(head, sizeof head);
+  const auto got = std::size_t(in.gcount());
+  std::uint32_t count = 0;
+  if (got == sizeof head) std::memcpy(&count, head + 80, sizeof count);
+  const std::uintmax_t binary_size = 84 + 50 * std::uintmax_t(count);
+  const bool looks_ascii = got >= 5 && std::string_view(head, 5) == "solid";
+  if (!looks_ascii || (got == sizeof head && bytes == binary_size)) {
+    if (got < sizeof head)
+      throw MeshError(MeshError::Kind::unreadable, path + ": " + std::to_string(bytes) +
+                                                       " bytes, shorter than a binary STL's 84-byte header; the file is damaged, re-export it");
+    if (bytes < binary_size)
+      throw MeshError(MeshError::Kind::unreadable, path + ": the binary STL declares " + std::to_string(count) + " facets (" +
+                                                       std::to_string(binary_size) + " bytes) but the file has " + std::to_string(bytes) +
+                                                       " bytes: it was cut after facet " + std::to_string((bytes - 84) / 50) +
+                                                       "; re-export or copy it again");
+    return;
+  }
+  in.clear(), in.seekg(0);
+  std::string line, last_word;
+  int line_number = 0, vertices = 0, open_line = 0;
+  bool open = false;
+  auto refuse = [&](const std::string& why) {
+    throw MeshError(MeshError::Kind::unreadable, path + ": line " + std::to_string(line_number) + " of the ASCII STL: " + why +
+                                                     "; the file is damaged or cut, re-export or copy it again");
+  };
+  while (std::getline(in, line)) {
+    ++line_number;
+    std::istringstream words(line);
+    std::string first;
+    if (!(words >> first)) continue;
+    last_word = first;
+    if (first == "facet") {
+      if (open) refuse("a facet begins before the facet of line " + std::to_string(open_line) + " ends (no endfacet)");
+      open = true, open_line = line_number, vertices = 0;
+    } else if (first == "vertex") {
+      ++vertices;
+    } else if (first == "endfacet") {
+      if (!open) refuse("endfacet without its facet");
+      if (vertices != 3) refuse("the facet of line " + std::to_string(open_line) + " has " + std::to_string(vertices) + " vertices, not 3");
+      open = false;
+    }
+  }
+  if (open) refuse("the file ends inside the facet of line " + std::to_string(open_line));
+  if (last_word != "endsolid") refuse("the file ends without endsolid (its last line begins '" + printable(last_word.substr(0, 40)) + "')");
+}
+
 /// Checks an OFF file line by line before assimp reads it: assimp 5.2's OFF reader crashes
 /// (segmentation fault) on face lines whose vertex count or indices do not fit the declared
 /// vertices (fuzzer finding tests/fuzz/regressions/mesh/off_bad_face_crash). Grammar: a keyword
@@ -363,6 +421,7 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
 
   refuse_impossible_counts(path);
   if (lower_extension(path) == ".off") check_off_file(path);
+  if (lower_extension(path) == ".stl") check_stl_file(path);
 
   // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
   Assimp::Importer importer;
