@@ -409,7 +409,7 @@ std::string case_key_reference(const std::string& source_dir, bool markdown) {
   for (const fs::path& file : cases) {
     CaseSpec spec = parse_case_file(file.string());
     equipment::expand_equipment(spec);
-    read_sweep(YAML::LoadFile(file.string()), file.string());
+    read_sweep(read_yaml_file(file.string(), "the case file"), file.string());
   }
   for (const fs::path& file : material_files) materials::read_material_model(file.string());
   for (const fs::path& file : measurement_files) materials::read_measurements(file.string());

@@ -70,11 +70,7 @@ YAML::Node load_case_yaml(const std::string& path, std::string* text_out = nullp
   std::stringstream text;
   text << in.rdbuf();
   if (text_out) *text_out = text.str();
-  try {
-    return YAML::Load(text.str());
-  } catch (const YAML::ParserException& e) {
-    throw dem::CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", path, e.mark.line + 1, e.mark.column + 1, e.msg));
-  }
+  return dem::parse_yaml(text.str(), path);
 }
 
 /// Reads a case with its equipment expanded: what every command compiles.
@@ -136,6 +132,7 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
   input.model = &model, input.state = &state, input.scalars = summary.scalars, input.events = summary.events;
   input.case_path = case_path, input.case_text = case_text, input.version = DEMDESIGN_VERSION;
   input.wall_seconds = summary.wall_seconds;
+  input.stopped = summary.stopped;
   input.records_from = model.output.records_from;
   input.sensors = model.sensors, input.design = model.design;
   for (const auto& mesh : spec.meshes) {
@@ -165,6 +162,34 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
   }
   const dem::report::RunMetrics metrics = dem::report::write_run_report(input, report_dir);
   std::cout << fmt::format("  report: {}/report.html ({})\n", report_dir, metrics.steady_text);
+}
+
+/// `demdesign check CASE`: everything a run reads, without running. A case with a sweep (or a
+/// bias check, or an uncertainty study) has every variant read and its equipment generated; the
+/// first variant is compiled and its set-up printed, as a run prints it.
+int check_case(const std::string& path) {
+  const YAML::Node root = load_case_yaml(path);
+  const dem::app::SweepPlan plan = dem::app::read_sweep(root, path);
+  if (plan.variants.empty()) {
+    const dem::Model model = compile_case(read_case(path));
+    dem::print_setup(model, dem::initial_state(model), std::cout);
+    return 0;
+  }
+  for (size_t k = 0; k < plan.variants.size(); ++k) {
+    try {
+      dem::CaseSpec spec = dem::parse_case_node(dem::app::variant_case(root, plan, k), path);
+      dem::equipment::expand_equipment(spec);
+    } catch (const dem::CaseError& e) {
+      throw dem::CaseError(fmt::format("sweep variant {} ({}): {}", plan.name(k), plan.label(k), e.what()));
+    }
+  }
+  std::cout << fmt::format("sweep: {} variants of {} key{}; every variant reads and its equipment is generated; the first, {} ({}):\n",
+                           plan.variants.size(), plan.paths.size(), plan.paths.size() == 1 ? "" : "s", plan.name(0), plan.label(0));
+  dem::CaseSpec first = dem::parse_case_node(dem::app::variant_case(root, plan, 0), path);
+  dem::equipment::expand_equipment(first);
+  const dem::Model model = compile_case(first);
+  dem::print_setup(model, dem::initial_state(model), std::cout);
+  return 0;
 }
 
 int run_case(const RunArgs& args) {
@@ -254,7 +279,21 @@ int run_case(const RunArgs& args) {
     dem::app::render_state(m, s, image_options(m), path);
     if (last) std::cout << fmt::format("  rendered {}\n", path);
   };
-  const dem::RunSummary summary = dem::run(model, state, work, options, log);
+  dem::RunSummary summary;
+  try {
+    summary = dem::run(model, state, work, options, log);
+  } catch (const dem::RunStopped& stopped) {
+    // Numerical trouble stopped the run: its report shows what it computed up to then, under a
+    // banner that says why (a split run's state is not gathered then: no report).
+    if (world.rank == 0 && args.report && !domain && !stopped.summary.scalars.empty()) {
+      try {
+        write_run_report(model, state, spec, stopped.summary, args.case_path, case_text);
+      } catch (const std::exception& e) {
+        std::cout << fmt::format("  no report of the stopped run: {}\n", e.what());
+      }
+    }
+    throw;
+  }
   if (world.rank != 0 || summary.already_complete) return 0;
   const std::string out = summary.output_directory;
   dem::write_file_atomically(out + "/case.yaml", case_text);
@@ -269,7 +308,7 @@ int run_case(const RunArgs& args) {
 /// Renders saved frames of a finished (or running) run: the case comes from run_info.yaml.
 int render_results(const std::string& out, const std::string& which, const dem::app::ImageOptions& given, bool video) {
   std::ifstream info(out + "/run_info.yaml");
-  if (!info) throw std::runtime_error(fmt::format("{}/run_info.yaml: not a demdesign output folder", out));
+  if (!info) throw dem::CaseError(fmt::format("{}/run_info.yaml: not a demdesign output folder (give the --out folder of a run)", out));
   std::string line, case_path;
   while (std::getline(info, line))
     if (line.rfind("case: ", 0) == 0) case_path = line.substr(6);
@@ -455,12 +494,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (validate_cmd->parsed()) return dem::app::validate_command(validate_source, validate_out, std::cout);
-    if (check_cmd->parsed()) {
-      const dem::Model model = compile_case(read_case(check_path));
-      const dem::State state = dem::initial_state(model);
-      dem::print_setup(model, state, std::cout);
-      return 0;
-    }
+    if (check_cmd->parsed()) return check_case(check_path);
     if (mesh_cmd->parsed()) return dem::geometry::check_mesh_command(mesh_files, mesh_options, mesh_particle_diameter, std::cout);
     if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options, render_video);
     if (args.case_path.empty()) {

@@ -106,6 +106,10 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
                    esc(title), esc(now_text()), esc(in.version), esc(in.case_path), num(t_end, 4), num(in.wall_seconds, 3));
 
   // Banners.
+  if (!in.stopped.empty())
+    h += fmt::format("<div class=\"banner bad\">The run stopped before its end, at t = {} s: {}. Everything below is what it computed up to "
+                     "then.</div>\n",
+                     num(t_end, 4), esc(in.stopped));
   if (!steady)
     h += fmt::format("<div class=\"banner bad\">No steady state reached ({}): {}. The values below are averages over the last third "
                      "of the run ({}) and are for information only.</div>\n",

@@ -45,6 +45,7 @@ struct RunReportInput {
   std::vector<std::pair<std::string, double>> design;
   viewer3d::Options viewer;  ///< the interactive 3D view (three.js to inline, particle limit)
   std::vector<RunEvent> events;  ///< the run's first arrivals (RunSummary::events)
+  std::string stopped;  ///< why the run stopped before its end (RunSummary::stopped); "" when it reached it
 };
 
 /// Key numbers of a run, to rank sweep variants. Names carry their unit ("throughput_t_h").

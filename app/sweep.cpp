@@ -132,6 +132,13 @@ SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file) {
       plan.variants.push_back(row);
     }
   } else {
+    // Sized before it is built: a grid of a few long lists is millions of variants.
+    double size = 1;
+    std::string sizes;
+    for (size_t p = 0; p < values.size(); ++p) size *= static_cast<double>(values[p].size()), sizes += fmt::format("{}{}", p ? " x " : "", values[p].size());
+    if (size > kMostSweepVariants)
+      map.fail("parameters", fmt::format("makes {:.0f} variants ({} values, combine: grid); at most {}: fewer values, or `combine: zip` to pair "
+                                         "the lists item by item", size, sizes, kMostSweepVariants));
     plan.variants = {{}};
     for (const auto& v : values) {
       std::vector<std::vector<YAML::Node>> next;
@@ -143,7 +150,7 @@ SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file) {
       plan.variants = std::move(next);
     }
   }
-  if (plan.variants.size() > 1000) map.fail("parameters", fmt::format("makes {} variants; at most 1000", plan.variants.size()));
+  if (plan.variants.size() > kMostSweepVariants) map.fail("parameters", fmt::format("makes {} variants; at most {}", plan.variants.size(), kMostSweepVariants));
   if (const YAML::Node rank = map.node("rank_by")) {
     if (!rank.IsSequence()) map.fail("rank_by", "must be a list of {metric, goal: minimize|maximize, weight}");
     for (size_t k = 0; k < rank.size(); ++k) {

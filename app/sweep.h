@@ -32,6 +32,9 @@ struct SweepCriterion {
   double weight = 1.0;
 };
 
+/// The most variants a sweep may make (a grid is sized before it is built).
+inline constexpr std::size_t kMostSweepVariants = 1000;
+
 struct SweepPlan {
   std::vector<std::string> paths;                   ///< key paths, in file order
   std::vector<std::vector<YAML::Node>> variants;    ///< per variant, one value per path

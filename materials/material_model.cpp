@@ -87,12 +87,7 @@ MaterialModel read_material_model(const std::string& path) {
   if (!fs::is_regular_file(path)) throw CaseError(fmt::format("{}: cannot open the material file", path));
   const fs::path file = fs::absolute(path).lexically_normal();
   const std::string stem = file.stem().string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::ParserException& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", path, e.mark.line + 1, e.mark.column + 1, e.msg));
-  }
+  const YAML::Node root = read_yaml_file(path, "the material file");
   // Wall materials named in `walls:`: the shipped library file, else a steel-like placeholder
   // (the measurement file replaces it with what was measured).
   std::string case_text = fmt::format("simulation: {{duration: 0.001}}\nmaterials:\n  \"{}\": {{library: \"{}\"}}\n", stem, stem);

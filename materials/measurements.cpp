@@ -175,12 +175,7 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
 }  // namespace
 
 MeasurementSet parse_measurements(const std::string& text, const std::string& name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
-  }
+  const YAML::Node root = parse_yaml(text, name);
   try {
     MeasurementSet set;
     set.file = name;

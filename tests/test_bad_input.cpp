@@ -3,6 +3,8 @@
 // names file, line and key (or mesh and triangle) and what is valid; none may crash or hang.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
@@ -11,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "bad_input.h"
 #include "case/spec.h"
@@ -194,6 +197,161 @@ TEST(BadInput, MeasurementFiles) {
                "experiments[0].setup.height", "finite");
   EXPECT_ERROR(read_measurement_text("walls: {steel: {youngs_modulus: -1}}\nexperiments: []\n"), "walls.steel.youngs_modulus",
                "out of range");
+}
+
+// ---- the table: one bad input a row, the reader it goes through, what the message must say ----
+
+enum class Reader { case_text, measurements, stl, obj, ply, step };
+
+struct BadInputRow {
+  const char* what;
+  Reader reader;
+  std::string input;
+  std::vector<std::string> says;
+};
+
+std::string measurement_file(const std::string& experiments, const std::string& head = "") {
+  return head + "walls:\n  steel: {youngs_modulus: 2.0e11, poisson_ratio: 0.3, density: 7800}\nexperiments:\n" + experiments;
+}
+
+std::string binary_stl(std::uint32_t declared, std::uint32_t written) {
+  std::string stl(80, ' ');
+  stl.append(reinterpret_cast<const char*>(&declared), 4);
+  const float tri[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  for (std::uint32_t k = 0; k < written; ++k) stl.append(reinterpret_cast<const char*>(tri), sizeof tri).append(2, '\0');
+  return stl;
+}
+
+std::vector<BadInputRow> bad_inputs() {
+  const std::string p = "{material: glass, diameter: 0.01, count: 10, region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}";
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string c = good_case();
+    c.replace(c.find(from), from.size(), to);
+    return c;
+  };
+  const std::string drop = "  - {id: drop, test: drop_rebound, setup: {drop_height: 0.1, plate: steel}, observed: {restitution: {value: 0.5, sigma: 0.02}}}\n";
+  const std::string silo = "  - {id: silo, test: hopper_discharge, setup: {silo_diameter: 0.12, orifice_diameter: 0.03, fill_height: 0.1, wall: steel}, "
+                           "observed: {mass_flow_rate: {value: 0.2, sigma: 0.01}}}\n";
+  const std::string drum = "  - {id: drum, test: rotating_drum, setup: {drum_diameter: 0.16, drum_depth: 0.03, fill_fraction: 0.35, rpm: 10, wall: steel}, "
+                           "observed: {dynamic_angle_deg: {value: 35, sigma: 1}}}\n";
+  const std::string tetra = facet("0 0 0", "0 1 0", "1 0 0") + facet("0 0 0", "1 0 0", "0 0 1") + facet("0 0 0", "0 0 1", "0 1 0") +
+                            facet("1 0 0", "0 1 0", "0 0 1");
+  const auto replaced = [](std::string text, const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+    return text;
+  };
+  return {
+      // Case files.
+      {"broken YAML", Reader::case_text, "simulation: {duration: 1\nmaterials: [", {"fuzz.yaml:", "not valid YAML"}},
+      {"an empty file", Reader::case_text, "", {"must be a map"}},
+      {"a misspelt top-level key", Reader::case_text, good_case() + "simulaton: {}\n", {"simulaton: unknown key", "simulation"}},
+      {"a misspelt particle key", Reader::case_text, good_case("{material: glass, diametr: 0.01, count: 10, region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}"),
+       {"particles[0]", "diameter"}},
+      {"a word for a number", Reader::case_text, with("diameter: 0.01", "diameter: ten"), {"fuzz.yaml:7:", "'ten' is not a number"}},
+      {"a fraction for a count", Reader::case_text, with("count: 10", "count: 2.5"), {"particles[0].count", "whole number"}},
+      {"a negative duration", Reader::case_text, with("duration: 0.01", "duration: -1"), {"simulation.duration", "out of range; valid: [0, 1e+06] s"}},
+      {"a negative density", Reader::case_text, with("density: 2500", "density: -5"), {"materials.glass.density", "out of range"}},
+      {"a missing count", Reader::case_text, with("count: 10, ", ""), {"particles[0].count", "missing"}},
+      {"an unknown material", Reader::case_text, with("material: glass, diameter", "material: glas, diameter"), {"unknown material 'glas'", "glass"}},
+      {"a library material that does not exist", Reader::case_text,
+       "simulation: {duration: 1}\nmaterials:\n  g: {library: no_such_material}\nparticles: []\n", {"materials.g.library", "no material file"}},
+      {"NaN for a duration", Reader::case_text, with("duration: 0.01", "duration: .nan"), {"simulation.duration", "is not a number"}},
+      {"an infinite position", Reader::case_text, good_case("{material: glass, diameter: 0.01, positions: [[0, 0, .inf]]}"), {"particles[0].positions", "finite"}},
+      {"a region inside out", Reader::case_text, with("max: [0.1, 0.1, 0.1]", "max: [0.1, -0.1, 0.1]"), {"region.max", "must exceed min"}},
+      {"a negative diameter", Reader::case_text, with("diameter: 0.01", "diameter: -0.01"), {"particles[0].diameter", "valid: (0, 10] m"}},
+      {"ninety million particles", Reader::case_text,
+       good_case("{material: glass, diameter: 0.001, count: 90000000, region: {min: [0, 0, 0], max: [100, 100, 100]}}"), {"exceeds the limit of 20000000"}},
+      {"more particles than the region holds", Reader::case_text, with("count: 10", "count: 1000000"), {"Enlarge `region` or lower `count`"}},
+      {"an output folder outside the working directory", Reader::case_text, good_case() + "output: {directory: ../../etc}\n", {"output.directory", "no `..`"}},
+      {"an inline mesh with a vertex index past its vertices", Reader::case_text,
+       good_case() + "meshes:\n  - {name: m, material: glass, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], triangles: [[0, 1, 3]]}\n",
+       {"meshes[0].triangles", "vertex index 3"}},
+      {"a key given twice", Reader::case_text, with("{duration: 0.01}", "{duration: 0.01, duration: 5}"),
+       {"fuzz.yaml:1:", "simulation.duration: given twice in one map (first at line 1)"}},
+      {"a section given twice", Reader::case_text, good_case() + "simulation: {duration: 5}\n", {"simulation: given twice", "first at line 1"}},
+      {"a material name given twice", Reader::case_text,
+       with("materials:\n", "materials:\n  glass: {density: 1000, youngs_modulus: 5.0e7, restitution: 0.9, friction: 0.3}\n"),
+       {"materials.glass: given twice", "first at line 3"}},
+      {"a wall name given twice", Reader::case_text,
+       good_case() + "meshes:\n  - {name: floor, material: glass, vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], triangles: [[0, 1, 2]]}\n",
+       {"wall name 'floor' given twice (first at line 5)"}},
+      {"an inlet name given twice", Reader::case_text,
+       good_case() + "inlets:\n  - {name: feed, material: glass, diameter: 0.01, count: 5, region: {min: [0, 0, 0.2], max: [0.1, 0.1, 0.3]}}\n"
+                     "  - {name: feed, material: glass, diameter: 0.01, count: 5, region: {min: [0, 0, 0.4], max: [0.1, 0.1, 0.5]}}\n",
+       {"inlet name 'feed' given twice"}},
+      {"an outlet name given twice", Reader::case_text,
+       good_case() + "outlets:\n  - {name: bin, region: {min: [0, 0, -1], max: [1, 1, -0.5]}}\n  - {name: bin, region: {min: [2, 0, -1], max: [3, 1, -0.5]}}\n",
+       {"outlet name 'bin' given twice"}},
+      {"a feed port too small for its rate (a short, slow feed belt at 2000 t/h)", Reader::case_text,
+       "simulation: {duration: 0.1}\nmaterials:\n  gravel: {density: 2650, youngs_modulus: 5.0e7, restitution: 0.5, friction: 0.5}\n"
+       "  steel: {density: 7800, youngs_modulus: 2.0e11, restitution: 0.5, friction: 0.5}\n"
+       "  rubber: {density: 1100, youngs_modulus: 1.0e7, restitution: 0.5, friction: 0.8}\n"
+       "equipment:\n  transfer_chute:\n    feed_belt: {length: 1.0, speed: 0.5}\n"
+       "inlets:\n  - {name: feed, port: feed_belt, material: gravel, mass_rate_tph: 2000, diameter: {distribution: uniform, min: 0.03, max: 0.05}}\n",
+       {"inlets.feed: 2000 t/h needs its region (the port 'feed_belt'", "cannot deliver it", "feed length"}},
+      {"a wall of an unknown material", Reader::case_text, replaced(good_case(), "{name: floor, material: glass", "{name: floor, material: stel"),
+       {"stel"}},
+      // Measurement files.
+      {"a measurement file of broken YAML", Reader::measurements, "experiments: [", {"fuzz_measurements.yaml:", "not valid YAML"}},
+      {"no experiments", Reader::measurements, "material: x\n", {"experiments", "missing"}},
+      {"a misspelt test", Reader::measurements, measurement_file(replaced(drop, "drop_rebound", "drop_rebond")), {"experiments[0].test", "drop_rebound"}},
+      {"a misspelt set-up key", Reader::measurements, measurement_file(replaced(drop, "plate: steel", "plate: steel, impact_angel_deg: 30")),
+       {"experiment 'drop'", "impact_angel_deg", "did you mean 'impact_angle_deg'"}},
+      {"NaN for a drop height", Reader::measurements, measurement_file(replaced(drop, "drop_height: 0.1", "drop_height: .nan")), {"drop_height"}},
+      {"a negative Young's modulus of a wall", Reader::measurements, "walls: {steel: {youngs_modulus: -1}}\nexperiments: []\n",
+       {"walls.steel.youngs_modulus", "out of range"}},
+      {"an orifice wider than its silo", Reader::measurements, measurement_file(replaced(silo, "orifice_diameter: 0.03", "orifice_diameter: 0.2")),
+       {"silo", "orifice_diameter"}},
+      {"a drum turning backwards", Reader::measurements, measurement_file(replaced(drum, "rpm: 10", "rpm: -20")), {"drum", "rpm"}},
+      {"an experiment id given twice", Reader::measurements, measurement_file(drop + drop), {"drop"}},
+      {"a key given twice in a measurement file", Reader::measurements, measurement_file(drop, "material: a\nmaterial: b\n"),
+       {"material: given twice", "first at line 1"}},
+      {"an outcome written as an observable", Reader::measurements,
+       measurement_file(replaced(silo, "observed: {mass_flow_rate: {value: 0.2, sigma: 0.01}}", "observed: {outcome: blocked}")), {"outcome"}},
+      // Mesh files.
+      {"an ASCII STL cut between facets", Reader::stl, "solid s\n" + tetra, {"input.stl", "ends without endsolid"}},
+      {"an ASCII STL cut inside a facet", Reader::stl, "solid s\n" + tetra + " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n",
+       {"ends inside the facet of line 30"}},
+      {"an ASCII STL facet of two vertices", Reader::stl, ascii_stl(replaced(tetra, "   vertex 1 0 0\n  endloop", "  endloop")), {"has 2 vertices, not 3"}},
+      {"a binary STL cut after 3 of 12 facets", Reader::stl, binary_stl(12, 3), {"declares 12 facets", "cut after facet 3"}},
+      {"a file shorter than a binary STL header", Reader::stl, "\x01\x02 not a mesh", {"shorter than a binary STL's 84-byte header"}},
+      {"a binary STL with a NaN vertex", Reader::stl,
+       [] {
+         std::string stl = binary_stl(1, 1);
+         const float nan = std::numeric_limits<float>::quiet_NaN();
+         std::memcpy(stl.data() + 84 + 12, &nan, sizeof nan);
+         return stl;
+       }(),
+       {"non-finite coordinates"}},
+      {"an OBJ of lines only", Reader::obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2\nl 2 3\n", {"no triangles"}},
+      {"a PLY header declaring more vertices than bytes", Reader::ply,
+       "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n", {"declares 99999999999 elements"}},
+      {"a STEP file", Reader::step, "ISO-10303-21;\n", {"STEP/IGES"}},
+  };
+}
+
+TEST(BadInput, TableOfInputsEachWithItsMessage) {
+  const std::vector<BadInputRow> rows = bad_inputs();
+  EXPECT_GE(rows.size(), 40u);
+  std::printf("| bad input | message (first 160 characters) |\n|---|---|\n");
+  for (const BadInputRow& row : rows) {
+    SCOPED_TRACE(row.what);
+    std::string message;
+    switch (row.reader) {
+      case Reader::case_text: message = read_case_text(row.input); break;
+      case Reader::measurements: message = read_measurement_text(row.input); break;
+      case Reader::stl: message = import_mesh_bytes(row.input, ".stl"); break;
+      case Reader::obj: message = import_mesh_bytes(row.input, ".obj"); break;
+      case Reader::ply: message = import_mesh_bytes(row.input, ".ply"); break;
+      case Reader::step: message = import_mesh_bytes(row.input, ".step"); break;
+    }
+    EXPECT_FALSE(message.empty()) << row.what << ": accepted";
+    for (const std::string& part : row.says) EXPECT_NE(message.find(part), std::string::npos) << row.what << ": '" << part << "' not in: " << message;
+    std::string shown = message.substr(0, 160);
+    for (char& c : shown)
+      if (c == '\n' || c == '|') c = ' ';
+    std::printf("| %s | %s |\n", row.what, shown.c_str());
+  }
 }
 
 /// Every saved fuzzer finding, through the reader that crashed on it: an answer, never a crash.

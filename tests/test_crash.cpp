@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <cstdio>
 #include <random>
 #include <sstream>
 #include <string>
@@ -453,6 +454,83 @@ TEST(KillAndResume, SigtermWritesACheckpointAndExitsCleanly) {
   EXPECT_NE(read_text(out / "run_info.yaml").find("completed: true"), std::string::npos);
 }
 
+// A default run (no checkpoint_every) killed with SIGKILL keeps its rows: scalars.csv is saved
+// whole every output.rows_seconds (5 s) of wall time, so the rows on disk are the run's own rows,
+// exactly, up to a save at most rows_seconds before the kill. The reference run to the last
+// saved row's time gives the same rows bit for bit (one thread: deterministic).
+TEST(KillKeepsRows, SigkillOfADefaultRunKeepsItsRowsUpToTheLastSave) {
+  fs::create_directories(kScratch);
+  std::string text = read_text(fs::path(DEMDESIGN_SOURCE_DIR) / "cases/inlet_outlet.yaml");
+  const std::string from = "output: {directory: out/inlet_outlet}";
+  text.replace(text.find(from), from.size(), "output: {directory: out/rows_test, scalars_every: 200}");
+  const fs::path c = kScratch / "rows_case.yaml";
+  std::ofstream(c) << text;
+  const fs::path out = kScratch / "rows_killed";
+  auto args = run_args(c, out);
+  args.insert(args.end(), {"--duration", "60"});
+  const pid_t pid = start(args, kScratch / "rows_killed.log");
+  // The first save comes after 5 s of wall time; then a seeded random moment within the next save interval.
+  while (!fs::exists(out / "scalars.csv") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(5ms);
+  std::mt19937 random(20261206);
+  std::this_thread::sleep_for(std::chrono::duration<double>(std::uniform_real_distribution<double>(0.2, 6.0)(random)));
+  const auto saved = fs::last_write_time(out / "scalars.csv");
+  const bool running = ::kill(pid, SIGKILL) == 0;
+  const auto killed = fs::file_time_type::clock::now();
+  ASSERT_TRUE(running && wait_exit(pid) == 128 + SIGKILL) << "the run ended before the kill: " << read_text(kScratch / "rows_killed.log");
+  const double since_save = std::chrono::duration<double>(killed - std::max(saved, fs::last_write_time(out / "scalars.csv"))).count();
+  const std::string kept = read_text(out / "scalars.csv");
+  ASSERT_EQ(kept.rfind("time_s,step", 0), 0u) << kept.substr(0, 200);
+  ASSERT_EQ(kept.back(), '\n') << "a torn row";
+  std::vector<std::string> rows;
+  std::istringstream lines(kept);
+  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  ASSERT_GE(rows.size(), 3u) << "the header and at least two rows";
+  const std::string last_time = rows.back().substr(0, rows.back().find(','));
+  // The same run to the last kept row's time: the same rows.
+  const fs::path reference = kScratch / "rows_reference";
+  auto reference_args = run_args(c, reference);
+  reference_args.insert(reference_args.end(), {"--duration", last_time});
+  ASSERT_EQ(wait_exit(start(reference_args, kScratch / "rows_reference.log")), 0) << read_text(kScratch / "rows_reference.log");
+  std::istringstream expected(read_text(reference / "scalars.csv"));
+  size_t same = 0;
+  for (std::string line; std::getline(expected, line) && same < rows.size() && line == rows[same];) ++same;
+  EXPECT_GE(same + 1, rows.size()) << "row " << same << " differs: " << rows[std::min(same, rows.size() - 1)];
+  std::printf("killed %.2f s after the last save of scalars.csv (rows_seconds 5): %zu rows kept, to t = %s s, equal to the reference's\n",
+              since_save, rows.size() - 1, last_time.c_str());
+  EXPECT_LE(since_save, 5.0 + 1.5) << "the rows were saved less often than output.rows_seconds";
+}
+
+// Without checkpoint_every, checkpoints come on the wall clock (output.checkpoint_seconds, 600 s
+// by default; here a quarter of the run): a run killed after one continues with --resume to the
+// uninterrupted run's final state, bit for bit.
+TEST(KillAndResume, WallClockCheckpointsLetAKilledRunWithoutCheckpointEveryResume) {
+  fs::create_directories(kScratch);
+  const std::string text = read_text(fs::path(DEMDESIGN_SOURCE_DIR) / "cases/inlet_outlet.yaml");
+  const std::string from = "output: {directory: out/inlet_outlet}";
+  const auto write_case = [&](const fs::path& path, double seconds) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), "output: {directory: out/wall_clock, checkpoint_seconds: " + std::to_string(seconds) + "}");
+    std::ofstream(path) << t;
+  };
+  const fs::path c = kScratch / "wall_clock.yaml";
+  write_case(c, 0);
+  const fs::path reference = kScratch / "wall_clock_reference";
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(start(run_args(c, reference), kScratch / "wall_clock_reference.log")), 0) << read_text(kScratch / "wall_clock_reference.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_FALSE(fs::exists(reference / "checkpoint.bin")) << "checkpoint_seconds: 0 writes none";
+  write_case(c, std::max(0.05, seconds / 4));
+  const fs::path out = kScratch / "wall_clock_trial";
+  const pid_t pid = start(run_args(c, out), kScratch / "wall_clock_trial.log");
+  while (!fs::exists(out / "checkpoint.bin") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(1ms);
+  const bool running = ::kill(pid, SIGKILL) == 0;
+  ASSERT_TRUE(running && wait_exit(pid) == 128 + SIGKILL) << "the run ended before its first checkpoint: " << read_text(kScratch / "wall_clock_trial.log");
+  auto args = run_args(c, out);
+  args.push_back("--resume");
+  ASSERT_EQ(wait_exit(start(args, kScratch / "wall_clock_resume.log")), 0) << read_text(kScratch / "wall_clock_resume.log");
+  EXPECT_EQ(end_hash(out), end_hash(reference)) << read_text(kScratch / "wall_clock_resume.log");
+}
+
 TEST(FullDisk, AFailedWriteIsAClearErrorAndEarlierResultsStayReadable) {
   // Every row of scalars (about 9000 steps a second); scalars.csv outgrows 256 kB mid-run, like a disk filling up.
   std::string text = read_text(checkpoint_case());
@@ -523,6 +601,31 @@ TEST(NumericalTrouble, EnergyRisingWithoutASourceIsCaught) {
   EXPECT_EQ(run_and_catch(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0]], velocity: [1, 0, 0]}\n"
                                     "  - {material: glass, diameter: 0.01, positions: [[0.0105, 0, 0]], velocity: [-1, 0, 0]}\n")),
             "");
+}
+
+// A run stopped by numerical trouble keeps what it computed and says why: the rows so far, and a
+// run record whose end block says it did not complete and why (the report's banner reads it).
+TEST(NumericalTrouble, AStoppedRunKeepsItsRowsAndItsRecordSaysWhy) {
+  const dem::Model model = dem::compile(
+      dem::parse_case_text(base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0], [0.0085, 0, 0]]}\n")));
+  dem::State state = dem::initial_state(model);
+  dem::Workspace work;
+  dem::RunOptions options;
+  options.output_directory = (kScratch / "stopped").string();
+  options.progress = false;
+  std::ostringstream log;
+  try {
+    dem::run(model, state, work, options, log);
+    FAIL() << "the energy rise should stop the run";
+  } catch (const dem::RunStopped& e) {
+    EXPECT_NE(e.summary.stopped.find("numerical trouble: "), std::string::npos) << e.summary.stopped;
+    EXPECT_NE(e.summary.stopped.find("the energy (kinetic + gravitational) rose"), std::string::npos) << e.summary.stopped;
+    EXPECT_FALSE(e.summary.scalars.empty());
+  }
+  const std::string info = read_text(kScratch / "stopped" / "run_info.yaml");
+  EXPECT_NE(info.find("completed: false"), std::string::npos) << info;
+  EXPECT_NE(info.find("stopped: \"numerical trouble: "), std::string::npos) << info;
+  EXPECT_EQ(read_text(kScratch / "stopped" / "scalars.csv").rfind("time_s,step", 0), 0u);
 }
 
 TEST(NumericalTrouble, BlowUpFromATooLargeTimeStepIsCaughtWithTheCause) {

@@ -185,6 +185,21 @@ TEST(RunReport, WithoutAWearCoefficientSaysHowToGiveOne) {
   EXPECT_GT(metrics.get("shear_power_max_W_m2"), 0) << "the wear input is still there";
 }
 
+TEST(RunReport, AStoppedRunSaysWhyAboveEverything) {
+  Fixture f("demdesign_report_stopped_test");
+  f.input.stopped = "numerical trouble: t = 3.5 s: particles 4 and 9 overlap by 60 % of the smaller radius";
+  const fs::path out = f.dir / "report";
+  report::write_run_report(f.input, out.string());
+  const std::string html = read(out / "report.html");
+  const auto banner = html.find("The run stopped before its end, at t = ");
+  ASSERT_NE(banner, std::string::npos);
+  EXPECT_NE(html.find("particles 4 and 9 overlap by 60 %", banner), std::string::npos);
+  EXPECT_LT(banner, html.find("<h2")) << "the banner comes before the first section";
+  Fixture g("demdesign_report_not_stopped_test");
+  report::write_run_report(g.input, (g.dir / "report").string());
+  EXPECT_EQ(read(g.dir / "report" / "report.html").find("stopped before its end"), std::string::npos);
+}
+
 TEST(RunReport, SelfContainedWithSteadyIntervalMeanAndFiles) {
   Fixture f("demdesign_report_test");
   const fs::path out = f.dir / "report";

@@ -253,5 +253,31 @@ particles:
   }
 }
 
+// A particle placed under the floor (a one-sided plane: its normal points to where particles
+// belong) never touches it and falls through; an inlet wholly under it feeds nothing the floor
+// holds. Both are warned of at the start, naming the wall; particles above it are not.
+TEST(RunOutputs, ParticlesAndInletsBehindAPlaneWallAreWarnedOf) {
+  const std::string text = R"(
+simulation: {duration: 0.01}
+materials: {beads: {density: 2500, youngs_modulus: 1.0e7, poisson_ratio: 0.25, restitution: 0.5, friction: 0.5}}
+walls:
+  - {name: floor, material: beads, plane: {point: [0, 0, 0], normal: [0, 0, 1]}}
+particles:
+  - {material: beads, diameter: 0.01, positions: [[0, 0, 0.1], [0, 0, -0.2], [0.1, 0, -0.3], [0.2, 0, 0.003]]}
+inlets:
+  - {name: below, material: beads, diameter: 0.01, mass_rate_kgs: 0.1, region: {min: [0, 0, -0.5], max: [0.1, 0.1, -0.4]}}
+  - {name: above, material: beads, diameter: 0.01, mass_rate_kgs: 0.1, region: {min: [0, 0, 0.4], max: [0.1, 0.1, 0.5]}}
+)";
+  const Model model = compile(parse_case_text(text, "behind.yaml"));
+  const State state = initial_state(model);
+  const std::vector<std::string> warnings = particles_behind_walls(model, state);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("2 particles (the first with id 1) start wholly behind plane wall 'floor'"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("inlet 'below' lies wholly behind plane wall 'floor'"), std::string::npos) << warnings[1];
+  std::ostringstream log;
+  print_setup(model, state, log);
+  EXPECT_NE(log.str().find("WARNING: 2 particles"), std::string::npos) << log.str();
+}
+
 }  // namespace
 }  // namespace dem

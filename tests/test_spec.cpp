@@ -177,7 +177,7 @@ TEST(Sensors, PlaneAndBoxAreReadAndBadOnesNamed) {
   const std::string both = replace(good, "box: {min", "plane: {point: [0, 0, 0]}, box: {min");
   EXPECT_NE(error_of(both).find("sensors[1]"), std::string::npos) << error_of(both);
   const std::string twice = replace(good, "name: load", "name: flow");
-  EXPECT_NE(error_of(twice).find("used twice"), std::string::npos) << error_of(twice);
+  EXPECT_NE(error_of(twice).find("sensor name 'flow' given twice"), std::string::npos) << error_of(twice);
 }
 
 TEST(Equipment, UnknownGeneratorSuggestsTheNearestAndPortsNeedEquipment) {

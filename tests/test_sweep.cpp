@@ -1,4 +1,5 @@
 // Design sweeps: reading the `sweep:` section, the variants' cases, errors with file and line.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "case/spec.h"
@@ -62,6 +63,26 @@ TEST(Sweep, ZipNeedsEqualListsAndBadPathsAreNamed) {
   std::string metric = kSweep;
   metric.replace(metric.find("goal: minimize"), 14, "goal: smallest");
   EXPECT_THROW(app::read_sweep(YAML::Load(metric), "sweep.yaml"), CaseError);
+}
+
+// A grid is sized before it is built: four keys of 50 values (6.25 million variants, gigabytes of
+// YAML copies) are refused at once, with the sizes and the way out.
+TEST(Sweep, AGridTooLargeIsRefusedBeforeItIsBuilt) {
+  std::string values;
+  for (int k = 0; k < 50; ++k) values += fmt::format("{}{}", k ? ", " : "", 0.5 + 0.01 * k);
+  std::string text = kSweep;
+  text.replace(text.find("    equipment.transfer_chute.spoon.radius"), 0,
+               fmt::format("    a.b: [{0}]\n    a.c: [{0}]\n    a.d: [{0}]\n    a.e: [{0}]\n", values));
+  try {
+    app::read_sweep(YAML::Load(text), "sweep.yaml");
+    FAIL() << "a grid of 37.5 million variants must be refused";
+  } catch (const CaseError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("sweep.yaml:"), std::string::npos) << m;
+    EXPECT_NE(m.find("makes 37500000 variants (50 x 50 x 50 x 50 x 3 x 2 values"), std::string::npos) << m;
+    EXPECT_NE(m.find("at most 1000"), std::string::npos) << m;
+    EXPECT_NE(m.find("combine: zip"), std::string::npos) << m;
+  }
 }
 
 }  // namespace

@@ -85,6 +85,8 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   o.progress_seconds = map.number("progress_seconds", o.progress_seconds, 0.0, 1e6, "s");
   o.frames_every = map.number("frames_every", 0.0, 0.0, 1e9, "s");
   o.checkpoint_every = map.number("checkpoint_every", 0.0, 0.0, 1e9, "s");
+  o.checkpoint_seconds = map.number("checkpoint_seconds", o.checkpoint_seconds, 0.0, 1e9, "s");
+  o.rows_seconds = map.number("rows_seconds", o.rows_seconds, 0.0, 1e9, "s");
   o.records_from = map.number("records_from", 0.0, 0.0, 1e9, "s");
   if (const YAML::Node render = map.node("render")) {
     MapReader r(render, file, "output.render");
@@ -114,6 +116,21 @@ OutputSpec read_output(const YAML::Node& node, const std::string& file, const st
   }
   map.finish();
   return o;
+}
+
+/// Names label a run's columns and files (walls.h5, scalars.csv): two parts of one kind under one
+/// name would give two columns of one name. Plane walls and meshes are one kind, the walls.
+void refuse_duplicate_names(const std::vector<std::pair<std::string, SourceLocation>>& named, const std::string& kind) {
+  for (size_t i = 0; i < named.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (named[i].first == named[j].first)
+        throw CaseError(fmt::format("{}: {} name '{}' given twice (first at {}); each {} needs a name of its own: its results are reported under it",
+                                    named[i].second.str(), kind, named[i].first, named[j].second.line > 0 ? fmt::format("line {}", named[j].second.line) : named[j].second.str(), kind));
+}
+
+template <class Items>
+void add_names(std::vector<std::pair<std::string, SourceLocation>>& named, const Items& items) {
+  for (const auto& item : items) named.emplace_back(item.name, item.location);
 }
 
 CaseSpec read_case(const YAML::Node& root, const std::string& file) {
@@ -210,6 +227,15 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     if (!sensors.IsSequence()) top.fail("sensors", "must be a list of sensors ({name, plane: {...}, region} or {name, box: {...}})");
     for (size_t k = 0; k < sensors.size(); ++k) spec.sensors.push_back(read_sensor(sensors[k], file, k));
   }
+  {
+    std::vector<std::pair<std::string, SourceLocation>> walls, inlets, outlets, sensors;
+    add_names(walls, spec.planes), add_names(walls, spec.meshes), add_names(inlets, spec.inlets), add_names(outlets, spec.outlets),
+        add_names(sensors, spec.sensors);
+    refuse_duplicate_names(walls, "wall");
+    refuse_duplicate_names(inlets, "inlet");
+    refuse_duplicate_names(outlets, "outlet");
+    refuse_duplicate_names(sensors, "sensor");
+  }
   if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
   if (const YAML::Node wear = top.node("wear_coefficients")) {
     MapReader w(wear, file, "wear_coefficients");
@@ -224,14 +250,6 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   return spec;
 }
 
-YAML::Node load_yaml(const std::string& text, const std::string& name) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
-  }
-}
-
 }  // namespace
 
 CaseSpec parse_case_node(const YAML::Node& root, const std::string& file) {
@@ -244,7 +262,7 @@ CaseSpec parse_case_node(const YAML::Node& root, const std::string& file) {
 
 CaseSpec parse_case_text(const std::string& text, const std::string& name) {
   try {
-    return read_case(load_yaml(text, name), name);
+    return read_case(parse_yaml(text, name), name);
   } catch (const YAML::Exception& e) {
     throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
   }

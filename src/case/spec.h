@@ -275,7 +275,14 @@ struct OutputSpec {
   int64_t scalars_every = 0;      ///< steps between rows of scalars.csv; 0: about 200 rows
   double progress_seconds = 2.0;  ///< wall-clock seconds between progress lines
   double frames_every = 0;        ///< [s] simulated time between HDF5 particle frames; 0: 20 frames
-  double checkpoint_every = 0;    ///< [s] simulated time between checkpoints; 0: none
+  double checkpoint_every = 0;    ///< [s] simulated time between checkpoints; 0: none but checkpoint_seconds'
+  /// [s] wall-clock time between checkpoints (beside checkpoint_every), so that a killed run
+  /// loses at most this much computing; 0: none.
+  double checkpoint_seconds = 600;
+  /// [s] wall-clock time between saves of the rows computed so far (scalars.csv, events.csv,
+  /// each replaced whole, never torn); a killed run loses at most this much of its rows; 0: saved
+  /// only at checkpoints and at the end.
+  double rows_seconds = 5;
   double records_from = 0;        ///< [s] wall records (pressure, wear inputs) accumulate from here on
   /// Images of the flow: every render_every-th particle frame (0: the last frame only).
   int render_every = 0;

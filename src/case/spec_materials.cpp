@@ -122,17 +122,9 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
   std::string searched;
   const std::filesystem::path found = find_library_file(wanted, case_file, searched);
   if (found.empty()) entry.fail("library", fmt::format("no material file '{}.yaml' found; looked in:{}", wanted, searched));
-  std::ifstream in(found);
-  std::stringstream text;
-  text << in.rdbuf();
   LibraryMaterial lib;
   lib.file = found.lexically_normal().string();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text.str());
-  } catch (const YAML::ParserException& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", lib.file, e.mark.line + 1, e.mark.column + 1, e.msg));
-  }
+  const YAML::Node root = read_yaml_file(lib.file, "the material file");
   MapReader file_map(root, lib.file, "");
   if (!file_map.has("properties")) file_map.fail("properties", "missing: the material's {density, youngs_modulus, ...}");
   lib.material = read_material(name, file_map.node("properties"), lib.file, "properties");

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <unordered_map>
 
 namespace dem {
 
@@ -35,6 +38,59 @@ std::string join(const std::vector<std::string>& words) {
   for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
   return out;
 }
+
+/// Throws on the first map (depth first, in file order) that holds a scalar key twice. `path`
+/// holds the key path of `node` a step an entry ("materials", "[0]"), joined only for the message.
+void refuse_duplicate_keys(const YAML::Node& node, const std::string& file, std::vector<std::string>& path) {
+  if (node.IsSequence()) {
+    for (size_t k = 0; k < node.size(); ++k) {
+      path.push_back(fmt::format("[{}]", k));
+      refuse_duplicate_keys(node[k], file, path);
+      path.pop_back();
+    }
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::unordered_map<std::string, YAML::Mark> seen;
+  for (const auto& kv : node) {
+    if (!kv.first.IsScalar()) continue;
+    const std::string& key = kv.first.Scalar();
+    path.push_back(key);
+    const auto [first, fresh] = seen.emplace(key, kv.first.Mark());
+    if (!fresh) {
+      std::string key_path;
+      for (const std::string& step : path) key_path += (key_path.empty() || step.front() == '[' ? "" : ".") + step;
+      throw CaseError(fmt::format("{}:{}:{}: {}: given twice in one map (first at line {}); a key may appear once: remove one or merge them",
+                                  file, kv.first.Mark().line + 1, kv.first.Mark().column + 1, key_path, first->second.line + 1));
+    }
+    refuse_duplicate_keys(kv.second, file, path);
+    path.pop_back();
+  }
+}
+
+}  // namespace
+
+YAML::Node parse_yaml(const std::string& text, const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", file, e.mark.line + 1, e.mark.column + 1, e.msg));
+  }
+  std::vector<std::string> path;
+  refuse_duplicate_keys(root, file, path);
+  return root;
+}
+
+YAML::Node read_yaml_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw CaseError(fmt::format("{}: cannot open {}", path, what));
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_yaml(text.str(), path);
+}
+
+namespace {
 
 std::string format_range(double min, double max) {
   return fmt::format("[{:g}, {:g}]", min, max);

@@ -16,6 +16,14 @@
 
 namespace dem {
 
+/// Parses YAML `text` read from `file` (the name errors give). Throws CaseError naming the file,
+/// line and column when the text is not valid YAML, or when a map holds a key twice: YAML does
+/// not allow it, and yaml-cpp would keep the first value without a word.
+YAML::Node parse_yaml(const std::string& text, const std::string& file);
+/// Reads the file at `path` and parses it as parse_yaml(); `what` names it in the error when it
+/// cannot be opened ("the case file").
+YAML::Node read_yaml_file(const std::string& path, const std::string& what);
+
 /// The valid word closest to `word` (edit distance), or "" when none is close.
 std::string nearest_word(std::string_view word, const std::vector<std::string>& valid);
 

@@ -269,6 +269,41 @@ void write_file_atomically(const std::string& path, const std::string& content) 
   }
 }
 
+/// Particles placed wholly behind a one-sided plane wall, and inlets whose whole region lies
+/// behind one: such particles never meet the wall they were meant to rest on and fall until they
+/// leave the domain (or forever, without one). One warning line each.
+std::vector<std::string> particles_behind_walls(const Model& model, const State& state) {
+  std::vector<std::string> out;
+  for (const PlaneWall& w : model.planes) {
+    if (w.shape != PlaneWall::Shape::plane) continue;
+    const auto side = [&](double x, double y, double z) {
+      return (x - w.point[0]) * w.normal[0] + (y - w.point[1]) * w.normal[1] + (z - w.point[2]) * w.normal[2];
+    };
+    std::int64_t behind = 0, first = -1;
+    for (std::size_t i = 0; i < state.size(); ++i)
+      if (state.attached[i] < 0 && side(state.x[i], state.y[i], state.z[i]) < -state.radius[i]) {
+        if (first < 0) first = state.id[i];
+        ++behind;
+      }
+    if (behind > 0)
+      out.push_back(fmt::format("{} particle{} (the first with id {}) start{} wholly behind plane wall '{}' (its normal points to where particles "
+                                "belong): {} never touch it and fall through; move them to its side or turn its normal",
+                                behind, behind == 1 ? "" : "s", first, behind == 1 ? "s" : "", w.name, behind == 1 ? "it will" : "they will"));
+    for (const Inlet& inlet : model.inlets) {
+      const Vec3& a = inlet.spec.region_min;
+      const Vec3& b = inlet.spec.region_max;
+      bool all_behind = true;
+      for (int corner = 0; corner < 8 && all_behind; ++corner)
+        all_behind = side(corner & 1 ? b.x() : a.x(), corner & 2 ? b.y() : a.y(), corner & 4 ? b.z() : a.z()) < 0;
+      if (all_behind)
+        out.push_back(fmt::format("inlet '{}' lies wholly behind plane wall '{}' (its normal points to where particles belong): what it "
+                                  "inserts never touches that wall",
+                                  inlet.spec.name, w.name));
+    }
+  }
+  return out;
+}
+
 void print_setup(const Model& model, const State& state, std::ostream& log) {
   fmt::print(log, "demdesign {}: {}{}\n", DEMDESIGN_VERSION, model.source, model.title.empty() ? "" : " - " + model.title);
   fmt::print(log, "  {} spheres ({} clumps), {} materials, {} plane walls, {} inlets, {} outlets, {} threads\n",
@@ -291,6 +326,7 @@ void print_setup(const Model& model, const State& state, std::ostream& log) {
                model.period[2] > 0 ? "z" : "", model.period[0], model.period[1], model.period[2]);
   fmt::print(log, "  neighbour skin {:.3g} m, interaction range {:.3g} m\n", model.skin, model.interaction_range);
   for (const std::string& note : model.notes) fmt::print(log, "  note: {}\n", note);
+  for (const std::string& warning : particles_behind_walls(model, state)) fmt::print(log, "  WARNING: {}\n", warning);
 }
 
 RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log) {
@@ -476,25 +512,38 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
   const std::int64_t check_every = std::min<std::int64_t>(every, 10);
   if (!energy.active() && writer) fmt::print(log, "  energy check: off ({})\n", energy.source());
   std::int64_t lost_reported = state.lost, warnings = 0;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
   auto trouble = [&](const NumericalError& e) {
     if (model.stop_on_trouble) {
-      // Keep what was computed: the rows so far (the last checkpoint stays as it was).
+      // Keep what was computed: the rows so far and a run record that says why it ended (the last
+      // checkpoint stays as it was).
+      summary.stopped = fmt::format("numerical trouble: {}", e.what());
+      summary.steps = state.step - first_step;
+      summary.events = events.fired();
+      summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
       if (options.write_files && writer) {
         try {
           write_tables();
+          write_file_atomically(out + "/run_info.yaml", run_info(model, options, run_id) +
+                                                            fmt::format("end:\n  completed: false\n  time_s: {:.17g}\n  step: {}\n  stopped: {}\n",
+                                                                        state.time, state.step, yaml_quoted(summary.stopped)));
         } catch (const std::exception&) {
         }
       }
       std::signal(SIGINT, previous_int);
       std::signal(SIGTERM, previous_term);
-      throw e;
+      throw RunStopped(e, summary);
     }
     if (warnings++ < 20) fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
   };
 
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
   auto last_progress = start;
+  // What a kill (SIGKILL, the OOM killer, a power cut) may cost: the rows since the last save
+  // (output.rows_seconds of wall time) and the computing since the last checkpoint
+  // (output.checkpoint_seconds, or checkpoint_every).
+  auto last_rows_saved = start, last_checkpoint = start;
+  const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   std::int64_t particle_steps = 0;
   std::int64_t loop_frames = 0;  // frames written in the loop; on_frame follows every render_every-th
   // Steps until the next one that checks, records or writes run as one advance() (each closing
@@ -518,7 +567,12 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
     const bool stopping = domain ? check_due && domain->any(stop_signal != 0) : stop_signal != 0;
     const bool scalars_due = state.step % every == 0 || last;
     const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
-    const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping);
+    // A checkpoint on the wall clock: the root's clock decides, for every rank at the same step.
+    bool checkpoint_timed = options.write_files && model.output.checkpoint_seconds > 0 && !last &&
+                            (!domain || check_due) && writer && seconds_since(last_checkpoint) >= model.output.checkpoint_seconds;
+    if (domain && check_due) checkpoint_timed = domain->any(checkpoint_timed);
+    const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping || checkpoint_timed);
+    if (checkpoint_due) last_checkpoint = Clock::now(), last_rows_saved = last_checkpoint;
     const bool render_due = frame_due && options.on_frame &&
                             (last || (model.output.render_every > 0 && loop_frames % model.output.render_every == 0));
     if (frame_due) ++loop_frames;
@@ -567,6 +621,11 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       Scalars row = measure_row();
       particles_now = static_cast<double>(row.particles);
       if (writer) summary.scalars.push_back(std::move(row));
+      if (writer && options.write_files && !checkpoint_due && !last && model.output.rows_seconds > 0 &&
+          seconds_since(last_rows_saved) >= model.output.rows_seconds) {
+        write_tables();
+        last_rows_saved = Clock::now();
+      }
     }
     if (frames && frame_due) {
       write_frame_now(*results);
@@ -593,6 +652,7 @@ RunSummary run(const Model& model, State& state, Workspace& work, const RunOptio
       write_tables();
     }
     if (stopping) {
+      summary.stopped = fmt::format("stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume", int(stop_signal), state.time);
       if (writer)
         fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
                    state.time);

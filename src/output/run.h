@@ -64,10 +64,24 @@ struct RunSummary {
   std::shared_ptr<RunFolder> folder;
   /// A resumed run that had already reached its end: nothing was run, the state is as given.
   bool already_complete = false;
+  /// Why the run stopped before its end (a signal, numerical trouble); "" when it reached it.
+  std::string stopped;
+};
+
+/// Thrown by run() when numerical trouble stops it (simulation.numerical_trouble: stop), after the
+/// rows, events and run_info.yaml so far are written: what the run computed up to then, for the
+/// caller's report. The message is the trouble's.
+class RunStopped : public NumericalError {
+ public:
+  RunStopped(const NumericalError& cause, RunSummary so_far) : NumericalError(cause.what()), summary(std::move(so_far)) {}
+  RunSummary summary;
 };
 
 /// Prints the model's set-up (effects, time-step advice, notes) to `log`.
 void print_setup(const Model& model, const State& state, std::ostream& log);
+/// Warnings for particles placed wholly behind a one-sided plane wall and for inlets whose region
+/// lies wholly behind one (print_setup says them): such particles fall through the wall.
+std::vector<std::string> particles_behind_walls(const Model& model, const State& state);
 
 /// Runs from the state as it is (prepare() is called here) to the model's end time. Writing files,
 /// it first claims OUT (RunFolder: refused when it holds another run's results unless resume or

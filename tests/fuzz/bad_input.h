@@ -13,7 +13,8 @@ namespace dem::fuzz {
 /// initial particle placement when the case holds at most `place_limit` particles.
 std::string read_case_text(const std::string& text, std::int64_t place_limit = 2000);
 
-/// dem::materials::parse_measurements.
+/// dem::materials::parse_measurements, then every set-up checked against a plain 6 mm bead
+/// (check_experiments: what `compare` does before any simulation).
 std::string read_measurement_text(const std::string& text);
 
 /// Writes `bytes` to a private temporary file named input`extension`, imports it
