@@ -501,7 +501,7 @@ TEST(KillKeepsRows, SigkillOfADefaultRunKeepsItsRowsUpToTheLastSave) {
 }
 
 // Without checkpoint_every, checkpoints come on the wall clock (output.checkpoint_seconds, 600 s
-// by default; here a quarter of the run): a run killed after one continues with --resume to the
+// by default; here an eighth of the run): a run killed after one continues with --resume to the
 // uninterrupted run's final state, bit for bit.
 TEST(KillAndResume, WallClockCheckpointsLetAKilledRunWithoutCheckpointEveryResume) {
   fs::create_directories(kScratch);
@@ -519,7 +519,7 @@ TEST(KillAndResume, WallClockCheckpointsLetAKilledRunWithoutCheckpointEveryResum
   ASSERT_EQ(wait_exit(start(run_args(c, reference), kScratch / "wall_clock_reference.log")), 0) << read_text(kScratch / "wall_clock_reference.log");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_FALSE(fs::exists(reference / "checkpoint.bin")) << "checkpoint_seconds: 0 writes none";
-  write_case(c, std::max(0.05, seconds / 4));
+  write_case(c, std::max(0.02, seconds / 8));
   const fs::path out = kScratch / "wall_clock_trial";
   const pid_t pid = start(run_args(c, out), kScratch / "wall_clock_trial.log");
   while (!fs::exists(out / "checkpoint.bin") && ::waitpid(pid, nullptr, WNOHANG) == 0) std::this_thread::sleep_for(1ms);
@@ -626,6 +626,21 @@ TEST(NumericalTrouble, AStoppedRunKeepsItsRowsAndItsRecordSaysWhy) {
   EXPECT_NE(info.find("completed: false"), std::string::npos) << info;
   EXPECT_NE(info.find("stopped: \"numerical trouble: "), std::string::npos) << info;
   EXPECT_EQ(read_text(kScratch / "stopped" / "scalars.csv").rfind("time_s,step", 0), 0u);
+}
+
+// The same through the program: the report of what was computed, under a banner that says why.
+TEST(NumericalTrouble, AStoppedRunsReportSaysWhy) {
+  fs::create_directories(kScratch);
+  const fs::path c = kScratch / "stopped_case.yaml";
+  std::ofstream(c) << base_case("  - {material: glass, diameter: 0.01, positions: [[0, 0, 0], [0.0085, 0, 0]]}\n");
+  const fs::path out = kScratch / "stopped_binary";
+  const int status = wait_exit(start({c.string(), "--out", out.string(), "--threads", "1", "--quiet"}, kScratch / "stopped_binary.log"));
+  const std::string log = read_text(kScratch / "stopped_binary.log");
+  EXPECT_NE(status, 0) << log;
+  EXPECT_NE(log.find("the energy (kinetic + gravitational) rose"), std::string::npos) << log;
+  const std::string html = read_text(out / "report" / "report.html");
+  EXPECT_NE(html.find("The run stopped before its end"), std::string::npos) << log;
+  EXPECT_NE(html.find("numerical trouble: "), std::string::npos);
 }
 
 TEST(NumericalTrouble, BlowUpFromATooLargeTimeStepIsCaughtWithTheCause) {
