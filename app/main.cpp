@@ -175,18 +175,18 @@ int check_case(const std::string& path) {
     dem::print_setup(model, dem::initial_state(model), std::cout);
     return 0;
   }
+  dem::CaseSpec first;
   for (size_t k = 0; k < plan.variants.size(); ++k) {
     try {
       dem::CaseSpec spec = dem::parse_case_node(dem::app::variant_case(root, plan, k), path);
       dem::equipment::expand_equipment(spec);
+      if (k == 0) first = std::move(spec);
     } catch (const dem::CaseError& e) {
       throw dem::CaseError(fmt::format("sweep variant {} ({}): {}", plan.name(k), plan.label(k), e.what()));
     }
   }
   std::cout << fmt::format("sweep: {} variants of {} key{}; every variant reads and its equipment is generated; the first, {} ({}):\n",
                            plan.variants.size(), plan.paths.size(), plan.paths.size() == 1 ? "" : "s", plan.name(0), plan.label(0));
-  dem::CaseSpec first = dem::parse_case_node(dem::app::variant_case(root, plan, 0), path);
-  dem::equipment::expand_equipment(first);
   const dem::Model model = compile_case(first);
   dem::print_setup(model, dem::initial_state(model), std::cout);
   return 0;
