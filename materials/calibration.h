@@ -73,6 +73,14 @@ using BatchRunner = std::function<std::vector<BatchOutcome>(size_t count, const 
 
 struct Diagnosis;
 
+/// What shrinking the apparatus does to one observation (term `experiment/observable`), measured
+/// once, at the start values: the full-size mean minus the shrunk mean, and the standard error of
+/// that difference (both means' standard errors combined).
+struct SizeShift {
+  double shift = 0;
+  double sigma = 0;
+};
+
 struct CalibrationOptions {
   Simulator simulator;          ///< empty: run_virtual_test
   BatchRunner batch;            ///< empty: simulations of a batch one after the other, in this process
@@ -85,6 +93,12 @@ struct CalibrationOptions {
   /// arching limit scatters by 20 %). At most `replicas`: none are added.
   int most_replicas = 6;
   double size_factor = 1.0;     ///< passed to the virtual tests
+  /// Per term name, the shift that takes a simulation at size_factor < 1 to the full-size
+  /// apparatus of the measurements: added to each of its replicas' values, its sigma added to the
+  /// term's simulation noise (compare_runs). Empty, or size_factor 1: nothing is added (the
+  /// measurements are then of the apparatus as simulated). A diagnosis that shrinks the apparatus
+  /// to fit its budget measures it (diagnose()).
+  std::map<std::string, SizeShift> size_shift;
   double rayleigh_fraction = 0; ///< the virtual tests' time step (TestOptions); 0: their rule
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default (1 when parallel > 1)
   /// Simulations of a batch run at once in this process when no `batch` runner is set, each on
@@ -421,6 +435,13 @@ struct Diagnosis {
   /// Per rival: the experiments that would tell it from the recommended candidate, best first.
   std::map<std::string, std::vector<Separator>> separators;
   std::vector<std::string> words;
+  /// The apparatus' size after the first comparison: below 1 when the budget could not be met at
+  /// full size, the simulations then carrying size_shift (CalibrationOptions::size_shift).
+  double size_factor = 1.0;
+  std::map<std::string, SizeShift> size_shift;
+  /// Shrunk diagnoses: the best candidate's fitted model compared at full size, on which its grade
+  /// rests (empty runs when none was checked).
+  Comparison full_size;
 };
 
 /// The settings of a calibration or diagnosis that fit options.budget_seconds, from the cost of a

@@ -52,10 +52,16 @@ class SimulationCosts {
   }
   /// Mean seconds of a simulation in a pass over the experiments (each experiment's mean
   /// weighs alike); NaN when nothing ran yet.
-  double pass_mean() const {
+  /// `size`: the apparatus' size tag of the keys counted (Progress::key; "" at full size).
+  double pass_mean(const std::string& size = "") const {
     double sum = 0;
-    for (const auto& [key, v] : by_key_) sum += v.first / v.second;
-    return by_key_.empty() ? kNaN : sum / static_cast<double>(by_key_.size());
+    int keys = 0;
+    for (const auto& [key, v] : by_key_) {
+      const size_t at = key.find('@');
+      if ((at == std::string::npos ? std::string() : key.substr(at)) != size) continue;
+      sum += v.first / v.second, ++keys;
+    }
+    return keys == 0 ? kNaN : sum / keys;
   }
 
  private:
@@ -223,7 +229,7 @@ class Progress {
     if (command.active()) {
       // Beyond this phase: the command's other planned simulations at the mean cost of one.
       const int beyond = std::max(command.left() - static_cast<int>(planned_.size()), 0);
-      const double all = left + beyond * costs.pass_mean() / workers(options_, static_cast<size_t>(beyond));
+      const double all = left + beyond * costs.pass_mean(size_tag()) / workers(options_, static_cast<size_t>(beyond));
       line += fmt::format("; {}: simulation {} of about {}, {} elapsed, about {} left", command.what(), command.done(), command.done() + command.left(),
                           duration_text(command.elapsed()), std::isfinite(all) ? duration_text(all) : std::string("? s"));
     }
@@ -231,7 +237,9 @@ class Progress {
   }
 
  private:
-  static std::string key(const Experiment& e) { return e.setup.test + "/" + e.id; }
+  /// A shrunk apparatus' simulations are timed apart from the full-size ones.
+  std::string size_tag() const { return options_.size_factor < 1 ? fmt::format("@{:g}", options_.size_factor) : std::string(); }
+  std::string key(const Experiment& e) const { return e.setup.test + "/" + e.id + size_tag(); }
   const CalibrationOptions& options_;
   std::string what_;
   std::vector<std::string> planned_;

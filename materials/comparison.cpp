@@ -99,6 +99,9 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
       // Another model's noise on the same apparatus: the noise of a run of one replica, and the
       // least noise of a few replicas (two that agree by chance must not look sure).
       if (const auto f = sigma_floor.find(t.name()); f != sigma_floor.end()) t.sigma_simulated = std::max(t.sigma_simulated, f->second);
+      // A shrunk apparatus' mean carries the shift to full size, measured with its own noise.
+      if (const auto s = options.size_shift.find(t.name()); options.size_factor < 1 && s != options.size_shift.end())
+        t.sigma_simulated = std::hypot(t.sigma_simulated, s->second.sigma);
       t.residual = (t.simulated - t.measured) / std::sqrt(t.sigma_measured * t.sigma_measured + t.sigma_simulated * t.sigma_simulated);
       c.terms.push_back(t);
     }

@@ -38,6 +38,15 @@ TestOptions test_options(const CalibrationOptions& options, std::uint64_t seed) 
   return t;
 }
 
+/// A shrunk apparatus' observations carried to full size (CalibrationOptions::size_shift). An
+/// outcome (an arch, no heap, a slipping bed) is the same at either size: its 0 is not shifted.
+void shift_to_full_size(SimulatedOutcome& out, const TestSetup& setup, const CalibrationOptions& options) {
+  if (!(options.size_factor < 1) || options.size_shift.empty()) return;
+  if (std::any_of(out.flags.begin(), out.flags.end(), [](const std::string& f) { return f == "blocked" || f == "no_heap" || f == "slipping"; })) return;
+  for (auto& [key, v] : out.observables)
+    if (const auto s = options.size_shift.find(setup.id + "/" + key); s != options.size_shift.end()) v += s->second.shift;
+}
+
 /// Runs one job, or takes its outcome from the store; an exception becomes the outcome's error (a
 /// runner must not throw mid-batch: under MPI every rank has to reach the gather). Failed
 /// simulations are not stored: they run again.
@@ -52,6 +61,7 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
       if (std::optional<SimulatedOutcome> stored = load_simulation(options.store, job.setup->test, inputs)) {
         b.outcome = std::move(*stored);
         b.error = BatchOutcome::Error::none, b.stored = true;
+        shift_to_full_size(b.outcome, *job.setup, options);
         return b;
       }
     }
@@ -64,6 +74,7 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
         b.outcome.notes.push_back(fmt::format("not stored: {}", e.what()));  // the outcome itself stands
       }
     }
+    shift_to_full_size(b.outcome, *job.setup, options);
   } catch (const CaseError& e) {
     b.error = BatchOutcome::Error::input, b.message = e.what();
   } catch (const NumericalError& e) {

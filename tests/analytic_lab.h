@@ -67,6 +67,7 @@ inline void add(MeasurementSet& set, const std::string& id, const std::string& t
   Experiment e;
   e.id = id;
   e.setup.test = test;
+  e.setup.id = id;
   e.setup.numbers = std::move(numbers);
   e.observed[observable] = Observation{0.0, sigma, {}};
   set.experiments.push_back(e);
