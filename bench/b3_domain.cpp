@@ -1,6 +1,6 @@
 // Benchmark B3 "split box": benchmark B1 (b1_spec.h: the lattice settling in an open-top box,
 // then the dense bed) split into slabs over the ranks of `mpirun -np R` (domain decomposition,
-// app/mpi_domain.h), to measure what the decomposition costs and buys. Without mpirun it is one
+// app/mpi/mpi_domain.h), to measure what the decomposition costs and buys. Without mpirun it is one
 // process, the reference. Prints per phase: particle-steps/s of all ranks together, and rank 0's
 // communication time and volume per step (what the scaling model in the README is built from).
 //
@@ -25,9 +25,9 @@
 #include "base/allocator.h"
 #include "core/domain.h"
 #include "core/step.h"
-#include "mpi_campaign.h"
-#include "mpi_domain.h"
-#include "mpi_frames.h"
+#include "campaign/mpi_campaign.h"
+#include "mpi/mpi_domain.h"
+#include "mpi/mpi_frames.h"
 #include "output/results_hdf5.h"
 #include "output/run.h"
 #include "statistics/diagnostics.h"

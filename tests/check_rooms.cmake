@@ -1,22 +1,59 @@
-# The engine's rooms include one way: every file of src/ lies in a room (a folder of src/), names
-# each engine header with its room (#include "core/state.h"), and includes only from its own room
-# and from the rooms it may use. The table is the one in docs/contributing.md.
+# A part's rooms include one way: every source file of the part lies in a room (a folder of it),
+# names each header of the part with its room (#include "core/state.h"), and includes only from
+# its own room and from the rooms it may use. Three parts have rooms: the engine (src/), the
+# material library (materials/) and the command line (app/); the tables are the ones in docs/contributing.md.
 #
 #   cmake -DSOURCE_DIR=<repository>/src -P tests/check_rooms.cmake
+#   cmake -DSOURCE_DIR=<repository>/materials -DPART=materials -P tests/check_rooms.cmake
+#   cmake -DSOURCE_DIR=<repository>/app -DPART=app -P tests/check_rooms.cmake
 #
 # Fails naming every file and line that breaks the rule.
 cmake_minimum_required(VERSION 3.22)
 
-# Each room, lowest first, with the rooms it may include.
-set(allowed_base "")
-set(allowed_motion base)
-set(allowed_bodies base)
-set(allowed_contact base)
-set(allowed_case base motion contact)
-set(allowed_core base motion bodies contact case)
-set(allowed_statistics base motion bodies contact case core)
-set(allowed_output base motion bodies contact case core statistics)
-set(rooms base motion bodies contact case core statistics output)
+# The engine's rooms, lowest first, with the rooms each may include.
+set(engine_rooms base motion bodies contact case core statistics output)
+if(NOT PART OR PART STREQUAL "src")
+  set(part "the engine (src/)")
+  set(prefix "src")
+  set(allowed_base "")
+  set(allowed_motion base)
+  set(allowed_bodies base)
+  set(allowed_contact base)
+  set(allowed_case base motion contact)
+  set(allowed_core base motion bodies contact case)
+  set(allowed_statistics base motion bodies contact case core)
+  set(allowed_output base motion bodies contact case core statistics)
+  set(rooms ${engine_rooms})
+  set(outside "")          # rooms of other parts any room may include
+  set(outside_headers "")  # headers of other parts, named without a room
+elseif(PART STREQUAL "materials")
+  # The material library stands on the engine (any of its rooms) and the equipment generators.
+  set(part "the material library (materials/)")
+  set(prefix "materials")
+  set(allowed_model "")
+  set(allowed_lab model)
+  set(allowed_calibration model lab)
+  set(allowed_diagnosis model lab calibration)
+  set(rooms model lab calibration diagnosis)
+  set(outside ${engine_rooms})
+  set(outside_headers equipment.h)
+elseif(PART STREQUAL "app")
+  # The command line stands on everything below it: the engine, the material library, the
+  # renderer and the geometry and equipment libraries.
+  set(part "the command line (app/)")
+  set(prefix "app")
+  set(allowed_pages "")
+  set(allowed_report pages)
+  set(allowed_mpi "")
+  set(allowed_validation pages)
+  set(allowed_campaign pages report mpi)
+  set(allowed_cli pages report mpi validation campaign)
+  set(rooms pages report mpi validation campaign cli)
+  set(outside ${engine_rooms} model lab calibration diagnosis render)
+  set(outside_headers equipment.h mesh_health.h triangle_mesh.h)
+else()
+  message(FATAL_ERROR "PART=${PART}: valid: src, materials, app")
+endif()
 
 if(NOT SOURCE_DIR OR NOT IS_DIRECTORY "${SOURCE_DIR}")
   message(FATAL_ERROR "give -DSOURCE_DIR=<repository>/src")
@@ -32,7 +69,7 @@ foreach(source IN LISTS sources)
   string(REGEX REPLACE "/$" "" room "${room}")
   if(NOT room IN_LIST rooms)
     string(REPLACE ";" ", " room_list "${rooms}")
-    string(APPEND problems "src/${source}: lies in no room; move it into one of: ${room_list}\n")
+    string(APPEND problems "${prefix}/${source}: lies in no room; move it into one of: ${room_list}\n")
     continue()
   endif()
   # Lines as a list: characters that CMake's lists treat specially are masked first.
@@ -50,20 +87,26 @@ foreach(source IN LISTS sources)
     endif()
     set(target "${CMAKE_MATCH_1}")
     math(EXPR checked "${checked} + 1")
+    if(target IN_LIST outside_headers)
+      continue()
+    endif()
     if(NOT target MATCHES "^([^/]+)/")
-      string(APPEND problems "src/${source}:${number}: #include \"${target}\" names no room; write the header with its room (#include \"core/state.h\")\n")
+      string(APPEND problems "${prefix}/${source}:${number}: #include \"${target}\" names no room; write the header with its room (#include \"${room}/...\")\n")
       continue()
     endif()
     set(target_room "${CMAKE_MATCH_1}")
+    if(target_room IN_LIST outside)
+      continue()
+    endif()
     if(NOT target_room IN_LIST rooms)
-      string(APPEND problems "src/${source}:${number}: #include \"${target}\" is outside the engine's rooms (the engine includes nothing from the other folders)\n")
+      string(APPEND problems "${prefix}/${source}:${number}: #include \"${target}\" is outside the rooms of ${part}, which includes nothing from the other folders\n")
     elseif(NOT target_room STREQUAL room AND NOT target_room IN_LIST allowed_${room})
       set(may "${allowed_${room}}")
       if(may STREQUAL "")
         set(may "none")
       endif()
       string(REPLACE ";" ", " may "${may}")
-      string(APPEND problems "src/${source}:${number}: #include \"${target}\": room ${room} may not include from ${target_room} (it may include: ${may})\n")
+      string(APPEND problems "${prefix}/${source}:${number}: #include \"${target}\": room ${room} may not include from ${target_room} (it may include: ${may})\n")
     endif()
   endforeach()
 endforeach()
@@ -73,7 +116,7 @@ if(NOT problems STREQUAL "")
   string(REPLACE "<open>" "[" problems "${problems}")
   string(REPLACE "<close>" "]" problems "${problems}")
   string(REPLACE "<semicolon>" ";" problems "${problems}")
-  message(FATAL_ERROR "the engine's rooms must include one way (docs/contributing.md):\n${problems}")
+  message(FATAL_ERROR "the rooms of ${part} must include one way (docs/contributing.md):\n${problems}")
 endif()
 list(LENGTH sources files)
 message(STATUS "${files} files, ${checked} includes: every one goes one way")

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "mpi_campaign.h"
+#include "campaign/mpi_campaign.h"
 
 int main(int argc, char** argv) {
   dem::app::mpi::Session session(&argc, &argv);

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "calibrated_material.h"
+#include "calibration/calibrated_material.h"
 #include "case/calibration_record.h"
-#include "material_model.h"
+#include "model/material_model.h"
 
 namespace dem::materials {
 namespace {

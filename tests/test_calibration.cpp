@@ -13,10 +13,10 @@
 #include <tuple>
 
 #include "analytic_lab.h"
-#include "calibration.h"
-#include "calibration_support.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "calibration/calibration.h"
+#include "calibration/calibration_support.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 
 namespace dem::materials {
 namespace {

@@ -1,4 +1,4 @@
-// Campaigns over MPI ranks (app/mpi_campaign.h): the tiny sweep of tests/data/campaign_sweep.yaml
+// Campaigns over MPI ranks (app/campaign/mpi_campaign.h): the tiny sweep of tests/data/campaign_sweep.yaml
 // run by the real binary, once alone and once under `mpirun -np 2`. The variants' metrics.csv
 // and final state hashes must be bitwise equal, both ranks must have run variants, the variant
 // made to fail (a negative feed rate) must be reported in the sweep report while the others

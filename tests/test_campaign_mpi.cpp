@@ -1,4 +1,4 @@
-// Calibration batches over MPI ranks (app/mpi_campaign.h), run as `mpirun -np 2 campaign_mpi_tests`
+// Calibration batches over MPI ranks (app/campaign/mpi_campaign.h), run as `mpirun -np 2 campaign_mpi_tests`
 // (see tests/CMakeLists.txt). Each rank calibrates the same material against the same analytic
 // stand-in twice: alone (every simulation in this process) and with its simulations shared among
 // the ranks. The two must agree bitwise, each rank must have run only its share, a design point
@@ -10,10 +10,10 @@
 #include <random>
 #include <stdexcept>
 
-#include "calibration.h"
+#include "calibration/calibration.h"
 #include "case/spec.h"
-#include "material_model.h"
-#include "mpi_campaign.h"
+#include "model/material_model.h"
+#include "campaign/mpi_campaign.h"
 
 namespace {
 

@@ -8,11 +8,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calibration.h"
+#include "calibration/calibration.h"
 #include "case/spec.h"
 #include "contact/effect.h"
 #include "core/model.h"
-#include "material_model.h"
+#include "model/material_model.h"
 
 namespace dem::materials {
 namespace {

@@ -17,9 +17,9 @@
 #include <filesystem>
 #include <string>
 
-#include "calibration.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "calibration/calibration.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 
 namespace dem::materials {
 namespace {

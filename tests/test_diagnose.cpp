@@ -11,12 +11,12 @@
 #include <random>
 
 #include "analytic_lab.h"
-#include "calibration.h"
-#include "calibration_support.h"
-#include "calibration_report.h"
-#include "discrimination.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "calibration/calibration.h"
+#include "calibration/calibration_support.h"
+#include "report/calibration_report.h"
+#include "diagnosis/discrimination.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 
 namespace dem::materials {
 namespace {

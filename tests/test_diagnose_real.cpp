@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <random>
 
-#include "calibration.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "calibration/calibration.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 
 namespace dem::materials {
 namespace {

@@ -1,4 +1,4 @@
-// The periodic direct shear test (materials/lab_direct_shear.cpp): plate stresses against the
+// The periodic direct shear test (materials/lab/lab_direct_shear.cpp): plate stresses against the
 // contact stress tensor, a yield locus of a frictional material, and cohesion from liquid
 // bridges raising its intercept. Coarse particles (2 mm, soft), small cells, a fast plate with
 // the inertial number reported: each experiment takes seconds on one core.
@@ -9,8 +9,8 @@
 #include <map>
 #include <numbers>
 
-#include "lab_direct_shear.h"
-#include "material_model.h"
+#include "lab/lab_direct_shear.h"
+#include "model/material_model.h"
 
 namespace dem::materials {
 namespace {

@@ -1,4 +1,4 @@
-// Domain decomposition (src/core/domain.h, app/mpi_domain.h), run as
+// Domain decomposition (src/core/domain.h, app/mpi/mpi_domain.h), run as
 // `mpirun -np 2 domain_mpi_tests` and with 4 ranks (tests/CMakeLists.txt). Every rank runs each
 // case twice: whole, in this process alone, and split into boxes shared with the other ranks. Particles and momentum
 // must be conserved exactly (to rounding), and the decomposed runs must match the single-rank runs
@@ -25,9 +25,9 @@
 #include "core/particles.h"
 #include "core/step.h"
 #include "equipment.h"
-#include "mpi_campaign.h"
-#include "mpi_domain.h"
-#include "mpi_frames.h"
+#include "campaign/mpi_campaign.h"
+#include "mpi/mpi_domain.h"
+#include "mpi/mpi_frames.h"
 #include "output/results_hdf5.h"
 #include "output/run.h"
 #include "statistics/diagnostics.h"

@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "sim.h"
-#include "validation.h"
+#include "validation/validation.h"
 
 namespace dem::test {
 namespace {

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "sim.h"
-#include "validation.h"
+#include "validation/validation.h"
 
 namespace dem::test {
 namespace {
@@ -107,7 +107,7 @@ void expect_curve(std::span<const CurvePoint> paper, Model model, double point_t
   EXPECT_LE(error / size, 0.10);
 }
 
-// Test 6, beta against chi: aluminium alloy and nylon spheres (app/validation.cpp holds the curves).
+// Test 6, beta against chi: aluminium alloy and nylon spheres (app/validation/validation.cpp holds the curves).
 TEST(ChungOoi, Test6SpringCapReproducesThePublishedCurveOfAluminium) {
   // coulomb_cap: spring, sliding and sticking regimes up to chi = 5.75 (largest deviation 0.034,
   // at chi 2.5-3.0).

@@ -22,8 +22,8 @@
 #include "equipment.h"
 #include "output/run.h"
 #include "render/render.h"
-#include "report.h"
-#include "viewer3d.h"
+#include "report/report.h"
+#include "pages/viewer3d.h"
 
 extern "C" char** environ;
 

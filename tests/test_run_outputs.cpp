@@ -14,7 +14,7 @@
 #include "core/model.h"
 #include "core/particles.h"
 #include "output/run.h"
-#include "report.h"
+#include "report/report.h"
 
 namespace dem {
 namespace {

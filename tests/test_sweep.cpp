@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "case/spec.h"
-#include "sweep.h"
+#include "campaign/sweep.h"
 
 namespace dem::test {
 namespace {
@@ -91,7 +91,7 @@ TEST(Sweep, AGridTooLargeIsRefusedBeforeItIsBuilt) {
 #include <cstdlib>
 #include <filesystem>
 
-#include "video.h"
+#include "pages/video.h"
 
 namespace dem::test {
 namespace {

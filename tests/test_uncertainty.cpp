@@ -6,8 +6,8 @@
 #include <fstream>
 
 #include "case/spec.h"
-#include "sweep.h"
-#include "uncertainty.h"
+#include "campaign/sweep.h"
+#include "campaign/uncertainty.h"
 
 namespace dem::test {
 namespace {

@@ -1,4 +1,4 @@
-// The published benchmarks as `demdesign validate` runs them (app/validation.h): every point of
+// The published benchmarks as `demdesign validate` runs them (app/validation/validation.h): every point of
 // Chung & Ooi (2011) tests 1 to 8 inside its tolerance, and the one stated known difference (the
 // aluminium curve of test 6 beyond chi = 6.2) exactly where the docs say it is.
 #include <gtest/gtest.h>
@@ -6,7 +6,7 @@
 #include <set>
 #include <string>
 
-#include "validation.h"
+#include "validation/validation.h"
 
 namespace dem::test {
 namespace {

@@ -1,4 +1,4 @@
-// Virtual laboratory tests (materials/virtual_tests.h) against closed forms and published ranges:
+// Virtual laboratory tests (materials/lab/virtual_tests.h) against closed forms and published ranges:
 // restitution of a normal and an oblique drop, bulk density of poured spheres against random
 // loose/close packing, the lifted-cylinder angle of repose (no heap without rolling resistance,
 // a heap that steepens with it), the rotating drum's dynamic angle and wall slip, and hopper
@@ -16,12 +16,12 @@
 #include <numbers>
 #include <numeric>
 
-#include "calibration.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "calibration/calibration.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 #include "sim.h"
-#include "virtual_test_support.h"
-#include "virtual_tests.h"
+#include "lab/virtual_test_support.h"
+#include "lab/virtual_tests.h"
 
 namespace dem::materials {
 namespace {

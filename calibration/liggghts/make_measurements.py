@@ -6,7 +6,7 @@ of this folder (drop_rebound.in, bulk_density.in, angle_of_repose_cylinder.in, r
 hopper_discharge.in, direct_shear.in) runs with `liggghts -in X.in -var ...` in a temporary
 folder; the observables are extracted from its output with the extraction rules of demdesign's
 virtual tests (materials/lab_*.cpp), optionally perturbed by Gaussian noise of each sigma with a
-fixed seed, and written as a demdesign measurement file (the format materials/measurements.h reads)
+fixed seed, and written as a demdesign measurement file (the format materials/lab/measurements.h reads)
 whose first line says how the values were made.
 
     python3 make_measurements.py --material materials/control.json \\
@@ -128,7 +128,7 @@ class Material:
 
 
 # ---------------------------------------------------------------------------------------------
-# Meshes (ASCII STL), as demdesign's inline meshes (materials/virtual_test_support.cpp)
+# Meshes (ASCII STL), as demdesign's inline meshes (materials/lab/virtual_test_support.cpp)
 
 
 def segments_around(r, edge, lo=48, hi=256):

@@ -242,9 +242,9 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     w.keys_are_names("MESH");  // a mesh name, or `default`
     for (const std::string& key : w.keys()) spec.wear_coefficients[key] = w.number(key, 0.0, 0.0, 1e-6, "m^3/J");
   }
-  top.node("sweep");  // read by the sweep runner (app/sweep.cpp) before the variants are parsed
-  top.node("uncertainty");  // likewise (app/uncertainty.h)
-  top.node("bias_check");   // likewise (app/bias_check.h)
+  top.node("sweep");  // read by the sweep runner (app/campaign/sweep.cpp) before the variants are parsed
+  top.node("uncertainty");  // likewise (app/campaign/uncertainty.h)
+  top.node("bias_check");   // likewise (app/campaign/bias_check.h)
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;

@@ -327,7 +327,7 @@ using LibraryLookup = std::function<std::filesystem::path(const std::string& fil
 /// Where the case reader looks for library materials beyond the case's own folders (the case's
 /// folder, its materials/ and ../materials/, which it always searches first). The engine does
 /// not know where a material library lives: the material library sets this
-/// (dem::materials::use_material_library, materials/library.h). Process-wide; not thread-safe.
+/// (dem::materials::use_material_library, materials/model/library.h). Process-wide; not thread-safe.
 void set_library_lookup(LibraryLookup lookup);
 
 /// Reads and checks a case file. Throws CaseError naming file, line and key.

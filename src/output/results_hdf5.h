@@ -31,7 +31,7 @@ struct ParticleFrame {
 };
 
 /// How the ranks of a split run write one frame together into one file, each rank its own particles
-/// as one block of rows (app/mpi_frames.h makes it, with parallel HDF5's MPI-IO driver). The file
+/// as one block of rows (app/mpi/mpi_frames.h makes it, with parallel HDF5's MPI-IO driver). The file
 /// holds what one process writes, the rows in rank order; no rank gathers the particles.
 struct FrameShare {
   std::size_t offset = 0;   ///< this rank's first row

@@ -47,7 +47,7 @@ struct RunOptions {
   /// the results and returns with the whole final state, the others with their share.
   Domain* domain = nullptr;
   /// With a domain: where this rank's particles go in a frame every rank writes together
-  /// (FrameShare; app/mpi_frames.h). Empty: the root gathers the whole state for each frame.
+  /// (FrameShare; app/mpi/mpi_frames.h). Empty: the root gathers the whole state for each frame.
   /// The whole state is still gathered once at the end, and for a frame on_frame is called with.
   std::function<FrameShare(std::size_t owned)> share_frame;
 };

@@ -1,6 +1,6 @@
 #include "bad_input.h"
-#include "material_model.h"
-#include "measurements.h"
+#include "model/material_model.h"
+#include "lab/measurements.h"
 
 namespace dem::fuzz {
 

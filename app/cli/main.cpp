@@ -1,0 +1,515 @@
+// demdesign command line: the top of the dependency graph (app -> materials -> equipment -> src;
+// app -> geometry and app -> render, which stand alone on assimp/CGAL and OSMesa).
+//   demdesign CASE.yaml            run a case (same as `demdesign run CASE.yaml`)
+//   demdesign check CASE.yaml      read and compile a case, print its set-up, run nothing
+//   demdesign check-mesh FILE...   import, check and repair meshes, print their health reports
+//   demdesign render OUT           images of a run's saved frames
+//   demdesign effects              the table of contact effects and their parameters
+//   demdesign materials            the material library
+//   demdesign keys [--markdown]    every key of case, material and measurement files (docs/case-keys.md)
+//   demdesign test | compare | calibrate | diagnose   virtual lab tests and material calibration
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+#include "base/allocator.h"
+#include "cli/calibration_commands.h"
+#include "case/spec.h"
+#include "case/yaml_check.h"
+#include "cli/case_keys.h"
+#include "cli/cli_checks.h"
+#include "core/model.h"
+#include "core/particles.h"
+#include "equipment.h"
+#include "pages/flow_images.h"
+#include "model/library.h"
+#include "mesh_health.h"
+#include "campaign/mpi_campaign.h"
+#include "mpi/mpi_domain.h"
+#include "mpi/mpi_frames.h"
+#include "output/results_hdf5.h"
+#include "output/run.h"
+#include "report/report.h"
+#include "statistics/diagnostics.h"
+#include "campaign/sweep.h"
+#include "triangle_mesh.h"
+#include "pages/video.h"
+#include "validation/validation_report.h"
+
+namespace {
+
+struct RunArgs {
+  std::string case_path;
+  double duration = -1;
+  long long max_steps = -1;
+  int threads = 0;
+  std::string out;
+  bool quiet = false;
+  bool resume = false;
+  bool overwrite = false;  ///< replace the results of an earlier run in OUT (only the files runs wrote)
+  long variant = -1;  ///< run this variant of the case's sweep (the sweep runner's children)
+  std::string rank_grid;  ///< "NXxNYxNZ": the grid of boxes under mpirun (empty: chosen)
+  std::string balance = "work";  ///< under mpirun: what the cuts balance, work or time
+  bool report = true;
+  std::string command_line;  ///< as typed, for the run record
+};
+
+/// The case file as YAML, with file:line errors.
+YAML::Node load_case_yaml(const std::string& path, std::string* text_out = nullptr) {
+  std::ifstream in(path);
+  if (!in) throw dem::CaseError(fmt::format("{}: cannot open the case file", path));
+  std::stringstream text;
+  text << in.rdbuf();
+  if (text_out) *text_out = text.str();
+  return dem::parse_yaml(text.str(), path);
+}
+
+/// Reads a case with its equipment expanded: what every command compiles.
+dem::CaseSpec read_case(const std::string& path) {
+  dem::CaseSpec spec = dem::parse_case_file(path);
+  dem::equipment::expand_equipment(spec);
+  return spec;
+}
+
+/// Mesh files go through the geometry library: import, health check, safe repair. A mesh that
+/// cannot be simulated stops the run with its report.
+dem::TriangleSoup load_mesh(const dem::MeshWallSpec& spec, double particle_diameter) {
+  dem::geometry::ImportOptions options;
+  options.unit_scale = spec.unit_scale;
+  for (int a = 0; a < 3; ++a)
+    options.scale[a] = spec.scale[a], options.rotate_deg[a] = spec.rotate_deg[a], options.translate[a] = spec.translate[a];
+  dem::geometry::TriangleMesh mesh = dem::geometry::import_mesh(spec.file, options);
+  const dem::geometry::MeshReport report = dem::geometry::check_and_repair(mesh, particle_diameter);
+  if (!report.simulable())
+    throw dem::CaseError(fmt::format("{}: meshes '{}': the mesh cannot be simulated:\n{}", spec.location.str(), spec.name, report.text()));
+  for (const auto& issue : report.issues)
+    if (issue.severity != dem::geometry::MeshIssue::Severity::info)
+      std::cout << fmt::format("  mesh {}: {} ({})\n", spec.name, issue.what, issue.count);
+  return {std::move(mesh.vertices), std::move(mesh.triangles)};
+}
+
+dem::Model compile_case(const dem::CaseSpec& spec) {
+  double diameter = 0;
+  for (const auto& p : spec.particles) diameter = std::max(diameter, p.diameter.largest());
+  for (const auto& in : spec.inlets) diameter = std::max(diameter, in.diameter.largest());
+  return dem::compile(spec, [diameter](const dem::MeshWallSpec& m) { return load_mesh(m, diameter); });
+}
+
+dem::app::ImageOptions image_options(const dem::Model& model) {
+  return {model.output.render_camera, model.output.render_colour, model.output.render_width, model.output.render_height};
+}
+
+/// Per-triangle rate per area [W/m^2] of a wall record over the recording interval; NaN where a
+/// mesh has no records.
+std::vector<std::vector<double>> wall_rate(const dem::Model& model, const dem::State& state, bool impact, double seconds) {
+  std::vector<std::vector<double>> out(model.meshes.size());
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const dem::TriangleSurface& surface = *model.meshes[m].surface;
+    out[m].assign(surface.size(), std::numeric_limits<double>::quiet_NaN());
+    if (m >= state.records.size()) continue;
+    const std::vector<double>& work = impact ? state.records[m].impact_energy : state.records[m].shear_work;
+    for (size_t t = 0; t < surface.size() && t < work.size(); ++t) out[m][t] = work[t] / (seconds * surface.areas[t]);
+  }
+  return out;
+}
+
+/// The run's report folder: renders of the flow and of the wear fields on the walls, then the
+/// report itself (throughput, power, wear, belt loading at steady state).
+void write_run_report(const dem::Model& model, const dem::State& state, const dem::CaseSpec& spec, const dem::RunSummary& summary,
+                      const std::string& case_path, const std::string& case_text) {
+  const std::string out = summary.output_directory, report_dir = out + "/report";
+  std::filesystem::create_directories(report_dir);
+  dem::report::RunReportInput input;
+  input.model = &model, input.state = &state, input.scalars = summary.scalars, input.events = summary.events;
+  input.case_path = case_path, input.case_text = case_text, input.version = DEMDESIGN_VERSION;
+  input.wall_seconds = summary.wall_seconds;
+  input.stopped = summary.stopped;
+  input.records_from = model.output.records_from;
+  input.sensors = model.sensors, input.design = model.design;
+  for (const auto& mesh : spec.meshes) {
+    auto k = spec.wear_coefficients.find(mesh.name);
+    if (k == spec.wear_coefficients.end()) k = spec.wear_coefficients.find("default");
+    if (k != spec.wear_coefficients.end()) input.wear_coefficient[mesh.name] = k->second;
+  }
+  for (const auto& outlet : spec.outlets)
+    if (!outlet.spillage) input.outlet_intended.push_back(outlet.name);
+  const std::string flow = fmt::format("{}/renders/frame_{:06d}.png", out, state.step);
+  if (std::filesystem::exists(flow))
+    input.images.push_back({"Flow at the end of the run", flow,
+                            fmt::format("Particles coloured by {} at t = {:.2f} s; walls cut away where they face the camera.",
+                                        model.output.render_colour, state.time)});
+  const double seconds = state.time - model.output.records_from;
+  if (!model.meshes.empty() && seconds > 0) {
+    dem::app::ImageOptions wear_view = image_options(model);
+    wear_view.camera = "iso";
+    const std::string shear = report_dir + "/wear_shear_work.png", impact = report_dir + "/wear_impact_energy.png";
+    dem::app::render_wall_field(model, state, wall_rate(model, state, false, seconds), "shear work rate [W/m²]", wear_view, shear);
+    dem::app::render_wall_field(model, state, wall_rate(model, state, true, seconds), "impact energy rate [W/m²]", wear_view, impact);
+    input.images.push_back({"Abrasive wear: shear work rate", shear,
+                            fmt::format("Friction work per area and time on the walls (Archard wear input), averaged over t = {:.2f} to {:.2f} s.",
+                                        model.output.records_from, state.time)});
+    input.images.push_back({"Impact wear: impact energy rate", impact,
+                            fmt::format("Normal impact energy per area and time on the walls, t = {:.2f} to {:.2f} s.", model.output.records_from, state.time)});
+  }
+  const dem::report::RunMetrics metrics = dem::report::write_run_report(input, report_dir);
+  std::cout << fmt::format("  report: {}/report.html ({})\n", report_dir, metrics.steady_text);
+}
+
+/// `demdesign check CASE`: everything a run reads, without running. A case with a sweep (or a
+/// bias check, or an uncertainty study) has every variant read and its equipment generated; the
+/// first variant is compiled and its set-up printed, as a run prints it.
+int check_case(const std::string& path) {
+  const YAML::Node root = load_case_yaml(path);
+  const dem::app::SweepPlan plan = dem::app::read_sweep(root, path);
+  if (plan.variants.empty()) {
+    const dem::Model model = compile_case(read_case(path));
+    dem::print_setup(model, dem::initial_state(model), std::cout);
+    return 0;
+  }
+  dem::CaseSpec first;
+  for (size_t k = 0; k < plan.variants.size(); ++k) {
+    try {
+      dem::CaseSpec spec = dem::parse_case_node(dem::app::variant_case(root, plan, k), path);
+      dem::equipment::expand_equipment(spec);
+      if (k == 0) first = std::move(spec);
+    } catch (const dem::CaseError& e) {
+      throw dem::CaseError(fmt::format("sweep variant {} ({}): {}", plan.name(k), plan.label(k), e.what()));
+    }
+  }
+  std::cout << fmt::format("sweep: {} variants of {} key{}; every variant reads and its equipment is generated; the first, {} ({}):\n",
+                           plan.variants.size(), plan.paths.size(), plan.paths.size() == 1 ? "" : "s", plan.name(0), plan.label(0));
+  const dem::Model model = compile_case(first);
+  dem::print_setup(model, dem::initial_state(model), std::cout);
+  return 0;
+}
+
+int run_case(const RunArgs& args) {
+  std::string case_text;
+  YAML::Node root = load_case_yaml(args.case_path, &case_text);
+  const dem::app::SweepPlan plan = dem::app::read_sweep(root, args.case_path);
+  if (!plan.variants.empty() && args.variant < 0) {
+    dem::app::SweepOptions sweep;
+    sweep.case_path = args.case_path;
+    sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
+    sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
+    return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
+  }
+  if (args.variant >= 0) {
+    if (args.variant >= static_cast<long>(plan.variants.size()))
+      throw dem::CaseError(fmt::format("--variant {}: the case has {} sweep variants", args.variant, plan.variants.size()));
+    root = dem::app::variant_case(root, plan, static_cast<size_t>(args.variant));
+    case_text = fmt::format("# {} of {}: {}\n", plan.name(args.variant), args.case_path, plan.label(args.variant)) + YAML::Dump(root) + "\n";
+  }
+  // The record is the case as run: a duration given on the command line is written into it.
+  if (args.duration > 0) {
+    const std::string header = case_text.starts_with("# ") && args.variant >= 0 ? case_text.substr(0, case_text.find('\n') + 1) : "";
+    root["simulation"]["duration"] = args.duration;
+    case_text = header + fmt::format("# {} as run with --duration {:g}\n", args.case_path, args.duration) + YAML::Dump(root) + "\n";
+  }
+  dem::CaseSpec spec = dem::parse_case_node(root, args.case_path);
+  dem::equipment::expand_equipment(spec);
+  // The output folder before the case is compiled: refused when it holds another run's results
+  // (without --resume or --overwrite) or a file of the run's names that no run wrote, and locked
+  // while this run writes it (output/run_folder.h). What this program writes there after the run
+  // (the case as run, equipment meshes, renders, the report) is guarded as the run's own.
+  const std::vector<std::string> caller_outputs = {"case.yaml",           "meshes/*.stl",       "renders/frame_*.png",
+                                                   "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
+                                                   "report/*.csv",        "report/*.png",       "report/plots/*.png",
+                                                   "report/plots/*.gp",   "report/plots/*.tsv"};
+  std::shared_ptr<dem::RunFolder> folder;
+  if (dem::app::mpi::world().rank == 0) {
+    std::vector<std::string> names = dem::run_output_names();
+    names.insert(names.end(), caller_outputs.begin(), caller_outputs.end());
+    const dem::FolderUse use = args.resume ? dem::FolderUse::resume : args.overwrite ? dem::FolderUse::overwrite : dem::FolderUse::fresh;
+    folder = std::make_shared<dem::RunFolder>(!args.out.empty() ? args.out : spec.output.directory, use, names, std::cout);
+  }
+  const dem::Model model = compile_case(spec);
+  const int threads = args.threads > 0 ? args.threads : model.threads;
+  if (threads > 0) omp_set_num_threads(threads);
+  dem::State state = dem::initial_state(model);
+  dem::Workspace work;
+  // Under mpirun the case is split into a grid of boxes, one per rank (app/mpi/mpi_domain.h); rank 0 writes.
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  std::string domain_note;
+  std::array<int, 3> grid{0, 0, 0};
+  if (!args.rank_grid.empty()) {
+    char x1 = 0, x2 = 0;
+    std::istringstream in(args.rank_grid);
+    if (!(in >> grid[0] >> x1 >> grid[1] >> x2 >> grid[2]) || x1 != 'x' || x2 != 'x' || !in.eof() || grid[0] < 1 || grid[1] < 1 || grid[2] < 1)
+      throw dem::CaseError(fmt::format("--rank-grid '{}': expected three box counts as NXxNYxNZ, for example 2x2x1", args.rank_grid));
+  }
+  const dem::app::mpi::Balance balance = args.balance == "time" ? dem::app::mpi::Balance::time : dem::app::mpi::Balance::work;
+  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid, true, balance) : nullptr;
+  if (world.active() && !domain && grid[0] > 0 && world.size > 1) throw dem::CaseError(fmt::format("--rank-grid {}: {}", args.rank_grid, domain_note));
+  if (world.active() && !domain) {  // cannot be split: rank 0 runs it alone, the others wait
+    if (world.rank != 0) return 0;
+    std::cout << fmt::format("note: {} MPI ranks, but this case runs on rank 0 alone: {}\n", world.size, domain_note);
+  }
+  if (domain && threads <= 0) omp_set_num_threads(dem::app::mpi::cores_per_rank());  // the ranks share the machine's cores
+  if (domain && world.rank == 0)
+    std::cout << fmt::format("domain decomposition: {}, {} OpenMP threads per rank\n", domain_note, omp_get_max_threads());
+  std::ostringstream quiet;  // the other ranks' log
+  std::ostream& log = world.rank == 0 ? std::cout : quiet;
+  dem::RunOptions options;
+  options.domain = domain.get();
+  options.duration = args.duration;
+  options.max_steps = args.max_steps;
+  options.output_directory = args.out;
+  options.progress = !args.quiet;
+  options.resume = args.resume;
+  options.overwrite = args.overwrite;
+  options.caller_outputs = caller_outputs;
+  options.folder = folder;
+  options.command_line = args.command_line;
+  // A split run's ranks write each frame together, with no gather (parallel HDF5).
+  if (domain) options.share_frame = dem::app::mpi::collective_frames();
+  // Images of the flow: every render_every-th frame, and always the last (run.h).
+  options.on_frame = [&](const dem::Model& m, const dem::State& s, const dem::Workspace&, const std::string& out, bool last) {
+    const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, s.step);
+    std::filesystem::create_directories(out + "/renders");
+    dem::app::render_state(m, s, image_options(m), path);
+    if (last) std::cout << fmt::format("  rendered {}\n", path);
+  };
+  dem::RunSummary summary;
+  try {
+    summary = dem::run(model, state, work, options, log);
+  } catch (const dem::RunStopped& stopped) {
+    // Numerical trouble stopped the run: its report shows what it computed up to then, under a
+    // banner that says why (a split run's state is not gathered then: no report).
+    if (world.rank == 0 && args.report && !domain && !stopped.summary.scalars.empty()) {
+      try {
+        write_run_report(model, state, spec, stopped.summary, args.case_path, case_text);
+      } catch (const std::exception& e) {
+        std::cout << fmt::format("  no report of the stopped run: {}\n", e.what());
+      }
+    }
+    throw;
+  }
+  if (world.rank != 0 || summary.already_complete) return 0;
+  const std::string out = summary.output_directory;
+  dem::write_file_atomically(out + "/case.yaml", case_text);
+  if (spec.equipment) {
+    const auto files = dem::equipment::write_equipment_meshes(spec, out + "/meshes");
+    std::cout << fmt::format("  wrote {} equipment meshes (STL) to {}/meshes\n", files.size(), out);
+  }
+  if (args.report) write_run_report(model, state, spec, summary, args.case_path, case_text);
+  return 0;
+}
+
+/// Renders saved frames of a finished (or running) run: the case comes from run_info.yaml.
+int render_results(const std::string& out, const std::string& which, const dem::app::ImageOptions& given, bool video) {
+  std::ifstream info(out + "/run_info.yaml");
+  if (!info) throw dem::CaseError(fmt::format("{}/run_info.yaml: not a demdesign output folder (give the --out folder of a run)", out));
+  std::string line, case_path;
+  while (std::getline(info, line))
+    if (line.rfind("case: ", 0) == 0) case_path = line.substr(6);
+  // The case as it ran (a sweep variant has its values set in OUT/case.yaml); relative paths in it
+  // resolve against the original case file.
+  dem::CaseSpec spec;
+  if (std::filesystem::exists(out + "/case.yaml")) {
+    spec = dem::parse_case_node(load_case_yaml(out + "/case.yaml"), case_path);
+    dem::equipment::expand_equipment(spec);
+  } else {
+    spec = read_case(case_path);
+  }
+  const dem::Model model = compile_case(spec);
+  dem::FrameWriter frames(out, {}, {});
+  frames.adopt_existing();
+  if (frames.frames().empty()) throw std::runtime_error(fmt::format("{}: no frames listed in particles.xdmf", out));
+  std::vector<dem::FrameInfo> chosen;
+  if (which == "all") chosen = frames.frames();
+  else if (which == "last") chosen = {frames.frames().back()};
+  else {
+    const long index = std::stol(which);
+    if (index < 0 || index >= static_cast<long>(frames.frames().size()))
+      throw std::runtime_error(fmt::format("--frame {}: the run has frames 0 to {}", which, frames.frames().size() - 1));
+    chosen = {frames.frames()[index]};
+  }
+  std::filesystem::create_directories(out + "/renders");
+  for (const dem::FrameInfo& info_frame : chosen) {
+    const dem::StoredFrame f = dem::read_frame(out + "/" + info_frame.file);
+    dem::State s = dem::initial_state(model);  // walls where they start
+    s.time = f.time, s.step = f.step;
+    s.x.resize(f.size()), s.y.resize(f.size()), s.z.resize(f.size());
+    s.vx.resize(f.size()), s.vy.resize(f.size()), s.vz.resize(f.size());
+    s.radius = f.radius, s.material = f.material;
+    for (size_t p = 0; p < f.size(); ++p) {
+      s.x[p] = f.position[3 * p], s.y[p] = f.position[3 * p + 1], s.z[p] = f.position[3 * p + 2];
+      s.vx[p] = f.velocity[3 * p], s.vy[p] = f.velocity[3 * p + 1], s.vz[p] = f.velocity[3 * p + 2];
+    }
+    const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, f.step);
+    dem::app::render_state(model, s, given, path);
+    std::cout << fmt::format("rendered {}\n", path);
+  }
+  if (video) {
+    std::string message;
+    const std::string movie = out + "/renders/flow.mp4";
+    if (dem::app::make_video(out + "/renders", "frame_", movie, 10.0, &message)) std::cout << fmt::format("video {}\n", movie);
+    else std::cout << message << "\n";
+  }
+  return 0;
+}
+
+/// The exit status of an error. Under MPI the error may be this rank's alone, and the others
+/// would wait for it forever: every rank stops.
+int stop_with(int code) {
+  std::cerr << std::flush;
+  dem::app::mpi::abort(code);
+  return code;
+}
+
+std::string rank_prefix() {
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  return world.active() ? fmt::format("rank {}: ", world.rank) : "";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  dem::tune_allocator();
+  dem::materials::use_material_library();  // cases find `library:` materials outside their own folders
+  // MPI only when mpirun (or another MPI launcher) started this process; see app/campaign/mpi_campaign.h.
+  dem::app::mpi::Session mpi_session(&argc, &argv);
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  CLI::App app{"demdesign: DEM simulation for the design of bulk-materials-handling equipment"};
+  app.require_subcommand(0, 1);
+  RunArgs args;
+  auto add_run_options = [&](CLI::App* cmd) {
+    cmd->add_option("--duration", args.duration, "simulated time [s], overrides the case")->check(dem::app::number_in(0, 1e6, "s", true));
+    cmd->add_option("--max-steps", args.max_steps, "stop after this many steps (shortened run)")->check(dem::app::whole_in(1, 1e15));
+    cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)")->check(dem::app::whole_in(1, 1024));
+    cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
+    cmd->add_flag("--quiet", args.quiet, "no progress lines");
+    cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
+    cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
+    cmd->add_option("--rank-grid", args.rank_grid, "under mpirun: the grid of boxes, NXxNYxNZ (default: chosen from the domain's shape)");
+    cmd->add_option("--balance", args.balance,
+                    "under mpirun: what the cuts balance: work (particles and contacts, reproducible) or time (each rank's measured computing time)")
+        ->check(CLI::IsMember({"work", "time"}));
+    CLI::Option* resume = cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
+    cmd->add_flag("--overwrite", args.overwrite,
+                  "replace the results of an earlier run in OUT: removes the files runs wrote there (run_files.txt), nothing else")
+        ->excludes(resume);
+  };
+  app.add_option("case", args.case_path, "case file (YAML) to run");
+  add_run_options(&app);
+  CLI::App* run_cmd = app.add_subcommand("run", "run a case");
+  run_cmd->add_option("case", args.case_path, "case file (YAML)")->required();
+  add_run_options(run_cmd);
+  std::string check_path;
+  CLI::App* check_cmd = app.add_subcommand("check", "read and compile a case and print its set-up");
+  check_cmd->add_option("case", check_path, "case file (YAML)")->required();
+  std::vector<std::string> mesh_files;
+  dem::geometry::ImportOptions mesh_options;
+  double mesh_particle_diameter = 0;
+  CLI::App* mesh_cmd = app.add_subcommand("check-mesh", "import meshes (STL, OBJ, PLY, glTF, 3MF, ...), check and repair them");
+  mesh_cmd->add_option("files", mesh_files, "mesh files")->required();
+  mesh_cmd->add_option("--unit-scale", mesh_options.unit_scale, "file units to metres (0.001 for millimetres)");
+  mesh_cmd->add_option("--particle-diameter", mesh_particle_diameter, "[m] enables the triangle size checks");
+  std::string render_out, render_frame = "last";
+  dem::app::ImageOptions render_options;
+  CLI::App* render_cmd = app.add_subcommand("render", "render saved frames of a run to PNG (headless)");
+  render_cmd->add_option("results", render_out, "output folder of a run")->required();
+  render_cmd->add_option("--frame", render_frame, "frame index, last or all")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return text == "last" || text == "all" || dem::app::whole_in(0, 1e9)(text).empty()
+                       ? std::string()
+                       : fmt::format("'{}' is not a frame; valid: a frame index (0, 1, ...), last or all", text);
+          },
+          "INDEX|last|all"));
+  render_cmd->add_option("--color-by", render_options.colour, "speed, radius or material")
+      ->check(CLI::IsMember({"speed", "radius", "material"}));
+  render_cmd->add_option("--camera", render_options.camera, "side, front, top or iso")
+      ->check(CLI::IsMember({"side", "front", "top", "iso"}));
+  bool render_video = false;
+  render_cmd->add_flag("--video", render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
+  render_cmd->add_option("--width", render_options.width, "[px]")->check(dem::app::whole_in(16, 8192));
+  render_cmd->add_option("--height", render_options.height, "[px]")->check(dem::app::whole_in(16, 8192));
+  CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
+  CLI::App* materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
+  bool keys_markdown = false;
+  std::string keys_source = dem::app::default_source_dir();
+  CLI::App* keys_cmd = app.add_subcommand("keys", "every key of case, material and measurement files, read from the "
+                                                  "readers themselves (docs/case-keys.md is its --markdown output)");
+  keys_cmd->add_flag("--markdown", keys_markdown, "Markdown tables, as in docs/case-keys.md");
+  keys_cmd->add_option("--source", keys_source, "source tree whose shipped files are read (default: the one built from)");
+
+  std::string validate_out = "out/validation", validate_source = dem::app::default_source_dir();
+  CLI::App* validate_cmd = app.add_subcommand("validate", "run the published benchmarks (Chung & Ooi 2011 tests 1-8) and write a "
+                                                          "validation page with tables and plots");
+  validate_cmd->add_option("--out", validate_out, "output folder (validation.html, validation.md, validation.csv, plots/)");
+  validate_cmd->add_option("--source", validate_source, "source tree whose cases/ are run (default: the one built from)");
+
+  // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
+  dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
+    dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
+  });
+
+  // A first word that is neither an option, a command nor a file is most likely a misspelt
+  // command (CLI11 would take it for the case file and then complain about the next word).
+  if (argc > 1 && argv[1][0] != '-' && !std::filesystem::exists(argv[1])) {
+    std::vector<std::string> commands;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) commands.push_back(sub->get_name());
+    if (std::find(commands.begin(), commands.end(), argv[1]) == commands.end()) {
+      const std::string hint = dem::nearest_word(argv[1], commands);
+      std::cerr << fmt::format("error: '{}' is neither a command{} nor a case file; commands: {} (or give a case file to run)\n", argv[1],
+                               hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), fmt::join(commands, ", "));
+      return 2;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end with 0; a bad command line with 2, as every other bad input.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  for (int k = 0; k < argc; ++k) args.command_line += (k ? " " : "") + std::string(argv[k]);
+  try {
+    if (calibration.parsed()) return calibration.run();  // compare, calibrate, diagnose: every rank; test: rank 0
+    // Commands that are not campaigns run on rank 0; a case decides in run_case (a sweep uses every rank).
+    if (world.active() && world.rank != 0 && args.case_path.empty()) return 0;
+    if (effects_cmd->parsed()) {
+      std::cout << dem::describe_effects();
+      return 0;
+    }
+    if (materials_cmd->parsed()) {
+      std::cout << fmt::format("material library: {}\n", dem::materials::library_folder());
+      for (const auto& m : dem::materials::list_library())
+        std::cout << fmt::format("  {:<20} {}\n", m.name, m.description);
+      std::cout << "use in a case: materials: {NAME: {library: FILE_STEM}}\n";
+      return 0;
+    }
+    if (keys_cmd->parsed()) {
+      std::cout << dem::app::case_key_reference(keys_source, keys_markdown);
+      return 0;
+    }
+    if (validate_cmd->parsed()) return dem::app::validate_command(validate_source, validate_out, std::cout);
+    if (check_cmd->parsed()) return check_case(check_path);
+    if (mesh_cmd->parsed()) return dem::geometry::check_mesh_command(mesh_files, mesh_options, mesh_particle_diameter, std::cout);
+    if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options, render_video);
+    if (args.case_path.empty()) {
+      std::cout << app.help();
+      return 2;
+    }
+    return run_case(args);
+  } catch (const dem::CaseError& e) {
+    std::cerr << rank_prefix() << "error: " << e.what() << "\n";
+    return stop_with(2);
+  } catch (const dem::NumericalError& e) {
+    std::cerr << rank_prefix() << "numerical trouble: " << e.what() << "\n";
+    return stop_with(3);
+  } catch (const std::exception& e) {
+    std::cerr << rank_prefix() << "error: " << e.what() << "\n";
+    return stop_with(1);
+  }
+}

@@ -1,0 +1,196 @@
+#include "pages/flow_images.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <limits>
+
+#include "render/render.h"
+
+namespace dem::app {
+
+std::string default_camera(const Model& model);
+
+namespace {
+
+/// The case's explicit camera when it gives one (and the command line names no preset), else the
+/// preset fitted to the box.
+render::Camera camera_for(const Model& model, const ImageOptions& options, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                          double aspect) {
+  const OutputSpec& o = model.output;
+  if (o.has_camera_pose && options.camera.empty()) {
+    render::Camera c;
+    c.eye = o.camera_eye, c.target = o.camera_target, c.up = o.camera_up, c.fov_deg = o.camera_fov_deg;
+    return c;
+  }
+  return render::fit_camera(lo, hi, options.camera.empty() ? default_camera(model) : options.camera, aspect);
+}
+
+}  // namespace
+
+void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  // Particles and the field they are coloured by.
+  std::vector<float> value(s.size());
+  for (size_t p = 0; p < s.size(); ++p) {
+    if (options.colour == "radius") value[p] = static_cast<float>(2000.0 * s.radius[p]);
+    else if (options.colour == "material") value[p] = static_cast<float>(s.material[p]);
+    else value[p] = static_cast<float>(std::sqrt(s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]));
+  }
+  render::ParticleLayer particles;
+  particles.x = s.x, particles.y = s.y, particles.z = s.z, particles.radius = s.radius, particles.value = value;
+  frame.particles.push_back(particles);
+  render::ColourMap colours;
+  colours.label = options.colour == "radius" ? "diameter [mm]" : options.colour == "material" ? "material" : "speed [m/s]";
+  if (options.colour == "speed") colours.min = 0.0;
+  frame.particle_colours = colours;
+
+  // Bounding box of what matters: particles and meshes.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (size_t p = 0; p < s.size(); ++p) {
+    const Eigen::Vector3d c(s.x[p], s.y[p], s.z[p]);
+    lo = lo.cwiseMin(c - Eigen::Vector3d::Constant(s.radius[p])), hi = hi.cwiseMax(c + Eigen::Vector3d::Constant(s.radius[p]));
+  }
+  // Meshes at their pose now.
+  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const Pose pose = model.meshes[m].motion.pose(s.time);
+    for (const auto& v : model.meshes[m].surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      placed[m].push_back({w.x(), w.y(), w.z()});
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+  }
+  if (!std::isfinite(lo.x())) lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Constant(0.1);
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    render::MeshLayer layer;
+    layer.vertices = placed[m];
+    layer.triangles = model.meshes[m].surface->triangles;
+    layer.cutaway = true;
+    layer.opacity = 0.45f;
+    frame.meshes.push_back(layer);
+  }
+  // Planes as squares around the particles' extent (an infinite plane cannot be drawn).
+  std::vector<std::vector<std::array<double, 3>>> plane_vertices;
+  std::vector<std::array<std::int32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
+  // Round walls as triangles: the rings of vertices and the triangles between them.
+  std::vector<std::vector<std::array<double, 3>>> round_vertices;
+  std::vector<std::array<std::int32_t, 3>> round_triangles;
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double half = 0.6 * (hi - lo).maxCoeff() + 1e-3;
+  for (size_t w = 0; w < model.planes.size(); ++w) {
+    const PlaneWall& wall = model.planes[w];
+    const Eigen::Vector3d n(wall.normal[0], wall.normal[1], wall.normal[2]);
+    const Eigen::Vector3d at(s.walls.px[w], s.walls.py[w], s.walls.pz[w]);
+    if (wall.shape != PlaneWall::Shape::plane) {
+      // A cylinder over the particles' extent along its axis (an infinite one cannot be drawn);
+      // a tube over its length; a disc as its ring.
+      const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+      const int around = 96;
+      double from = 0, to = wall.length;
+      if (wall.shape == PlaneWall::Shape::cylinder) {
+        const double a0 = (lo - at).dot(n), a1 = (hi - at).dot(n);
+        from = std::min(a0, a1) - 0.1 * wall.radius, to = std::max(a0, a1) + 0.1 * wall.radius;
+      }
+      std::vector<std::array<double, 3>> ring;
+      for (int k = 0; k < around; ++k) {
+        const double angle = 2 * std::numbers::pi * k / around;
+        const Eigen::Vector3d radial = std::cos(angle) * u + std::sin(angle) * v;
+        const bool disc = wall.shape == PlaneWall::Shape::disc;
+        for (int end = 0; end < 2; ++end) {
+          const Eigen::Vector3d c = disc ? Eigen::Vector3d(at + (end ? wall.radius : wall.hole) * radial)
+                                         : Eigen::Vector3d(at + (end ? to : from) * n + wall.radius * radial);
+          ring.push_back({c.x(), c.y(), c.z()});
+        }
+      }
+      if (round_triangles.empty())
+        for (std::int32_t k = 0; k < around; ++k) {
+          const std::int32_t a = 2 * k, b = 2 * ((k + 1) % around);
+          round_triangles.push_back({a, b, a + 1}), round_triangles.push_back({b, b + 1, a + 1});
+        }
+      round_vertices.push_back(std::move(ring));
+      continue;
+    }
+    const Eigen::Vector3d foot = centre - (centre - at).dot(n) * n;
+    const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+    std::vector<std::array<double, 3>> corners;
+    for (auto [a, b] : {std::pair{-1, -1}, std::pair{1, -1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+      const Eigen::Vector3d c = foot + half * (a * u + b * v);
+      corners.push_back({c.x(), c.y(), c.z()});
+    }
+    plane_vertices.push_back(corners);
+  }
+  // Exact walls drawn as translucent, cut-away layers.
+  const auto add_wall = [&](const auto& vertices, const auto& triangles) {
+    render::MeshLayer layer;
+    layer.vertices = vertices;
+    layer.triangles = triangles;
+    layer.cutaway = true;
+    layer.opacity = 0.35f;
+    frame.meshes.push_back(std::move(layer));
+  };
+  for (const auto& ring : round_vertices) add_wall(ring, round_triangles);
+  for (const auto& corners : plane_vertices) add_wall(corners, quad);
+  frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
+  frame.caption = fmt::format("{}   t = {:.3f} s   {} particles", model.title.empty() ? model.source : model.title, s.time, s.size());
+  render::render_png(frame, path);
+}
+
+}  // namespace dem::app
+
+namespace dem::app {
+
+std::string default_camera(const Model& model) {
+  if (!model.output.render_camera.empty()) return model.output.render_camera;
+  return model.equipment_camera.empty() ? "iso" : model.equipment_camera;
+}
+
+void render_wall_field(const Model& model, const State& s, const std::vector<std::vector<double>>& field,
+                       const std::string& label, const ImageOptions& options, const std::string& path) {
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
+  std::vector<std::vector<float>> values(model.meshes.size());
+  std::vector<double> all;
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const Pose pose = model.meshes[m].motion.pose(s.time);
+    for (const auto& v : model.meshes[m].surface->vertices) {
+      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+      placed[m].push_back({w.x(), w.y(), w.z()});
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+    for (double v : field[m]) {
+      values[m].push_back(static_cast<float>(v));
+      if (std::isfinite(v)) all.push_back(v);
+    }
+  }
+  if (!std::isfinite(lo.x())) return;
+  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
+  if (!all.empty()) {
+    std::sort(all.begin(), all.end());
+    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
+  }
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    render::MeshLayer layer;
+    layer.vertices = placed[m];
+    layer.triangles = model.meshes[m].surface->triangles;
+    layer.triangle_value = values[m];
+    // Walls that carry little of the field (side plates, skirts) are drawn faint and cut away
+    // where they face the camera, so they do not hide the hot spots behind them.
+    float highest = 0;
+    for (float v : values[m])
+      if (std::isfinite(v)) highest = std::max(highest, v);
+    if (highest < 0.35 * colours.max) layer.opacity = 0.25f, layer.cutaway = true;
+    frame.meshes.push_back(layer);
+  }
+  frame.mesh_colours = colours;
+  frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
+  frame.caption = fmt::format("{}   {}", model.title.empty() ? model.source : model.title, label);
+  render::render_png(frame, path);
+}
+
+}  // namespace dem::app
