@@ -11,9 +11,8 @@ namespace dem {
 /// above a threshold from its own mapping, returned on free; but the threshold follows the
 /// largest block freed so far (up to 32 MiB), after which a rebuild's buffers come from the heap
 /// and the holes they leave stay resident. Fixing the threshold at 256 KiB (glibc's initial
-/// value) lowered the peak of the 100,000-sphere settling bed from 792 to 691 bytes per particle
-/// (bench/b1_settle, 10,000 steps, same results); its speed moved within the noise (2.87e7 and
-/// 2.78e7 particle-steps/s, runs differ by 5 %).
+/// value) lowered the peak memory of the settling bed with the same results, and its speed moved
+/// within the noise (bench/results/design_measurements.csv).
 /// Call once at the start of main(), before the engine allocates. Does nothing where the C
 /// library is not glibc. Returns whether the setting took.
 bool tune_allocator();

@@ -42,12 +42,12 @@ namespace dem {
 /// Builds a list in rows (CSR: row r's entries are out[begin[r]] .. out[begin[r + 1] - 1]) in
 /// one pass over the rows: they are cut into pieces, 8 per thread, which the threads take in
 /// turn as they become free (the entries per row vary: a sphere by a wall has many candidate
-/// triangles, one in free flight none; with one piece per thread, B2's threads waited for each
-/// other 4 % of the time). Each piece's rows are appended to a buffer of its own (fill(r,
-/// buffer, m) appends row r's entries from index m on, growing the buffer as needed, and returns
-/// the new end), then the buffers are copied into place. Rows come out in order whatever the
-/// thread count. The buffers are kept between calls, so a rebuild allocates nothing once they
-/// have grown.
+/// triangles, one in free flight none; with one piece per thread, the chute's threads waited for
+/// each other: bench/results/design_measurements.csv). Each piece's rows are appended to a
+/// buffer of its own (fill(r, buffer, m) appends row r's entries from index m on, growing the
+/// buffer as needed, and returns the new end), then the buffers are copied into place. Rows come
+/// out in order whatever the thread count. The buffers are kept between calls, so a rebuild
+/// allocates nothing once they have grown.
 template <typename T, typename Fill>
 void fill_rows(long rows, bool parallel, std::vector<std::vector<T>>& buffers, std::vector<std::int32_t>& begin,
                std::vector<T>& out, Fill&& fill) {

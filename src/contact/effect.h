@@ -68,8 +68,8 @@ struct HistorySpec {
 };
 
 /// Contacts evaluated together. Columns, so kernels stream through them; 128 contacts (about 45
-/// doubles a contact, 46 KiB: L1's size on Zen 5) against 64: B1 20k dense bed +4.7 %, settle
-/// +1 %; 256 as fast as 128, 32 7 % slower (A/B, medians of 6).
+/// doubles a contact, 46 KiB: L1's size on Zen 5) rather than 64: measured faster on the dense
+/// bed and the settle; 256 was no faster, 32 slower (bench/results/design_measurements.csv).
 inline constexpr int kBatch = 128;
 /// Most doubles of history one contact can carry (all effects of a case together; compile checks).
 inline constexpr int kHistoryMax = 8;

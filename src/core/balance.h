@@ -10,8 +10,9 @@
 // made in an order fixed by the data (forces.cpp), so the results are bitwise the same.
 // Rejected: OpenMP's dynamic schedule over the blocks (what the contact pass did first): the
 // blocks of one half ran on whichever thread was free, so their spheres moved between the
-// cores' caches every step, and the two halves needed a barrier each. The runs measured
-// against it, B1 20k on 2 threads: +20-25 % settle and dense bed.
+// cores' caches every step, and the two halves needed a barrier each. Measured against it,
+// blocks kept by their thread ran faster on the settle and the dense bed
+// (bench/results/design_measurements.csv).
 #pragma once
 
 #include <omp.h>

@@ -53,8 +53,9 @@ Grid make_grid(const Model& model, const State& s, double cell, const std::uint8
   }
   // Cap the number of cells at 4 per particle, or 2^19 (2 MiB of cell starts) if more: a few
   // particles flung far away must not make the grid huge, while a thin stream in a large box
-  // (a chute) keeps cells one reach wide. Larger cells stay correct, only slower (B2: cells
-  // 1.6 reaches wide under a cap of 4 per particle, 4 times the candidates to measure).
+  // (a chute) keeps cells one reach wide. Larger cells stay correct, only slower: a cap of 4 per
+  // particle alone widened the chute's cells and multiplied the candidates to measure
+  // (bench/results/design_measurements.csv).
   // Periodic axes keep whole periods.
   const double cap = std::max(4.0 * static_cast<double>(s.size()) + 64.0, 524288.0);
   for (;;) {

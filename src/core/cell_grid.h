@@ -52,8 +52,8 @@ Grid make_grid(const Model& model, const State& s, double cell, const std::uint8
 /// entries, the last unused). Each cell's count is kept one place further up than its start,
 /// so the scatter, which advances cell_start[c + 1] as cell c's cursor, leaves every start in
 /// place: no pass over the cells afterwards to shift them back. The passes over the cells are
-/// shared by the threads when there are many (B2: half a million cells for 18,000 spheres, so
-/// the cells, not the spheres, made most of the sort's time).
+/// shared by the threads when there are many (in a thin stream through a large box the cells,
+/// not the spheres, made most of the sort's time: bench/results/design_measurements.csv).
 void sort_by_cell(const std::vector<std::int32_t>& cell_of, size_t n, int n_cells, std::vector<std::int32_t>& cell_start,
                   std::vector<std::int32_t>& out);
 

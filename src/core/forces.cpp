@@ -9,23 +9,25 @@
 // schedule. Rejected alternatives: atomics or thread-private force arrays (the summation order,
 // and so the last bits of every trajectory, would depend on the number of threads); a buffer slot
 // per contact summed afterwards (what this engine did first: 48 bytes more per pair each step,
-// 1.3x slower on B1).
+// and slower; bench/results/design_measurements.csv).
 //
 // Sum per particle: particle pairs and plane walls as above, then meshes, then gravity. The
 // closing half kick of the step runs in the pass that adds gravity. Within step() the sums start
-// from the zeros the kick-drift pass left (Workspace::loads_cleared; 1M spheres in free fall
-// +10-15 %: one pass over six columns less).
+// from the zeros the kick-drift pass left (Workspace::loads_cleared: one pass over six columns
+// less, faster for spheres in free fall; bench/results/design_measurements.csv).
 //
-// A contact passes three stages (measured with perf on B1; each change kept the results
-// bitwise the same, except the one-division pair geometry, which changed the last bits):
+// A contact passes three stages (measured with perf on B1, the gains of each choice in
+// bench/results/design_measurements.csv; each change kept the results bitwise the same, except
+// the one-division pair geometry, which changed the last bits):
 //   1. the list scan (list_contacts): distance of every pair read, from the x, y, z and
-//      radius columns (a copy of the four side by side, one cache line per partner, was 5 %
-//      faster while the contact pass was slower; later its pass cost more than it saved: B1 and
-//      B2 +3 % without it). Every pair is written to the next batch entry and kept by advancing
-//      the count, with no branch on whether it touches: for the pairs of the skin that is a coin
-//      toss the branch predictor loses (+4 %). Most steps read only the near pairs (gap under a
-//      margin of 0.05-0.5 skin at the last full scan, adapted below; Workspace::NearPairs): B1
-//      dense +15-25 %, settle +8-10 %, B2 +2-3 % (its spheres cross the margin in a few steps);
+//      radius columns (a copy of the four side by side, one cache line per partner, sped the
+//      scan while the contact pass was slower; later its pass cost more than it saved, and B1
+//      and B2 ran faster without it). Every pair is written to the next batch entry and kept by
+//      advancing the count, with no branch on whether it touches: for the pairs of the skin
+//      that is a coin toss the branch predictor loses. Most steps read only the near pairs (gap
+//      under a margin of 0.05-0.5 skin at the last full scan, adapted below;
+//      Workspace::NearPairs): much faster on B1's dense bed and settle, a little on B2 (its
+//      spheres cross the margin in a few steps);
 //   2. pair_geometry over the whole batch, vectorised (normal, overlap, relative motion, reduced
 //      radius, mass and inertia: the square roots and divisions of a contact);
 //   3. the effects' kernels over the batch columns (vectorised, effect.h), then the loads worked
@@ -77,8 +79,8 @@ struct Batch {
 /// distances the list pass found: normal, overlap, levers, relative motion, effective radius,
 /// mass and inertia. Gathers the bodies' columns by slot; vectorised (DEM_KERNEL below).
 /// kSpin: also the relative spin and the reduced moment of inertia, which only some effects
-/// read (EffectSpec::reads_spin; without: two gathers and four stores a contact less, B1 20k
-/// +5.7 % settle, +9.5 % dense).
+/// read (EffectSpec::reads_spin; without: two gathers and four stores a contact less, faster on
+/// the settle and more on the dense bed; bench/results/design_measurements.csv).
 template <bool kSpin>
 [[gnu::always_inline]] inline void pair_geometry_loop(const State& s, int n_materials, Batch& batch, int pairs) {
   ContactBatch& b = batch.b;
@@ -280,7 +282,7 @@ void list_contacts(const Model& model, State& s, Workspace& work, Batch& batch, 
     }
     if (!acts & (active[k] != 0)) forget(s.pairs, active[k], k, width);  // rare: a contact ends
     // The row evaluate_effects will copy: the rows of the touching pairs, spread over the list's,
-    // missed the cache there (B1 20k +3.3 % settle, +3.4 % dense with the prefetch).
+    // missed the cache there without the prefetch (bench/results/design_measurements.csv).
     __builtin_prefetch(history + static_cast<size_t>(k) * width, 1);
     c += acts;
     if (c == kBatch) {
@@ -397,7 +399,7 @@ void block_pass(const Model& model, State& s, Workspace& work, Batch& batch, con
     const long first = b * block, last = std::min(n, (b + 1) * block);
     // The block's pairs in one loop, then its plane-wall contacts. (A slot's walls right after
     // its own pairs split the loop at every slot with walls, and the predictor missed its ends:
-    // B1 20k's box +5.6 % settle, +2.4 % dense without the split.)
+    // the box's settle and dense bed ran slower that way: bench/results/design_measurements.csv.)
     Workspace::NearPairs& near = work.near;
     std::int32_t kept = work.pair_begin[first];  // the block's run of near pairs
     const std::int32_t to = kScan == Scan::kNear ? near.end[b] : work.pair_begin[last];

@@ -17,8 +17,8 @@ namespace dem {
 
 namespace {
 
-/// Without a branch per value: whether a row is zero is a coin toss to the branch predictor
-/// (B1 20k: 40 % of the listed pairs touch).
+/// Without a branch per value: whether a row is zero is a coin toss to the branch predictor (in
+/// a dense bed a large share of the listed pairs touch; bench/results/design_measurements.csv).
 bool row_is_zero(const double* row, int width) {
   bool any = false;
   for (int k = 0; k < width; ++k) any |= row[k] != 0.0;
@@ -531,8 +531,8 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   // Carry histories to the new lists by particle id: each old row finds its pair in the new
   // list's row of the lower slot (a handful of partners), so the carry needs no index of its own.
   // Each old row has a new row of its own (or none), so the threads share the old rows.
-  // The new lists' histories start at zero, set by the threads together (MiB: 0.4 ms of a
-  // B1 20k rebuild on one thread).
+  // The new lists' histories start at zero, set by the threads together (MiB of them: on one
+  // thread a noticeable part of a rebuild; bench/results/design_measurements.csv).
   resize_discarding(s.pairs.history, n_pairs * width);
   s.wall_pairs.history.resize(s.wall_pairs.size() * width);
   for (std::vector<double>* history : {&s.pairs.history, &s.wall_pairs.history}) {

@@ -16,8 +16,8 @@ namespace dem {
 namespace {
 /// Columns gathered together by State::permute: each thread gathers its share of the slots of a
 /// group of columns into as many scratch columns, then one thread swaps each column with its
-/// scratch. Two barriers per group (not three per column: 30 columns, 90 barriers of a few
-/// microseconds each were half of a rebuild's sort, B2).
+/// scratch. Two barriers per group (not three per column: 30 columns, 90 barriers, which made
+/// much of a rebuild's sort; bench/results/design_measurements.csv).
 constexpr size_t kGroup = 4;
 
 /// Gathers the columns by `order`, as many at a time as there are scratch columns (called by

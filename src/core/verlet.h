@@ -29,7 +29,8 @@ enum Moved : int { kRebuild = 1, kRescan = 2, kRescanDrift = 4 };
 /// |d_i| plus the wall's own motion: a sphere may move a whole skin from static walls, half of
 /// it where walls move (these take the other half). Where the lists follow the drift
 /// (neighbors.h, lists_follow_drift), c moves at the middle of the spheres' velocities at the
-/// build, and a stream in a chute (B2: 3 m/s, a 2 mm skin) is rebuilt about half as often.
+/// build, and a stream in a chute is rebuilt much less often
+/// (bench/results/design_measurements.csv).
 struct DriftLimits {
   const double *x_built = nullptr, *y_built = nullptr, *z_built = nullptr;  ///< [m] at the last build (State)
   const float *x_near = nullptr, *y_near = nullptr, *z_near = nullptr;      ///< [m] at the last full scan, from x_built (Workspace::near)

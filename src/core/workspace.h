@@ -148,7 +148,8 @@ struct Workspace {
 
   /// The histories a rebuild carries from the old lists to the new ones (rebuild_contacts). Kept
   /// between rebuilds: blocks of MiB, mapped anew at each rebuild, cost their page faults every
-  /// time (B1 20k: 2.5 of a rebuild's 6.9 ms); the peak memory is the same.
+  /// time, a large part of a rebuild (bench/results/design_measurements.csv); the peak memory is
+  /// the same.
   HistoryRows old_pairs, old_walls;
   PairForces pair_forces;
   /// Keep each pair's force (pair_forces.fx, fy, fz; for contact_stress): 24 bytes per listed

@@ -17,7 +17,8 @@ inline constexpr ParamSpec kRollingFrictionParam = {"rolling_friction", "-", 0.0
 // Pieces shared by the kernels with a spring in the contact plane (Mindlin, EPSD), written as
 // selects so the kernels' loops stay vectorised, and always inlined: a call left in a loop stops
 // its vectorisation (GCC 12 left them out of line in Mindlin's loop with -march=native, and the
-// kernel ran 3x slower: B1 20k 0.6x of the default build, with them inlined 0.9x).
+// kernel, and with it the native build, ran far slower than with them inlined;
+// bench/results/design_measurements.csv).
 
 /// Turns a spring (x, y, z) into the contact plane of unit normal n at constant length.
 [[gnu::always_inline]] inline void keep_in_contact_plane(double& x, double& y, double& z, double nx, double ny, double nz) {
