@@ -124,54 +124,86 @@ double Model::pair_param(int a, int b, std::string_view key) const {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-Model compile(const CaseSpec& spec, const MeshLoader& loader) {
-  Model model;
-  model.source = spec.path;
-  model.title = spec.title;
+namespace {
 
+// Phases of compile, in the order it calls them. Each builds its part of the Model from the spec;
+// the Model built so far is the state they share.
+
+/// Index of a named material, or a CaseError naming the key and the nearest material name.
+int material_or_fail(const Model& model, const std::string& name, const SourceLocation& where, const std::string& key) {
+  const int index = model.material_index(name);
+  if (index >= 0) return index;
+  std::vector<std::string> names;
+  std::string list;
+  for (const auto& m : model.materials) names.push_back(m.name), list += (list.empty() ? "" : ", ") + m.name;
+  const std::string hint = nearest_word(name, names);
+  throw CaseError(fmt::format("{}: {}: unknown material '{}'{}; materials of this case: {}", where.str(), key, name,
+                              hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
+}
+
+/// Index of a named clump template, -1 for none (spheres), or a CaseError naming the nearest template.
+int clump_or_fail(const Model& model, const std::string& name, const SourceLocation& where, const std::string& key) {
+  if (name.empty()) return -1;
+  for (size_t k = 0; k < model.clumps.size(); ++k)
+    if (model.clumps[k].name == name) return static_cast<int>(k);
+  std::vector<std::string> names;
+  for (const auto& known : model.clumps) names.push_back(known.name);
+  const std::string hint = nearest_word(name, names);
+  throw CaseError(fmt::format("{}: {}: unknown clump template '{}'{}; define it under `clumps:`", where.str(), key, name,
+                              hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
+}
+
+/// The material's own value of a parameter, or null when it does not state it.
+const double* stated_value(const MaterialSpec& m, const ParamSpec& p) {
+  const auto it = m.params.find(std::string(p.key));
+  return it == m.params.end() ? nullptr : &it->second;
+}
+
+/// Largest and smallest sphere a size distribution can create, for a sphere or a clump.
+void extend_radii(Model& model, const SizeDistributionSpec& d, int clump) {
+  double big = 0.5, small = 0.5;
+  if (clump >= 0) {
+    const auto& radii = model.clumps[clump].radii;
+    big = *std::max_element(radii.begin(), radii.end());
+    small = *std::min_element(radii.begin(), radii.end());
+  }
+  model.radius_max = std::max(model.radius_max, big * d.largest());
+  model.radius_min = std::min(model.radius_min, small * d.smallest());
+}
+
+void add_materials(const CaseSpec& spec, Model& model) {
   for (const MaterialSpec& m : spec.materials)
     model.materials.push_back({m.name, m.density, m.youngs_modulus, m.poisson_ratio});
   // Mass scaling and reduced stiffness act on the materials particles are made of.
   model.mass_scaling = spec.simulation.mass_scaling;
   model.stiffness_scaling = spec.simulation.stiffness_scaling;
-  {
-    std::vector<std::uint8_t> particle_material(model.materials.size(), 0);
-    for (const auto& p : spec.particles)
-      if (const int k = model.material_index(p.material); k >= 0) particle_material[k] = 1;
-    for (const auto& in : spec.inlets)
-      if (const int k = model.material_index(in.material); k >= 0) particle_material[k] = 1;
-    for (size_t k = 0; k < model.materials.size(); ++k) {
-      if (!particle_material[k]) continue;
-      model.materials[k].density *= model.mass_scaling;
-      model.materials[k].youngs_modulus *= model.stiffness_scaling;
-      // Parameters fitted at one stiffness need not hold at another: say so when a calibrated
-      // material runs at a stiffness more than 25 % away from the one its calibration used.
-      if (const auto& record = spec.materials[k].calibration) {
-        const double ratio = model.stiffness_scaling / record->stiffness_scaling;
-        if (ratio > 1.25 || ratio < 0.8)
-          model.notes.push_back(fmt::format(
-              "{} was calibrated with its Young's modulus x {:g} ({:.3g} Pa in the virtual tests) and runs here at x {:g} ({:.3g} Pa): "
-              "parameters fitted at one stiffness need not hold at another; calibrate at the case's stiffness, or add `bias_check:` "
-              "to see what the difference moves",
-              spec.materials[k].name, record->stiffness_scaling, spec.materials[k].youngs_modulus * record->stiffness_scaling,
-              model.stiffness_scaling, spec.materials[k].youngs_modulus * model.stiffness_scaling));
-      }
+  std::vector<std::uint8_t> particle_material(model.materials.size(), 0);
+  for (const auto& p : spec.particles)
+    if (const int k = model.material_index(p.material); k >= 0) particle_material[k] = 1;
+  for (const auto& in : spec.inlets)
+    if (const int k = model.material_index(in.material); k >= 0) particle_material[k] = 1;
+  for (size_t k = 0; k < model.materials.size(); ++k) {
+    if (!particle_material[k]) continue;
+    model.materials[k].density *= model.mass_scaling;
+    model.materials[k].youngs_modulus *= model.stiffness_scaling;
+    // Parameters fitted at one stiffness need not hold at another: say so when a calibrated
+    // material runs at a stiffness more than 25 % away from the one its calibration used.
+    if (const auto& record = spec.materials[k].calibration) {
+      const double ratio = model.stiffness_scaling / record->stiffness_scaling;
+      if (ratio > 1.25 || ratio < 0.8)
+        model.notes.push_back(fmt::format(
+            "{} was calibrated with its Young's modulus x {:g} ({:.3g} Pa in the virtual tests) and runs here at x {:g} ({:.3g} Pa): "
+            "parameters fitted at one stiffness need not hold at another; calibrate at the case's stiffness, or add `bias_check:` "
+            "to see what the difference moves",
+            spec.materials[k].name, record->stiffness_scaling, spec.materials[k].youngs_modulus * record->stiffness_scaling,
+            model.stiffness_scaling, spec.materials[k].youngs_modulus * model.stiffness_scaling));
     }
   }
-  auto material_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
-    const int index = model.material_index(name);
-    if (index >= 0) return index;
-    std::vector<std::string> names;
-    std::string list;
-    for (const auto& m : model.materials) names.push_back(m.name), list += (list.empty() ? "" : ", ") + m.name;
-    const std::string hint = nearest_word(name, names);
-    throw CaseError(fmt::format("{}: {}: unknown material '{}'{}; materials of this case: {}", where.str(), key, name,
-                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
-  };
+}
 
-  // Effects in stage order.
+/// Effects in stage order.
+void switch_on_effects(const ContactSpec& c, Model& model) {
   int param_cursor = 2;  // columns 0, 1: E*, G*
-  const ContactSpec& c = spec.contact;
   if (c.normal.model == "none")
     throw CaseError(fmt::format("{}: contact.normal: a normal force law is required (hertz or linear)", c.normal.location.str()));
   add_effect(model, c.normal, Stage::normal, param_cursor);
@@ -187,17 +219,15 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
       throw CaseError(fmt::format("{}: contact: '{}' is written for the '{}' normal law, but contact.normal is '{}'",
                                   c.normal.location.str(), e.spec->name, e.spec->requires_normal, c.normal.model));
   }
+}
 
-  // Pair table: mixed material values, then explicit interactions, then derived values. A
-  // material that does not state a parameter leaves the pair's value to the one that does (the
-  // particles' rolling resistance or cohesion acts on a wall that says nothing of it, as their
-  // own property); neither states it: the default.
+/// Pair table: mixed material values, then explicit interactions, then derived values. A
+/// material that does not state a parameter leaves the pair's value to the one that does (the
+/// particles' rolling resistance or cohesion acts on a wall that says nothing of it, as their
+/// own property); neither states it: the default.
+void fill_pair_table(const CaseSpec& spec, Model& model) {
   const int n = model.n_materials();
   model.pair_table.assign(static_cast<size_t>(n) * n * model.pair_stride, 0.0);
-  auto stated = [&](const MaterialSpec& m, const ParamSpec& p) -> const double* {
-    const auto it = m.params.find(std::string(p.key));
-    return it == m.params.end() ? nullptr : &it->second;
-  };
   for (int a = 0; a < n; ++a) {
     for (int b = 0; b < n; ++b) {
       double* row = model.pair_table.data() + static_cast<size_t>(model.pair_type(a, b)) * model.pair_stride;
@@ -206,7 +236,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
       for (const ActiveEffect& e : model.effects)
         for (size_t k = 0; k < e.spec->params.size(); ++k) {
           const ParamSpec& p = e.spec->params[k];
-          const double *va = stated(spec.materials[a], p), *vb = stated(spec.materials[b], p);
+          const double *va = stated_value(spec.materials[a], p), *vb = stated_value(spec.materials[b], p);
           row[e.param_offset + k] = va && vb ? mix(p.mixing, *va, *vb) : va ? *va : vb ? *vb : p.default_value;
         }
     }
@@ -214,8 +244,8 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   for (size_t k = 0; k < spec.interactions.size(); ++k) {
     const InteractionSpec& in = spec.interactions[k];
     const std::string key = fmt::format("interactions[{}].materials", k);
-    const int a = material_or_fail(in.material_a, in.location, key);
-    const int b = material_or_fail(in.material_b, in.location, key);
+    const int a = material_or_fail(model, in.material_a, in.location, key);
+    const int b = material_or_fail(model, in.material_b, in.location, key);
     for (const auto& [name, value] : in.params) {
       for (const ActiveEffect& e : model.effects)
         for (size_t p = 0; p < e.spec->params.size(); ++p)
@@ -230,13 +260,15 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   for (int t = 0; t < n * n; ++t)
     for (const ActiveEffect& e : model.effects)
       if (e.spec->derive) e.spec->derive(model.pair_table.data() + static_cast<size_t>(t) * model.pair_stride + e.param_offset);
+}
 
-  // Walls.
+/// Walls.
+void add_plane_walls(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.planes.size(); ++k) {
     const PlaneWallSpec& w = spec.planes[k];
     PlaneWall wall{w.name, {w.point.x(), w.point.y(), w.point.z()}, {w.normal.x(), w.normal.y(), w.normal.z()},
                    {w.velocity.x(), w.velocity.y(), w.velocity.z()},
-                   material_or_fail(w.material, w.location, fmt::format("walls[{}].material", k))};
+                   material_or_fail(model, w.material, w.location, fmt::format("walls[{}].material", k))};
     wall.shape = w.shape;
     wall.radius = w.radius;
     wall.hole = w.hole_radius;
@@ -248,8 +280,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     wall.servo_max_speed = w.servo.max_speed;
     model.planes.push_back(wall);
   }
+}
 
-  // Mesh walls: triangles inline or from the loader, placed by their transform.
+/// Mesh walls: triangles inline or from the loader, placed by their transform.
+void add_mesh_walls(const CaseSpec& spec, const MeshLoader& loader, Model& model) {
   for (size_t k = 0; k < spec.meshes.size(); ++k) {
     const MeshWallSpec& m = spec.meshes[k];
     auto surface = std::make_shared<TriangleSurface>();
@@ -276,7 +310,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     surface->build_topology();
     MeshWall wall;
     wall.name = m.name;
-    wall.material = material_or_fail(m.material, m.location, fmt::format("meshes[{}].material", k));
+    wall.material = material_or_fail(model, m.material, m.location, fmt::format("meshes[{}].material", k));
     wall.surface = surface;
     wall.bvh = std::make_shared<TriangleBvh>(*surface);
     wall.motion = m.motion;
@@ -284,8 +318,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     wall.active_from = m.active_from;
     model.meshes.push_back(std::move(wall));
   }
+}
 
-  // Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
+/// Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
+void add_clump_templates(const CaseSpec& spec, Model& model) {
   for (const ClumpTemplateSpec& clump : spec.clumps) {
     std::vector<ClumpSphere> spheres;
     for (size_t k = 0; k < clump.radii.size(); ++k) spheres.push_back({clump.centres[k], clump.radii[k]});
@@ -304,34 +340,18 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     t.bounding_radius = props.bounding_radius * scale;
     model.clumps.push_back(std::move(t));
   }
-  auto clump_or_fail = [&](const std::string& name, const SourceLocation& where, const std::string& key) {
-    if (name.empty()) return -1;
-    for (size_t k = 0; k < model.clumps.size(); ++k)
-      if (model.clumps[k].name == name) return static_cast<int>(k);
-    std::vector<std::string> names;
-    for (const auto& known : model.clumps) names.push_back(known.name);
-    const std::string hint = nearest_word(name, names);
-    throw CaseError(fmt::format("{}: {}: unknown clump template '{}'{}; define it under `clumps:`", where.str(), key, name,
-                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
-  };
-  // Largest and smallest sphere a size distribution can create, for a sphere or a clump.
+}
+
+/// Particle sets created at the start, with their material, clump and wall resolved; the radius
+/// range starts here.
+void add_particle_sources(const CaseSpec& spec, Model& model) {
   model.radius_min = std::numeric_limits<double>::infinity();
-  auto extend_radii = [&](const SizeDistributionSpec& d, int clump) {
-    double big = 0.5, small = 0.5;
-    if (clump >= 0) {
-      const auto& radii = model.clumps[clump].radii;
-      big = *std::max_element(radii.begin(), radii.end());
-      small = *std::min_element(radii.begin(), radii.end());
-    }
-    model.radius_max = std::max(model.radius_max, big * d.largest());
-    model.radius_min = std::min(model.radius_min, small * d.smallest());
-  };
   for (size_t k = 0; k < spec.particles.size(); ++k) {
     const ParticleSetSpec& p = spec.particles[k];
     const std::string key = fmt::format("particles[{}]", k);
-    ParticleSource source{p, material_or_fail(p.material, p.location, key + ".material"),
-                          clump_or_fail(p.clump, p.location, key + ".clump")};
-    extend_radii(p.diameter, source.clump);
+    ParticleSource source{p, material_or_fail(model, p.material, p.location, key + ".material"),
+                          clump_or_fail(model, p.clump, p.location, key + ".clump")};
+    extend_radii(model, p.diameter, source.clump);
     // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
     if (!p.attach_to.empty()) {
       for (size_t w = 0; w < model.planes.size(); ++w)
@@ -352,39 +372,46 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     }
     model.sources.push_back(std::move(source));
   }
-  // Particle counts are bounded before anything is allocated for them: a mistyped `count`
-  // (an extra zero or three) must be an error, not an out-of-memory kill minutes later.
-  {
-    std::int64_t total = 0;
-    for (size_t k = 0; k < spec.particles.size(); ++k) {
-      const ParticleSetSpec& p = spec.particles[k];
-      total += p.count;
-      if (total > kMaxParticles)
-        throw CaseError(fmt::format("{}: particles[{}].count: {} particles in all exceeds the limit of {} (about {:.0f} GB at "
-                                    "~1 kB per particle with its contacts); lower `count`",
-                                    p.location.str(), k, total, kMaxParticles, kMaxParticles * 1e3 / 1e9));
-      if (!p.positions.empty()) continue;
-      // Random placement without overlap stops near 30-35 % solid: refuse what cannot fit
-      // before drawing any diameter.
-      const double region = (p.region_max - p.region_min).prod();
-      const double d = p.diameter.smallest();
-      const double scale = p.clump.empty() ? 1.0 : 0.5;  // a clump's spheres may overlap
-      const double solid = static_cast<double>(p.count) * std::numbers::pi / 6.0 * d * d * d * scale;
-      if (!(solid <= 0.6 * region))
-        throw CaseError(fmt::format("{}: particles[{}].count: {} particles of at least {:g} m hold {:.3g} m^3 of solid, "
-                                    "{:.0f} % of the region's {:.3g} m^3; random placement stops near 30-35 %. Enlarge "
-                                    "`region` or lower `count`",
-                                    p.location.str(), k, p.count, d, solid, 100.0 * solid / region, region));
-    }
+}
+
+/// Particle counts are bounded before anything is allocated for them: a mistyped `count`
+/// (an extra zero or three) must be an error, not an out-of-memory kill minutes later.
+void check_particle_counts(const CaseSpec& spec) {
+  std::int64_t total = 0;
+  for (size_t k = 0; k < spec.particles.size(); ++k) {
+    const ParticleSetSpec& p = spec.particles[k];
+    total += p.count;
+    if (total > kMaxParticles)
+      throw CaseError(fmt::format("{}: particles[{}].count: {} particles in all exceeds the limit of {} (about {:.0f} GB at "
+                                  "~1 kB per particle with its contacts); lower `count`",
+                                  p.location.str(), k, total, kMaxParticles, kMaxParticles * 1e3 / 1e9));
+    if (!p.positions.empty()) continue;
+    // Random placement without overlap stops near 30-35 % solid: refuse what cannot fit
+    // before drawing any diameter.
+    const double region = (p.region_max - p.region_min).prod();
+    const double d = p.diameter.smallest();
+    const double scale = p.clump.empty() ? 1.0 : 0.5;  // a clump's spheres may overlap
+    const double solid = static_cast<double>(p.count) * std::numbers::pi / 6.0 * d * d * d * scale;
+    if (!(solid <= 0.6 * region))
+      throw CaseError(fmt::format("{}: particles[{}].count: {} particles of at least {:g} m hold {:.3g} m^3 of solid, "
+                                  "{:.0f} % of the region's {:.3g} m^3; random placement stops near 30-35 %. Enlarge "
+                                  "`region` or lower `count`",
+                                  p.location.str(), k, p.count, d, solid, 100.0 * solid / region, region));
   }
-  const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());
+}
+
+void add_inlets(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.inlets.size(); ++k) {
     const InletSpec& in = spec.inlets[k];
     const std::string key = fmt::format("inlets[{}]", k);
-    Inlet inlet{in, material_or_fail(in.material, in.location, key + ".material"), clump_or_fail(in.clump, in.location, key + ".clump"), in.interval};
-    extend_radii(in.diameter, inlet.clump);
+    Inlet inlet{in, material_or_fail(model, in.material, in.location, key + ".material"),
+                clump_or_fail(model, in.clump, in.location, key + ".clump"), in.interval};
+    extend_radii(model, in.diameter, inlet.clump);
     model.inlets.push_back(std::move(inlet));
   }
+}
+
+void add_outlets(const CaseSpec& spec, Model& model) {
   model.outlets = spec.outlets;
   for (size_t k = 0; k < spec.outlets.size(); ++k) {
     if (!spec.outlets[k].domain) continue;
@@ -398,12 +425,18 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
                                   spec.outlets[model.domain_outlet].name));
     model.domain_outlet = static_cast<int>(k);
   }
+}
+
+void check_inlet_ports(const CaseSpec& spec) {
   for (size_t k = 0; k < spec.inlets.size(); ++k)
     if (!spec.inlets[k].port.empty() && !(spec.inlets[k].region_max.array() > spec.inlets[k].region_min.array()).all())
       throw CaseError(fmt::format("{}: inlets[{}].port: '{}' names an equipment port that was not resolved: the "
                                   "case needs `equipment:` with that port (or give `region` instead)",
                                   spec.inlets[k].location.str(), k, spec.inlets[k].port));
-  // Sensors: unit directions, a slab a couple of particles thick, unique names.
+}
+
+/// Sensors: unit directions, a slab a couple of particles thick, unique names.
+void add_sensors(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.sensors.size(); ++k) {
     SensorSpec sensor = spec.sensors[k];
     for (size_t j = 0; j < k; ++j)
@@ -414,10 +447,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     if (sensor.kind == SensorSpec::Kind::plane && sensor.thickness <= 0) sensor.thickness = 4.0 * model.radius_max;
     model.sensors.push_back(sensor);
   }
-  model.design = spec.design;
-  model.equipment_camera = spec.equipment_camera;
+}
 
-  // Options.
+/// Options.
+void set_options(const CaseSpec& spec, Model& model) {
   const SimulationSpec& s = spec.simulation;
   model.duration = s.duration;
   model.gravity = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
@@ -433,6 +466,11 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   model.output = spec.output;
   for (int a = 0; a < 3; ++a)
     if (s.periodic[a]) model.period[a] = s.domain_max[a] - s.domain_min[a];
+}
+
+/// Largest gap at which any effect acts, over every material pair.
+void find_interaction_range(Model& model) {
+  const int n = model.n_materials();
   for (const ActiveEffect& e : model.effects) {
     if (!e.spec->range) continue;
     for (int t = 0; t < n * n; ++t) {
@@ -440,7 +478,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
       model.interaction_range = std::max(model.interaction_range, e.spec->range(row, row + e.param_offset, model.radius_max));
     }
   }
+}
 
+void choose_time_step(const CaseSpec& spec, Model& model) {
+  const SimulationSpec& s = spec.simulation;
   model.advice = advise_time_step(model, s);
   model.dt = model.advice.dt;
   if (!model.advice.safe && s.refuse_unsafe_step)
@@ -448,8 +489,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
                                 "Use a smaller step, `time_step: auto`, or `unsafe_time_step: warn` to run anyway.",
                                 spec.path, model.dt, model.advice.report));
   if (!model.advice.safe) model.notes.push_back("time step is unsafe (unsafe_time_step: warn):\n" + model.advice.report);
+}
 
-  // Inlets insert in batches: often enough that a batch is a thin layer of the region.
+/// Inlets insert in batches: often enough that a batch is a thin layer of the region.
+void set_inlet_intervals(Model& model, double g_norm) {
   for (Inlet& inlet : model.inlets) {
     if (inlet.interval > 0) continue;
     const Vec3 extent = inlet.spec.region_max - inlet.spec.region_min;
@@ -458,12 +501,15 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
                                    : (g_norm > 0 ? 0.25 * std::sqrt(2.0 * extent.maxCoeff() / g_norm) : 0.01);
     inlet.interval = std::clamp(clear, 20.0 * model.dt, 0.05);
   }
-  // What an inlet's region can deliver: particles placed at random without overlaps fill a box to
-  // about 30 % solid (random sequential placement jams near 38 %), and the box empties in the time
-  // the particles take to cross it along their velocity, from their inlet speed with the part of
-  // gravity along it (a belt port: length / belt speed, as the generators size them; from rest:
-  // the fall through the box). A rate beyond 40 % solid cannot be delivered (the inlet falls
-  // behind and its particles crowd the box); beyond 30 % it is a note.
+}
+
+/// What an inlet's region can deliver: particles placed at random without overlaps fill a box to
+/// about 30 % solid (random sequential placement jams near 38 %), and the box empties in the time
+/// the particles take to cross it along their velocity, from their inlet speed with the part of
+/// gravity along it (a belt port: length / belt speed, as the generators size them; from rest:
+/// the fall through the box). A rate beyond 40 % solid cannot be delivered (the inlet falls
+/// behind and its particles crowd the box); beyond 30 % it is a note.
+void check_inlet_rates(Model& model, double g_norm) {
   for (const Inlet& inlet : model.inlets) {
     if (inlet.spec.mass_rate <= 0) continue;
     const Vec3 extent = inlet.spec.region_max - inlet.spec.region_min;
@@ -493,7 +539,10 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
                                         "failed insertions are counted at the end of the run). {} would leave room",
                                         what, remedy));
   }
-  // Servo walls: area from the periodic cross-section, speed limit from the step.
+}
+
+/// Servo walls: area from the periodic cross-section, speed limit from the step.
+void size_servo_walls(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < model.planes.size(); ++k) {
     PlaneWall& w = model.planes[k];
     if (!w.servo) continue;
@@ -509,15 +558,20 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     }
     if (w.servo_max_speed <= 0) w.servo_max_speed = 0.002 * model.radius_min / model.dt;
   }
-  // Periodic axes: the minimum image is unique only if a period spans three cells.
+}
+
+/// Periodic axes: the minimum image is unique only if a period spans three cells.
+void check_periodic_lengths(const CaseSpec& spec, const Model& model) {
   const double cell = 2.0 * model.radius_max + model.interaction_range + model.skin;
   for (int a = 0; a < 3; ++a)
     if (model.period[a] > 0 && model.period[a] < 3.0 * cell)
       throw CaseError(fmt::format("{}: simulation.domain: the periodic length along {} is {:g} m; it must be at least "
                                   "three neighbour cells, {:g} m (2 x largest radius + interaction range + skin, x 3)",
                                   spec.path, "xyz"[a], model.period[a], 3.0 * cell));
+}
 
-  // Hash of what determines the physics (checkpoints refuse a different model).
+/// Hash of what determines the physics (checkpoints refuse a different model).
+std::uint64_t physics_hash(const Model& model) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   h = fnv1a(model.pair_table.data(), model.pair_table.size() * sizeof(double), h);
   for (const ActiveEffect& e : model.effects) h = fnv1a(e.spec->name.data(), e.spec->name.size(), h);
@@ -533,7 +587,45 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
     }
     if (w.spin != 0) h = fnv1a(&w.spin, sizeof w.spin, h);
   }
-  model.hash = h;
+  return h;
+}
+
+}  // namespace
+
+Model compile(const CaseSpec& spec, const MeshLoader& loader) {
+  Model model;
+  model.source = spec.path;
+  model.title = spec.title;
+
+  // Contact law: materials, effects, per-pair parameters.
+  add_materials(spec, model);
+  switch_on_effects(spec.contact, model);
+  fill_pair_table(spec, model);
+
+  // Walls, clump templates, particles and what enters, leaves and measures them.
+  add_plane_walls(spec, model);
+  add_mesh_walls(spec, loader, model);
+  add_clump_templates(spec, model);
+  add_particle_sources(spec, model);
+  check_particle_counts(spec);
+  const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());  // [m/s^2]
+  add_inlets(spec, model);
+  add_outlets(spec, model);
+  check_inlet_ports(spec);
+  add_sensors(spec, model);
+  model.design = spec.design;
+  model.equipment_camera = spec.equipment_camera;
+
+  // Options, the time step, and what depends on it.
+  set_options(spec, model);
+  find_interaction_range(model);
+  choose_time_step(spec, model);
+  set_inlet_intervals(model, g_norm);
+  check_inlet_rates(model, g_norm);
+  size_servo_walls(spec, model);
+  check_periodic_lengths(spec, model);
+
+  model.hash = physics_hash(model);
   return model;
 }
 

@@ -329,390 +329,605 @@ void print_setup(const Model& model, const State& state, std::ostream& log) {
   for (const std::string& warning : particles_behind_walls(model, state)) fmt::print(log, "  WARNING: {}\n", warning);
 }
 
-RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log) {
-  RunSummary summary;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using SignalHandler = void (*)(int);  // what std::signal returns
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// What run() is given and what it decides before its first step.
+struct RunSetup {
+  const Model& model;
+  State& state;
+  Workspace& work;
+  const RunOptions& options;
+  std::ostream& log;
+  std::string out;        // the output folder
+  double duration;        // [s] to run
+  std::int64_t end_step;  // the step that reaches `duration`
+  // Under domain decomposition every rank steps its share with the domain's model; the ranks
+  // write each frame together (options.share_frame) or the root gathers the whole state for it,
+  // and the root gathers it for images and at the end and writes the rest as one process would.
+  Domain* domain;
+  bool writer;            // this process writes the results: the only one, or the root
+  bool collective;        // the ranks write each frame together
+  const Model& stepped;   // the model this process steps
+  std::uint64_t run_id;   // in run_info.yaml and every checkpoint
+};
+
+/// The whole state for results: the state itself, or (domain) the root's gathered copy with its
+/// lists rebuilt (and, for the caller at the end, a copy with this instant's contact forces),
+/// gathered for frames unless the ranks write them together, for rendered frames and at the end.
+struct WholeResults {
+  std::optional<WholeState> whole;
+  const State* state;     // positions, counters, histories
+  const Workspace* work;
+  bool gathered;          // on every rank alike: whether gather_whole has run
+};
+
+/// Counts of the whole run, as of the last row of scalars (every rank's under domain decomposition).
+struct RowTotals {
+  std::int64_t lost;      // particles lost, every rank's
+  double particles;       // particles in the whole run, for the progress line
+};
+
+/// Which steps end the run, record a row of scalars, write a frame or a checkpoint, and check.
+struct Schedule {
+  std::int64_t first_step;
+  std::int64_t last_step;
+  std::int64_t total;             // steps to run
+  std::int64_t every;             // steps between rows of scalars
+  std::int64_t frame_every;       // steps between frames
+  std::int64_t checkpoint_every;  // steps between checkpoints; 0: none by step count
+  std::int64_t check_every;       // steps between numerical checks
+};
+
+/// What watches the run for trouble and for events, and what it has told of them.
+struct Watches {
+  EnergyWatch energy;
+  // First arrivals to the step (events.h); one process only: under domain decomposition each rank
+  // holds a share of the particles.
+  EventWatch events;
+  double last_check;           // [s] the time of the last check
+  std::int64_t lost_reported;  // particles lost as last told
+  std::int64_t warnings;       // numerical trouble warned of, the run going on
+};
+
+/// The particle frames the run writes.
+struct Outputs {
+  std::optional<FrameWriter> frames;
+  double frame_seconds = 0;  // [s] this rank's time writing frames
+};
+
+/// The step loop's start: the signal handlers it replaced and the wall clock's reading.
+struct LoopStart {
+  SignalHandler previous_int;
+  SignalHandler previous_term;
+  Clock::time_point start;
+};
+
+/// What the step loop and the run's end share: the setup and the parts built before the loop.
+struct RunParts {
+  const RunSetup& setup;
+  RunSummary& summary;
+  Watches& watches;
+  WholeResults& results;
+  RowTotals& totals;
+  const Schedule& schedule;
+  Outputs& outputs;
+  const LoopStart& loop_start;
+};
+
+/// Where the run writes, how far it runs and, under domain decomposition, which process writes.
+RunSetup plan_run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log,
+                  RunSummary& summary) {
   summary.output_directory = options.output_directory.empty() ? model.output.directory : options.output_directory;
-  const std::string out = summary.output_directory;
   const double duration = options.duration >= 0 ? options.duration : model.duration;
   if (!(duration >= 0) || duration / model.dt > 1e15)
     throw CaseError(fmt::format("duration {:g} s is not a time this run can reach ({:.3g} steps of {:.3g} s); valid: 0 to 1e6 s", duration,
                                 duration / model.dt, model.dt));
   const std::int64_t end_step = static_cast<std::int64_t>(std::ceil(duration / model.dt - 1e-9));
-  // Under domain decomposition every rank steps its share with the domain's model; the ranks
-  // write each frame together (options.share_frame) or the root gathers the whole state for it,
-  // and the root gathers it for images and at the end and writes the rest as one process would.
   Domain* domain = options.domain;
   const bool writer = domain == nullptr || domain->root();
   const bool collective = domain != nullptr && static_cast<bool>(options.share_frame);
   const Model& stepped = domain ? domain->local_model() : model;
   work.domain = domain;
-  // A refusal on the root stops every rank (the others would wait for it forever).
-  const auto stop_if_refused = [&](const std::string& refused) {
-    if (domain ? domain->any(!refused.empty()) : !refused.empty())
-      throw CaseError(!refused.empty() ? refused : "rank 0 refused the output folder (its message is on standard error)");
-  };
-  // The output folder, claimed by the process that writes the results: refused when it holds
-  // another run's results (unless resumed or overwritten) or a file of the run's names that no
-  // run wrote; locked until the caller lets go of the summary (run_folder.h).
-  if (options.write_files) {
-    std::string refused;
-    if (writer && options.folder) {
-      summary.folder = options.folder;
-    } else if (writer) {
-      try {
-        std::vector<std::string> names = run_output_names();
-        names.insert(names.end(), options.caller_outputs.begin(), options.caller_outputs.end());
-        const FolderUse use = options.resume ? FolderUse::resume : options.overwrite ? FolderUse::overwrite : FolderUse::fresh;
-        summary.folder = std::make_shared<RunFolder>(out, use, names, log);
-      } catch (const std::exception& e) {
-        refused = e.what();
-      }
+  return RunSetup{model, state, work, options, log, summary.output_directory, duration, end_step, domain, writer, collective, stepped, 0};
+}
+
+/// A refusal on the root stops every rank (the others would wait for it forever).
+void stop_if_refused(const RunSetup& s, const std::string& refused) {
+  if (s.domain ? s.domain->any(!refused.empty()) : !refused.empty())
+    throw CaseError(!refused.empty() ? refused : "rank 0 refused the output folder (its message is on standard error)");
+}
+
+/// The output folder, claimed by the process that writes the results: refused when it holds
+/// another run's results (unless resumed or overwritten) or a file of the run's names that no
+/// run wrote; locked until the caller lets go of the summary (run_folder.h).
+void claim_folder(const RunSetup& s, RunSummary& summary) {
+  std::string refused;
+  if (s.writer && s.options.folder) {
+    summary.folder = s.options.folder;
+  } else if (s.writer) {
+    try {
+      std::vector<std::string> names = run_output_names();
+      names.insert(names.end(), s.options.caller_outputs.begin(), s.options.caller_outputs.end());
+      const FolderUse use = s.options.resume ? FolderUse::resume : s.options.overwrite ? FolderUse::overwrite : FolderUse::fresh;
+      summary.folder = std::make_shared<RunFolder>(s.out, use, names, s.log);
+    } catch (const std::exception& e) {
+      refused = e.what();
     }
-    stop_if_refused(refused);
   }
+  stop_if_refused(s, refused);
+}
 
-  // The run's id, in run_info.yaml and every checkpoint: a new one, or the resumed run's.
-  std::uint64_t run_id = options.resume ? 0 : new_run_id();
-  if (options.resume) {
-    // A run that reached its end has nothing to resume: it is said, not rewound to its last checkpoint.
-    const RunRecord record = writer ? read_run_record(out) : RunRecord{};
-    bool complete = writer && record.completed && record.step >= end_step;
-    if (domain) complete = domain->any(complete);
-    if (complete) {
-      if (writer)
-        fmt::print(log, "  {}: the run is complete (t = {:.6g} s, step {}; run_info.yaml): nothing to resume. To run it again from the "
-                        "start, use --overwrite instead of --resume\n", out, record.time, record.step);
-      summary.already_complete = true;
-      return summary;
-    }
-    std::string from;
-    state = load_resumable(out, model, &from, &run_id);
-    // The checkpoint must belong to the rows beside it, or the resumed run would splice two runs.
-    const std::int64_t rows_every = model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, end_step / 200);
-    stop_if_refused(writer ? foreign_checkpoint(model, out, from, run_id, state, rows_every) : "");
-    if (writer) summary.scalars = read_scalars(model, out + "/scalars.csv", state.time);
-    if (writer) fmt::print(log, "  resumed from {} at t = {:.6g} s (step {})\n", from, state.time, state.step);
+/// The state, run id, rows and events of the run in OUT, from its checkpoint; a run that reached
+/// its end is left as it is (summary.already_complete).
+void resume_from_checkpoint(RunSetup& s, RunSummary& summary) {
+  // A run that reached its end has nothing to resume: it is said, not rewound to its last checkpoint.
+  const RunRecord record = s.writer ? read_run_record(s.out) : RunRecord{};
+  bool complete = s.writer && record.completed && record.step >= s.end_step;
+  if (s.domain) complete = s.domain->any(complete);
+  if (complete) {
+    if (s.writer)
+      fmt::print(s.log, "  {}: the run is complete (t = {:.6g} s, step {}; run_info.yaml): nothing to resume. To run it again from the "
+                        "start, use --overwrite instead of --resume\n", s.out, record.time, record.step);
+    summary.already_complete = true;
+    return;
   }
-  if (writer) print_setup(model, state, log);
-  EnergyWatch energy(model, state, model.energy_rise_limit);
-  // First arrivals to the step (events.h); one process only: under domain decomposition each rank
-  // holds a share of the particles.
-  EventWatch events(model);
-  if (options.resume && writer) events.restore(read_events(out + "/events.csv", state.time));
-  double last_check = state.time;
-  if (domain) domain->distribute(state);
-  prepare(stepped, state, work);
+  std::string from;
+  s.state = load_resumable(s.out, s.model, &from, &s.run_id);
+  // The checkpoint must belong to the rows beside it, or the resumed run would splice two runs.
+  const std::int64_t rows_every =
+      s.model.output.scalars_every > 0 ? s.model.output.scalars_every : std::max<std::int64_t>(1, s.end_step / 200);
+  stop_if_refused(s, s.writer ? foreign_checkpoint(s.model, s.out, from, s.run_id, s.state, rows_every) : "");
+  if (s.writer) summary.scalars = read_scalars(s.model, s.out + "/scalars.csv", s.state.time);
+  if (s.writer) fmt::print(s.log, "  resumed from {} at t = {:.6g} s (step {})\n", from, s.state.time, s.state.step);
+}
 
-  // The whole state for results: the state itself, or (domain) the root's gathered copy with its
-  // lists rebuilt (and, for the caller at the end, a copy with this instant's contact forces),
-  // gathered for frames unless the ranks write them together, for rendered frames and at the end.
-  std::optional<WholeState> whole;
-  const State* results = &state;  // positions, counters, histories
-  const Workspace* results_work = &work;
-  bool gathered = false;  // on every rank alike: whether gather_whole has run
-  auto gather_whole = [&]() {
-    if (!domain) return;
-    gathered = true;
-    State gathered_state = domain->gather(state);
-    if (!writer) return;
-    whole = ready_for_results(model, std::move(gathered_state));
-    results = &whole->state, results_work = &whole->work;
-  };
-  // A row of scalars (collective under domain decomposition): each rank measures its own
-  // particles and the contacts it lists, the parts are summed over the ranks and the root
-  // finishes the row; no rank gathers the state for it (diagnostics.h).
-  std::int64_t lost_total = state.lost;  // every rank's, as of the last row
-  const auto measure_row = [&] {
-    if (!domain) return measure(model, state, work);
-    ScalarParts parts = measure_parts(stepped, state, work);
-    domain->sum(parts.sums);
-    parts.max_overlap_ratio = domain->max(parts.max_overlap_ratio);
-    Scalars row = finish_scalars(model, state, parts);
-    lost_total = row.lost;
-    return row;
-  };
-  // Particles in the whole run, for the progress line: every rank's, as of the last row.
-  double particles_now = domain ? domain->sum(static_cast<double>(state.owned())) : 0.0;
-  if (!collective) gather_whole();
-  if (!options.resume) {
-    Scalars row = measure_row();
-    particles_now = static_cast<double>(row.particles);
-    if (writer) summary.scalars.push_back(std::move(row));
-  }
+/// The energy and event watches, from the state the run starts from (a resumed run's events kept).
+Watches watch_run(const RunSetup& s) {
+  Watches w{EnergyWatch(s.model, s.state, s.model.energy_rise_limit), EventWatch(s.model), s.state.time, 0, 0};
+  if (s.options.resume && s.writer) w.events.restore(read_events(s.out + "/events.csv", s.state.time));
+  return w;
+}
 
-  const std::int64_t first_step = state.step;
-  std::int64_t last_step = end_step;
-  if (options.max_steps >= 0) last_step = std::min(last_step, first_step + options.max_steps);
+/// Under domain decomposition, the whole state gathered on the root for results (collective).
+void gather_whole(const RunSetup& s, WholeResults& r) {
+  if (!s.domain) return;
+  r.gathered = true;
+  State gathered_state = s.domain->gather(s.state);
+  if (!s.writer) return;
+  r.whole = ready_for_results(s.model, std::move(gathered_state));
+  r.state = &r.whole->state, r.work = &r.whole->work;
+}
+
+/// A row of scalars (collective under domain decomposition): each rank measures its own
+/// particles and the contacts it lists, the parts are summed over the ranks and the root
+/// finishes the row; no rank gathers the state for it (diagnostics.h).
+Scalars measure_row(const RunSetup& s, RowTotals& totals) {
+  if (!s.domain) return measure(s.model, s.state, s.work);
+  ScalarParts parts = measure_parts(s.stepped, s.state, s.work);
+  s.domain->sum(parts.sums);
+  parts.max_overlap_ratio = s.domain->max(parts.max_overlap_ratio);
+  Scalars row = finish_scalars(s.model, s.state, parts);
+  totals.lost = row.lost;
+  return row;
+}
+
+/// A row of scalars measured and, by the process that writes the results, kept.
+void add_row(const RunSetup& s, RunSummary& summary, RowTotals& totals) {
+  Scalars row = measure_row(s, totals);
+  totals.particles = static_cast<double>(row.particles);
+  if (s.writer) summary.scalars.push_back(std::move(row));
+}
+
+/// Where the run ends (options.max_steps may end it early) and how often it records, writes and checks.
+Schedule schedule_steps(const RunSetup& s) {
+  const Model& model = s.model;
+  const std::int64_t first_step = s.state.step;
+  std::int64_t last_step = s.end_step;
+  if (s.options.max_steps >= 0) last_step = std::min(last_step, first_step + s.options.max_steps);
   const std::int64_t total = std::max<std::int64_t>(last_step - first_step, 0);
   const std::int64_t every =
-      model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, end_step / 200);
+      model.output.scalars_every > 0 ? model.output.scalars_every : std::max<std::int64_t>(1, s.end_step / 200);
   const std::int64_t frame_every = std::max<std::int64_t>(
-      1, static_cast<std::int64_t>(std::llround((model.output.frames_every > 0 ? model.output.frames_every : duration / 20) / model.dt)));
+      1, static_cast<std::int64_t>(std::llround((model.output.frames_every > 0 ? model.output.frames_every : s.duration / 20) / model.dt)));
   const std::int64_t checkpoint_every =
       model.output.checkpoint_every > 0 ? std::max<std::int64_t>(1, std::llround(model.output.checkpoint_every / model.dt)) : 0;
-
-  std::optional<FrameWriter> frames;
-  double frame_seconds = 0;  // [s] this rank's time writing frames
-  const auto write_frame_now = [&](const State& whole_or_mine) {
-    const auto begun = std::chrono::steady_clock::now();
-    if (collective) {
-      const FrameShare share = options.share_frame(state.owned());
-      write_frame(*frames, state, &share);
-    } else {
-      write_frame(*frames, whole_or_mine);
-    }
-    frame_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
-  };
-  // Just before the first write: an earlier run's files go (overwrite) and the folder is listed.
-  if (options.write_files) {
-    std::string failed;
-    if (writer) {
-      try {
-        summary.folder->begin(log);
-      } catch (const std::exception& e) {
-        failed = e.what();
-      }
-    }
-    stop_if_refused(failed);
-  }
-  if (options.write_files && (writer || collective)) {
-    if (writer) write_file_atomically(out + "/run_info.yaml", run_info(model, options, run_id));
-    frames.emplace(make_frame_writer(model, out));
-    if (options.resume && writer) frames->adopt_existing();
-    else if (!options.resume) write_frame_now(*results);
-  }
-  // Trouble present from the start (particles created overlapping): told before the first step.
-  // With frames written together no rank holds the whole state: each checks its share.
-  if (!options.resume && (writer || collective)) {
-    std::optional<NumericalError> found;
-    try {
-      if (collective) check_numerics(stepped, state, work, model.max_overlap_ratio);
-      else check_numerics(model, *results, *results_work, model.max_overlap_ratio);
-    } catch (const NumericalError& e) {
-      found = e;
-    }
-    if (collective && domain->any(found.has_value()) && !found)
-      found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
-    if (found) {
-      if (model.stop_on_trouble) throw *found;
-      fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", found->what());
-    }
-  }
-  // The rows so far, the events and the ParaView script (at checkpoints, on trouble, at the end).
-  const auto write_tables = [&] {
-    write_file_atomically(out + "/scalars.csv", scalars_csv(model, summary.scalars));
-    write_file_atomically(out + "/events.csv", events_csv(events.fired()));
-    if (frames) write_paraview_script(out);
-  };
-  stop_signal = 0;
-  auto previous_int = std::signal(SIGINT, on_stop_signal);
-  auto previous_term = std::signal(SIGTERM, on_stop_signal);
   // Numerical trouble: checked every few steps (cheap next to a step), so it is caught within
   // a few steps of its start, not at the next row of scalars.
   const std::int64_t check_every = std::min<std::int64_t>(every, 10);
-  if (!energy.active() && writer) fmt::print(log, "  energy check: off ({})\n", energy.source());
-  std::int64_t lost_reported = state.lost, warnings = 0;
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  auto trouble = [&](const NumericalError& e) {
-    if (model.stop_on_trouble) {
-      // Keep what was computed: the rows so far and a run record that says why it ended (the last
-      // checkpoint stays as it was).
-      summary.stopped = fmt::format("numerical trouble: {}", e.what());
-      summary.steps = state.step - first_step;
-      summary.events = events.fired();
-      summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-      if (options.write_files && writer) {
-        try {
-          write_tables();
-          write_file_atomically(out + "/run_info.yaml", run_info(model, options, run_id) +
-                                                            fmt::format("end:\n  completed: false\n  time_s: {:.17g}\n  step: {}\n  stopped: {}\n",
-                                                                        state.time, state.step, yaml_quoted(summary.stopped)));
-        } catch (const std::exception&) {
-        }
-      }
-      std::signal(SIGINT, previous_int);
-      std::signal(SIGTERM, previous_term);
-      throw RunStopped(e, summary);
-    }
-    if (warnings++ < 20) fmt::print(writer ? log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
-  };
+  return Schedule{first_step, last_step, total, every, frame_every, checkpoint_every, check_every};
+}
 
+/// A particle frame: this rank's share written by every rank together, or the whole state (or,
+/// in one process, the state) by this process; its time counted in frame_seconds.
+void write_frame_now(const RunSetup& s, Outputs& o, const State& whole_or_mine) {
+  const auto begun = std::chrono::steady_clock::now();
+  if (s.collective) {
+    const FrameShare share = s.options.share_frame(s.state.owned());
+    write_frame(*o.frames, s.state, &share);
+  } else {
+    write_frame(*o.frames, whole_or_mine);
+  }
+  o.frame_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begun).count();
+}
+
+/// Just before the first write: an earlier run's files go (overwrite) and the folder is listed.
+void begin_writing(const RunSetup& s, const RunSummary& summary) {
+  std::string failed;
+  if (s.writer) {
+    try {
+      summary.folder->begin(s.log);
+    } catch (const std::exception& e) {
+      failed = e.what();
+    }
+  }
+  stop_if_refused(s, failed);
+}
+
+/// The run record of the run begun and its frames: a new run's with its first frame, a resumed
+/// run's adopted.
+void open_outputs(const RunSetup& s, const WholeResults& results, Outputs& o) {
+  if (s.writer) write_file_atomically(s.out + "/run_info.yaml", run_info(s.model, s.options, s.run_id));
+  o.frames.emplace(make_frame_writer(s.model, s.out));
+  if (s.options.resume && s.writer) o.frames->adopt_existing();
+  else if (!s.options.resume) write_frame_now(s, o, *results.state);
+}
+
+/// Trouble present from the start (particles created overlapping): told before the first step.
+/// With frames written together no rank holds the whole state: each checks its share.
+void check_start(const RunSetup& s, const WholeResults& results) {
+  std::optional<NumericalError> found;
+  try {
+    if (s.collective) check_numerics(s.stepped, s.state, s.work, s.model.max_overlap_ratio);
+    else check_numerics(s.model, *results.state, *results.work, s.model.max_overlap_ratio);
+  } catch (const NumericalError& e) {
+    found = e;
+  }
+  if (s.collective && s.domain->any(found.has_value()) && !found)
+    found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", s.state.time));
+  if (found) {
+    if (s.model.stop_on_trouble) throw *found;
+    fmt::print(s.writer ? s.log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", found->what());
+  }
+}
+
+/// The step loop begun: SIGINT and SIGTERM caught (they stop the run at a step, with a
+/// checkpoint), an energy check that cannot be used told, losses counted from here, the wall
+/// clock read.
+LoopStart start_loop(const RunSetup& s, Watches& w) {
+  stop_signal = 0;
+  const SignalHandler previous_int = std::signal(SIGINT, on_stop_signal);
+  const SignalHandler previous_term = std::signal(SIGTERM, on_stop_signal);
+  if (!w.energy.active() && s.writer) fmt::print(s.log, "  energy check: off ({})\n", w.energy.source());
+  w.lost_reported = s.state.lost, w.warnings = 0;
+  return LoopStart{previous_int, previous_term, Clock::now()};
+}
+
+void restore_signals(const LoopStart& loop_start) {
+  std::signal(SIGINT, loop_start.previous_int);
+  std::signal(SIGTERM, loop_start.previous_term);
+}
+
+/// The rows so far, the events and the ParaView script (at checkpoints, on trouble, at the end).
+void write_tables(const RunParts& parts) {
+  const std::string& out = parts.setup.out;
+  write_file_atomically(out + "/scalars.csv", scalars_csv(parts.setup.model, parts.summary.scalars));
+  write_file_atomically(out + "/events.csv", events_csv(parts.watches.events.fired()));
+  if (parts.outputs.frames) write_paraview_script(out);
+}
+
+/// Numerical trouble found by a check: the run stops with RunStopped (numerical_trouble: stop)
+/// or goes on with a warning (the first 20 told).
+void on_trouble(RunParts& parts, const NumericalError& e) {
+  const RunSetup& s = parts.setup;
+  RunSummary& summary = parts.summary;
+  if (s.model.stop_on_trouble) {
+    // Keep what was computed: the rows so far and a run record that says why it ended (the last
+    // checkpoint stays as it was).
+    summary.stopped = fmt::format("numerical trouble: {}", e.what());
+    summary.steps = s.state.step - parts.schedule.first_step;
+    summary.events = parts.watches.events.fired();
+    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - parts.loop_start.start).count();
+    if (s.options.write_files && s.writer) {
+      try {
+        write_tables(parts);
+        write_file_atomically(s.out + "/run_info.yaml", run_info(s.model, s.options, s.run_id) +
+                                                            fmt::format("end:\n  completed: false\n  time_s: {:.17g}\n  step: {}\n  stopped: {}\n",
+                                                                        s.state.time, s.state.step, yaml_quoted(summary.stopped)));
+      } catch (const std::exception&) {
+      }
+    }
+    restore_signals(parts.loop_start);
+    throw RunStopped(e, summary);
+  }
+  if (parts.watches.warnings++ < 20) fmt::print(s.writer ? s.log : std::cerr, "  WARNING (numerical_trouble: warn, the run goes on): {}\n", e.what());
+}
+
+/// Particles that left the domain, told at the first loss and then at each tenfold.
+void tell_losses(RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const State& state = s.state;
+  Domain* const domain = s.domain;
+  std::int64_t& lost_reported = parts.watches.lost_reported;
+  // Under domain decomposition the count is every rank's as of the last row, and the
+  // particle named is the last the root knows of (its own, or of the last gathered state).
+  const std::int64_t lost_now = domain ? parts.totals.lost : state.lost;
+  if (s.writer && lost_now > lost_reported) {
+    const auto& p = state.lost > 0 || !domain ? state.last_lost : parts.results.state->last_lost;
+    const bool named = state.lost > 0 || (domain && parts.results.state->lost > 0);
+    // The first loss, then each tenfold: a leak is told, not repeated every step.
+    if (lost_reported == 0 || lost_now >= 10 * lost_reported) {
+      fmt::print(s.log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; {}Likely "
+                        "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
+                        "large that particles pass through a wall\n",
+                 state.time, lost_now,
+                 named ? fmt::format("the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. ", p.id,
+                                     p.x, p.y, p.z, p.vx, p.vy, p.vz)
+                       : "");
+      lost_reported = lost_now;
+    }
+  }
+}
+
+/// The checks at a step that checks: numerical trouble, first arrivals, particles lost.
+void check_step(RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const Model& model = s.model;
+  const State& state = s.state;
+  Domain* const domain = s.domain;
+  Watches& w = parts.watches;
+  // Under domain decomposition every rank's energy, summed before any rank may throw; the
+  // root judges it.
+  const double energy_total = domain && w.energy.active() ? domain->sum(mechanical_energy(s.stepped, state)) : 0.0;
+  std::optional<NumericalError> found;
+  try {
+    check_numerics(s.stepped, state, s.work, model.max_overlap_ratio);
+    if (!domain) w.energy.check(model, state);
+    else if (s.writer) w.energy.check(model, state, energy_total);
+  } catch (const NumericalError& e) {
+    found = e;
+  }
+  if (domain && domain->any(found.has_value()) && !found)
+    found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
+  if (found) on_trouble(parts, *found);
+  if (!domain && w.events.check(s.stepped, state, w.last_check) && s.writer && s.options.progress)
+    for (auto e = w.events.fired().rbegin(); e != w.events.fired().rend() && e->step > state.step - parts.schedule.check_every; ++e)
+      fmt::print(s.log, "  t = {:.6g} s (step {}): {} (particle {})\n", e->time, e->step, e->what, e->particle);
+  w.last_check = state.time;
+  tell_losses(parts);
+}
+
+/// A checkpoint with the tables: every rank's share committed by the root (domain), or the whole state.
+void write_checkpoint(RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const State& state = s.state;
+  Domain* const domain = s.domain;
+  if (domain) {
+    // Every rank's share on disk before the root names the step: a failed write on any rank
+    // stops every rank, the last complete checkpoint kept.
+    std::string failed;
+    try {
+      save_checkpoint_share(s.out, s.model, state.step, domain->rank(), domain->ranks(), pack_share(state, s.stepped.history_width));
+    } catch (const std::exception& e) {
+      failed = e.what();
+    }
+    if (domain->any(!failed.empty()))
+      throw std::runtime_error(failed.empty() ? fmt::format("t = {:.6g} s: another rank could not write its checkpoint share (its log says why)", state.time)
+                                              : failed);
+    if (s.writer) {
+      commit_checkpoint_shares(s.out, s.model, state, s.run_id);
+      write_tables(parts);
+    }
+  } else if (s.writer) {
+    save_whole_checkpoint(s.out, s.model, *parts.results.state, s.run_id);
+    write_tables(parts);
+  }
+}
+
+/// The progress line: simulated time, particles, speed and the time left.
+void report_progress(const RunParts& parts, Clock::time_point now, std::int64_t particle_steps) {
+  const RunSetup& s = parts.setup;
+  const State& state = s.state;
+  const Schedule& schedule = parts.schedule;
+  const double elapsed = std::chrono::duration<double>(now - parts.loop_start.start).count();
+  const std::int64_t done = state.step - schedule.first_step;
+  const double left = elapsed / static_cast<double>(done) * static_cast<double>(schedule.last_step - state.step);
+  fmt::print(s.log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
+             state.time, s.duration, 100.0 * done / std::max<std::int64_t>(schedule.total, 1),
+             s.domain ? static_cast<std::size_t>(parts.totals.particles) : state.size(), particle_steps / elapsed,
+             format_duration(left));
+  s.log.flush();
+}
+
+// Steps until the next one that checks, records or writes run as one advance() (each closing
+// kick gives the next step's drift, step.h); under domain decomposition one at a time.
+std::int64_t steps_to_next_event(const Schedule& schedule, const State& state) {
+  std::int64_t steps = schedule.last_step - state.step;
+  for (const std::int64_t every_n : {schedule.check_every, schedule.every, schedule.frame_every, schedule.checkpoint_every})
+    if (every_n > 0) steps = std::min(steps, every_n - state.step % every_n);
+  return std::max<std::int64_t>(steps, 1);
+}
+
+/// The steps to the end, or to a stop by a signal: after each run of steps, what is due at the
+/// step it reached. Returns the particle-steps run (every rank's under domain decomposition).
+std::int64_t run_steps(RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const Model& model = s.model;
+  const RunOptions& options = s.options;
+  State& state = s.state;
+  Domain* const domain = s.domain;
+  const bool writer = s.writer, collective = s.collective;
+  const Schedule schedule = parts.schedule;  // a copy: the loop reads it at every step
+  const auto start = parts.loop_start.start;
   auto last_progress = start;
   // What a kill (SIGKILL, the OOM killer, a power cut) may cost: the rows since the last save
   // (output.rows_seconds of wall time) and the computing since the last checkpoint
   // (output.checkpoint_seconds, or checkpoint_every).
   auto last_rows_saved = start, last_checkpoint = start;
-  const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   std::int64_t particle_steps = 0;
   std::int64_t loop_frames = 0;  // frames written in the loop; on_frame follows every render_every-th
-  // Steps until the next one that checks, records or writes run as one advance() (each closing
-  // kick gives the next step's drift, step.h); under domain decomposition one at a time.
-  const auto steps_to_next_event = [&] {
-    std::int64_t steps = last_step - state.step;
-    for (const std::int64_t every_n : {check_every, every, frame_every, checkpoint_every})
-      if (every_n > 0) steps = std::min(steps, every_n - state.step % every_n);
-    return std::max<std::int64_t>(steps, 1);
-  };
-  while (state.step < last_step) {
+  while (state.step < schedule.last_step) {
     if (domain) {
-      step(stepped, state, work);
-      particle_steps += static_cast<std::int64_t>(particles_now);
+      step(s.stepped, state, s.work);
+      particle_steps += static_cast<std::int64_t>(parts.totals.particles);
     } else {
-      particle_steps += advance(stepped, state, work, steps_to_next_event());
+      particle_steps += advance(s.stepped, state, s.work, steps_to_next_event(schedule, state));
     }
-    const bool last = state.step == last_step;
-    const bool check_due = state.step % check_every == 0 || last;
+    const bool last = state.step == schedule.last_step;
+    const bool check_due = state.step % schedule.check_every == 0 || last;
     // A signal stops every rank at the same step.
     const bool stopping = domain ? check_due && domain->any(stop_signal != 0) : stop_signal != 0;
-    const bool scalars_due = state.step % every == 0 || last;
-    const bool frame_due = options.write_files && (state.step % frame_every == 0 || last);
+    const bool scalars_due = state.step % schedule.every == 0 || last;
+    const bool frame_due = options.write_files && (state.step % schedule.frame_every == 0 || last);
     // A checkpoint on the wall clock: the root's clock decides, for every rank at the same step.
     bool checkpoint_timed = options.write_files && model.output.checkpoint_seconds > 0 && !last &&
                             (!domain || check_due) && writer && seconds_since(last_checkpoint) >= model.output.checkpoint_seconds;
     if (domain && check_due) checkpoint_timed = domain->any(checkpoint_timed);
-    const bool checkpoint_due = options.write_files && ((checkpoint_every && state.step % checkpoint_every == 0) || stopping || checkpoint_timed);
+    const bool checkpoint_due =
+        options.write_files && ((schedule.checkpoint_every && state.step % schedule.checkpoint_every == 0) || stopping || checkpoint_timed);
     if (checkpoint_due) last_checkpoint = Clock::now(), last_rows_saved = last_checkpoint;
     const bool render_due = frame_due && options.on_frame &&
                             (last || (model.output.render_every > 0 && loop_frames % model.output.render_every == 0));
     if (frame_due) ++loop_frames;
     // A checkpoint needs no gather: each rank writes its share (checkpoint.h); nor does a frame
     // the ranks write together.
-    if (domain && ((frame_due && !collective) || render_due || last || stopping)) gather_whole();
-    if (check_due) {
-      // Under domain decomposition every rank's energy, summed before any rank may throw; the
-      // root judges it.
-      const double energy_total = domain && energy.active() ? domain->sum(mechanical_energy(stepped, state)) : 0.0;
-      std::optional<NumericalError> found;
-      try {
-        check_numerics(stepped, state, work, model.max_overlap_ratio);
-        if (!domain) energy.check(model, state);
-        else if (writer) energy.check(model, state, energy_total);
-      } catch (const NumericalError& e) {
-        found = e;
-      }
-      if (domain && domain->any(found.has_value()) && !found)
-        found = NumericalError(fmt::format("t = {:.6g} s: another rank found numerical trouble (its message is on standard error)", state.time));
-      if (found) trouble(*found);
-      if (!domain && events.check(stepped, state, last_check) && writer && options.progress)
-        for (auto e = events.fired().rbegin(); e != events.fired().rend() && e->step > state.step - check_every; ++e)
-          fmt::print(log, "  t = {:.6g} s (step {}): {} (particle {})\n", e->time, e->step, e->what, e->particle);
-      last_check = state.time;
-      // Under domain decomposition the count is every rank's as of the last row, and the
-      // particle named is the last the root knows of (its own, or of the last gathered state).
-      const std::int64_t lost_now = domain ? lost_total : state.lost;
-      if (writer && lost_now > lost_reported) {
-        const auto& p = state.lost > 0 || !domain ? state.last_lost : results->last_lost;
-        const bool named = state.lost > 0 || (domain && results->lost > 0);
-        // The first loss, then each tenfold: a leak is told, not repeated every step.
-        if (lost_reported == 0 || lost_now >= 10 * lost_reported) {
-          fmt::print(log, "  WARNING: t = {:.6g} s: {} particles have left the domain (simulation.domain) and were removed; {}Likely "
-                          "causes: an opening in the walls, a wall that does not reach the domain's edge, or a time step so "
-                          "large that particles pass through a wall\n",
-                     state.time, lost_now,
-                     named ? fmt::format("the last, particle {}, at [{:.4g}, {:.4g}, {:.4g}] m moving at [{:.3g}, {:.3g}, {:.3g}] m/s. ", p.id,
-                                         p.x, p.y, p.z, p.vx, p.vy, p.vz)
-                           : "");
-          lost_reported = lost_now;
-        }
-      }
-    }
+    if (domain && ((frame_due && !collective) || render_due || last || stopping)) gather_whole(s, parts.results);
+    if (check_due) check_step(parts);
     if (scalars_due) {
-      Scalars row = measure_row();
-      particles_now = static_cast<double>(row.particles);
-      if (writer) summary.scalars.push_back(std::move(row));
+      add_row(s, parts.summary, parts.totals);
       if (writer && options.write_files && !checkpoint_due && !last && model.output.rows_seconds > 0 &&
           seconds_since(last_rows_saved) >= model.output.rows_seconds) {
-        write_tables();
+        write_tables(parts);
         last_rows_saved = Clock::now();
       }
     }
-    if (frames && frame_due) {
-      write_frame_now(*results);
-      if (render_due && writer) options.on_frame(model, *results, *results_work, out, last);
+    if (parts.outputs.frames && frame_due) {
+      const WholeResults& results = parts.results;
+      write_frame_now(s, parts.outputs, *results.state);
+      if (render_due && writer) options.on_frame(model, *results.state, *results.work, s.out, last);
     }
-    if (checkpoint_due && domain) {
-      // Every rank's share on disk before the root names the step: a failed write on any rank
-      // stops every rank, the last complete checkpoint kept.
-      std::string failed;
-      try {
-        save_checkpoint_share(out, model, state.step, domain->rank(), domain->ranks(), pack_share(state, stepped.history_width));
-      } catch (const std::exception& e) {
-        failed = e.what();
-      }
-      if (domain->any(!failed.empty()))
-        throw std::runtime_error(failed.empty() ? fmt::format("t = {:.6g} s: another rank could not write its checkpoint share (its log says why)", state.time)
-                                                : failed);
-      if (writer) {
-        commit_checkpoint_shares(out, model, state, run_id);
-        write_tables();
-      }
-    } else if (checkpoint_due && writer) {
-      save_whole_checkpoint(out, model, *results, run_id);
-      write_tables();
-    }
+    if (checkpoint_due) write_checkpoint(parts);
     if (stopping) {
-      summary.stopped = fmt::format("stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume", int(stop_signal), state.time);
+      parts.summary.stopped = fmt::format("stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume", int(stop_signal), state.time);
       if (writer)
-        fmt::print(log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
+        fmt::print(s.log, "  stopped by signal {} at t = {:.6g} s; checkpoint written, resume with --resume\n", int(stop_signal),
                    state.time);
       break;
     }
     const auto now = Clock::now();
     if (writer && options.progress && std::chrono::duration<double>(now - last_progress).count() >= model.output.progress_seconds) {
       last_progress = now;
-      const double elapsed = std::chrono::duration<double>(now - start).count();
-      const std::int64_t done = state.step - first_step;
-      const double left = elapsed / static_cast<double>(done) * static_cast<double>(last_step - state.step);
-      fmt::print(log, "  t = {:.4g} / {:.4g} s ({:.0f} %), {} particles, {:.3g} particle-steps/s, time left {}\n",
-                 state.time, duration, 100.0 * done / std::max<std::int64_t>(total, 1), domain ? static_cast<std::size_t>(particles_now) : state.size(),
-                 particle_steps / elapsed,
-                 format_duration(left));
-      log.flush();
+      report_progress(parts, now, particle_steps);
     }
   }
-  std::signal(SIGINT, previous_int);
-  std::signal(SIGTERM, previous_term);
-  if (domain && !gathered) gather_whole();  // no step was left to run (a resumed run at its end)
-  summary.steps = state.step - first_step;
-  summary.events = events.fired();
-  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
-  if (!writer) return summary;
+  return particle_steps;
+}
 
-  const State& final_state = *results;
+/// The loop left: the signal handlers put back, the whole state gathered if no step was, and the
+/// summary's counts.
+void end_loop(RunParts& parts, std::int64_t particle_steps) {
+  const RunSetup& s = parts.setup;
+  RunSummary& summary = parts.summary;
+  restore_signals(parts.loop_start);
+  if (s.domain && !parts.results.gathered) gather_whole(s, parts.results);  // no step was left to run (a resumed run at its end)
+  summary.steps = s.state.step - parts.schedule.first_step;
+  summary.events = parts.watches.events.fired();
+  summary.wall_seconds = std::chrono::duration<double>(Clock::now() - parts.loop_start.start).count();
+  summary.particle_steps_per_second = summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0;
+}
+
+/// The log's account of the run: steps and speed, the end state, each inlet's and outlet's totals.
+void tell_end(const RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const Model& model = s.model;
+  const RunSummary& summary = parts.summary;
+  const State& final_state = *parts.results.state;
   const Scalars& final_row = summary.scalars.back();
-  fmt::print(log, "  done: {} steps to t = {:.6g} s in {:.2f} s ({:.3g} particle-steps/s, {} neighbour-list rebuilds)\n",
-             summary.steps, state.time, summary.wall_seconds, summary.particle_steps_per_second, work.rebuilds);
-  fmt::print(log, "  end: {} particles, {} contacts, kinetic energy {:.4g} J, max overlap {:.2g} % of radius{}\n",
+  fmt::print(s.log, "  done: {} steps to t = {:.6g} s in {:.2f} s ({:.3g} particle-steps/s, {} neighbour-list rebuilds)\n",
+             summary.steps, s.state.time, summary.wall_seconds, summary.particle_steps_per_second, s.work.rebuilds);
+  fmt::print(s.log, "  end: {} particles, {} contacts, kinetic energy {:.4g} J, max overlap {:.2g} % of radius{}\n",
              final_row.particles, final_row.contacts, final_row.kinetic_translation + final_row.kinetic_rotation,
              100 * final_row.max_overlap_ratio, final_state.lost ? fmt::format(", {} particles left the domain", final_state.lost) : "");
   for (size_t k = 0; k < model.inlets.size(); ++k)
-    fmt::print(log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, final_state.inlets[k].inserted,
+    fmt::print(s.log, "  inlet {}: {} particles, {:.4g} kg{}\n", model.inlets[k].spec.name, final_state.inlets[k].inserted,
                final_state.inlets[k].inserted_mass,
                final_state.inlets[k].failed ? fmt::format(" ({} insertions found the region full)", final_state.inlets[k].failed) : "");
   for (size_t k = 0; k < model.outlets.size(); ++k)
-    fmt::print(log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, final_state.outlets[k].removed,
+    fmt::print(s.log, "  outlet {}: {} particles, {:.4g} kg\n", model.outlets[k].name, final_state.outlets[k].removed,
                final_state.outlets[k].removed_mass);
-  if (options.write_files && !model.meshes.empty()) write_mesh_records(model, final_state, out);
-  if (options.write_files) {
-    write_tables();
-    // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
-    write_file_atomically(out + "/run_info.yaml",
-                          run_info(model, options, run_id) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
-                                                        "  state_hash: {:016x}\n",
-                                                        state.step >= last_step ? "true" : "false", state.time, state.step,
-                                                        final_state.size(), state_hash(final_state, model.history_width)));
-    fmt::print(log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", out,
-               frames ? frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", out));
+}
+
+/// The files of the run's end: the mesh records, the tables and the run record with the end state.
+void write_results(const RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const Model& model = s.model;
+  const State& state = s.state;
+  const State& final_state = *parts.results.state;
+  if (!model.meshes.empty()) write_mesh_records(model, final_state, s.out);
+  write_tables(parts);
+  // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
+  write_file_atomically(s.out + "/run_info.yaml",
+                        run_info(model, s.options, s.run_id) + fmt::format("end:\n  completed: {}\n  time_s: {:.17g}\n  step: {}\n  particles: {}\n"
+                                                      "  state_hash: {:016x}\n",
+                                                      state.step >= parts.schedule.last_step ? "true" : "false", state.time, state.step,
+                                                      final_state.size(), state_hash(final_state, model.history_width)));
+  fmt::print(s.log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", s.out,
+             parts.outputs.frames ? parts.outputs.frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", s.out));
+}
+
+/// Under domain decomposition: what it cost rank 0, and how the frames were written.
+void tell_domain(const RunParts& parts) {
+  const RunSetup& s = parts.setup;
+  const Outputs& o = parts.outputs;
+  fmt::print(s.log, "  domain (rank 0): {}\n", s.domain->statistics());
+  if (o.frames)
+    fmt::print(s.log, "  frames: {} {}, {:.3g} s on rank 0\n", o.frames->frames().size(),
+               s.collective ? fmt::format("written together by {} ranks (parallel HDF5)", s.domain->ranks()) : "gathered on rank 0", o.frame_seconds);
+}
+
+}  // namespace
+
+RunSummary run(const Model& model, State& state, Workspace& work, const RunOptions& options, std::ostream& log) {
+  RunSummary summary;
+  RunSetup setup = plan_run(model, state, work, options, log, summary);
+  if (options.write_files) claim_folder(setup, summary);
+  // The run's id, in run_info.yaml and every checkpoint: a new one, or the resumed run's.
+  setup.run_id = options.resume ? 0 : new_run_id();
+  if (options.resume) {
+    resume_from_checkpoint(setup, summary);
+    if (summary.already_complete) return summary;
   }
-  if (domain) fmt::print(log, "  domain (rank 0): {}\n", domain->statistics());
-  if (domain && frames)
-    fmt::print(log, "  frames: {} {}, {:.3g} s on rank 0\n", frames->frames().size(),
-               collective ? fmt::format("written together by {} ranks (parallel HDF5)", domain->ranks()) : "gathered on rank 0", frame_seconds);
-  if (domain) {  // the caller (reports, renders) gets the whole state, with this instant's forces
-    state = std::move(whole->evaluated);
-    work = std::move(whole->work);
+  if (setup.writer) print_setup(model, state, log);
+  Watches watches = watch_run(setup);
+  if (setup.domain) setup.domain->distribute(state);
+  prepare(setup.stepped, state, work);
+
+  WholeResults results{std::nullopt, &state, &work, false};
+  RowTotals totals{state.lost, setup.domain ? setup.domain->sum(static_cast<double>(state.owned())) : 0.0};
+  if (!setup.collective) gather_whole(setup, results);
+  if (!options.resume) add_row(setup, summary, totals);
+  const Schedule schedule = schedule_steps(setup);
+
+  Outputs outputs;
+  if (options.write_files) begin_writing(setup, summary);
+  if (options.write_files && (setup.writer || setup.collective)) open_outputs(setup, results, outputs);
+  if (!options.resume && (setup.writer || setup.collective)) check_start(setup, results);
+
+  const LoopStart loop_start = start_loop(setup, watches);
+  RunParts parts{setup, summary, watches, results, totals, schedule, outputs, loop_start};
+  end_loop(parts, run_steps(parts));
+  if (!setup.writer) return summary;
+
+  tell_end(parts);
+  if (options.write_files) write_results(parts);
+  if (setup.domain) tell_domain(parts);
+  if (setup.domain) {  // the caller (reports, renders) gets the whole state, with this instant's forces
+    state = std::move(results.whole->evaluated);
+    work = std::move(results.whole->work);
   }
   return summary;
 }
