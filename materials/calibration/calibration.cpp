@@ -285,25 +285,70 @@ std::vector<std::string> implausible_fits(const MaterialModel& model, const std:
   return keys;
 }
 
-CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
-                            const CalibrationOptions& given, const Comparison* before, const EarlierPoints& earlier) {
-  const Clock::time_point t0 = Clock::now();
-  CalibrationOptions options = given;  // a budget may reduce it
-  CalibrationResult result;
+namespace {
+
+/// The numeric terms of the first comparison: what the surrogate predicts and the fit matches.
+struct Targets {
+  std::vector<std::string> names;          ///< term names (experiment/observable)
+  Eigen::VectorXd measured_values, sigma;  ///< (terms) measured value; measured and simulation noise combined
+  std::map<std::string, int> index;        ///< term name -> its place in names
+};
+
+/// What every phase after the first comparison reads: the inputs as the walls' first stage and the
+/// budget left them, and the size of a surrogate round.
+struct Fit {
+  const MaterialModel& model;                   ///< with the walls' first stage
+  const MeasurementSet& measured;
+  const std::vector<FitParameter>& parameters;
+  const CalibrationOptions& options;            ///< as the budget plan left them
+  const Targets& targets;
+  int p;                                        ///< parameters fitted
+  int points;                                   ///< design points per round
+  int rounds;                                   ///< surrogate rounds before any refinement
+};
+
+/// The surrogate rounds' state: the box searched, its optimum, and every point simulated so far.
+struct Search {
+  std::vector<FitParameter> box;           ///< the box of the round running
+  Eigen::VectorXd x_best;                  ///< (p) the last optimum, physical units
+  Surrogate full_range;                    ///< of round 1, over the whole parameter box: drawn in the contour maps
+  Eigen::MatrixXd all_points, all_values;  ///< (points simulated x p), (points simulated x terms)
+  std::vector<Eigen::VectorXd> included;   ///< points the first round takes from EarlierPoints::include
+  void add_point(const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+    all_points.conservativeResize(all_points.rows() + 1, Eigen::NoChange);
+    all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
+    all_points.row(all_points.rows() - 1) = x.transpose();
+    all_values.row(all_values.rows() - 1) = v.transpose();
+  }
+};
+
+/// The wall pairs' restitution fitted first, and the pairs it gave another value ("steel.restitution 0.6").
+struct WallStage {
+  detail::WallsFirst first;
+  std::vector<std::string> moved;
+};
+
+/// The parameters fitted (the model's tunable ranges when none are given) and their start values.
+void choose_parameters(const MaterialModel& given_model, std::vector<FitParameter>& parameters, CalibrationResult& result) {
   if (parameters.empty()) parameters = fit_parameters(given_model);
   if (parameters.empty()) throw std::invalid_argument("nothing to calibrate: the material declares no `tunable:` ranges and none were given");
   result.parameters = parameters;
-  const int p = static_cast<int>(parameters.size());
   for (const FitParameter& f : parameters) result.start.push_back(get_parameter(given_model, f.key));
+}
+
+/// The walls' first stage, and the wall pairs it moved.
+WallStage fit_walls_stage(const MaterialModel& given_model, const MeasurementSet& measured, const std::vector<FitParameter>& parameters,
+                          const EarlierPoints& earlier, CalibrationOptions& options, CalibrationResult& result) {
+  const int p = static_cast<int>(parameters.size());
   // Stage one: the wall pairs' restitution from their drop tests (walls_first.cpp). The design
   // starts from that model; `before` stays the comparison of the model as given.
-  const detail::WallsFirst walls = detail::fit_walls_first(given_model, measured, parameters, options);
-  const MaterialModel& model = walls.model;
-  result.words = walls.words;
+  WallStage stage{detail::fit_walls_first(given_model, measured, parameters, options), {}};
+  const MaterialModel& model = stage.first.model;
+  result.words = stage.first.words;
   // Wall pairs the first stage gave another value: points simulated before (EarlierPoints::known)
   // had the old one and are left out below; a design reduced to stand beside them
   // (design_points_beside_known) takes the full rule again.
-  std::vector<std::string> moved;
+  std::vector<std::string>& moved = stage.moved;
   for (size_t k = 0; k < model.wall_pairs.size() && k < given_model.wall_pairs.size(); ++k)
     for (const auto& [key, value] : model.wall_pairs[k].params)
       if (const auto it = given_model.wall_pairs[k].params.find(key); it == given_model.wall_pairs[k].params.end() || it->second != value)
@@ -311,15 +356,23 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                                                                                  : model.wall_pairs[k].material_a,
                                     key, value));
   if (!moved.empty() && !earlier.known.empty() && options.design_points > 0 && options.design_points <= basis_size(p)) options.design_points = 0;
+  return stage;
+}
 
-  const int n = static_cast<int>(measured.experiments.size());
-  const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
-  // The start, with replicas: its simulation noise stands for the noise everywhere.
+/// The start, with replicas: its simulation noise stands for the noise everywhere.
+void compare_start(const MaterialModel& given_model, const MeasurementSet& measured, const CalibrationOptions& options, const Comparison* before,
+                   CalibrationResult& result) {
   if (before) result.before = *before;
   else result.before = compare(given_model, measured, options), result.simulations += result.before.simulations();
+}
+
+/// With a budget, the options reduced to fit it and the words saying so; without, the whole plan
+/// in a progress line.
+std::string plan_for_budget(const CalibrationOptions& given, Clock::time_point t0, const detail::CommandScope& command, int n, int p,
+                            const Comparison& first, CalibrationOptions& options) {
   std::string budget_words;
   if (options.budget_seconds > 0) {
-    const BudgetPlan plan = plan_within_budget(options, result.before, p, 0, 0, seconds_since(t0));
+    const BudgetPlan plan = plan_within_budget(options, first, p, 0, 0, seconds_since(t0));
     options = plan.options;
     options.budget_seconds = 0;
     budget_words = fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
@@ -330,199 +383,272 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     // Without a budget the whole plan, at what the first comparison's simulations cost.
     CalibrationOptions unlimited = options;
     unlimited.budget_seconds = 1e12;
-    const BudgetPlan plan = plan_within_budget(unlimited, result.before, p, 0, 0, seconds_since(t0));
+    const BudgetPlan plan = plan_within_budget(unlimited, first, p, 0, 0, seconds_since(t0));
     options.progress(fmt::format("calibrate: the first comparison took {}; the calibration will take about {} more (give --budget to fit it "
                                  "into less)", detail::duration_text(seconds_since(t0)), detail::duration_text(plan.seconds)));
   }
+  return budget_words;
+}
+
+/// The numeric terms (not the outcomes) of the first comparison, with their combined sigma.
+Targets numeric_targets(const Comparison& first) {
   std::vector<Term> numeric;
-  for (const Term& t : result.before.terms)
+  for (const Term& t : first.terms)
     if (!t.is_outcome()) numeric.push_back(t);
   if (numeric.empty()) throw std::invalid_argument("no numeric observations to calibrate against");
-  std::vector<std::string> names;
-  Eigen::VectorXd measured_values(numeric.size()), sigma(numeric.size());
+  Targets targets;
+  targets.measured_values.resize(static_cast<Eigen::Index>(numeric.size()));
+  targets.sigma.resize(static_cast<Eigen::Index>(numeric.size()));
   std::map<std::string, double> sigma_sim;
   for (size_t i = 0; i < numeric.size(); ++i) {
-    names.push_back(numeric[i].name());
-    measured_values[i] = numeric[i].measured;
-    sigma[i] = std::sqrt(numeric[i].sigma_measured * numeric[i].sigma_measured + numeric[i].sigma_simulated * numeric[i].sigma_simulated);
+    targets.names.push_back(numeric[i].name());
+    targets.measured_values[i] = numeric[i].measured;
+    targets.sigma[i] = std::sqrt(numeric[i].sigma_measured * numeric[i].sigma_measured + numeric[i].sigma_simulated * numeric[i].sigma_simulated);
     sigma_sim[numeric[i].name()] = numeric[i].sigma_simulated;
   }
-  std::map<std::string, int> index;
-  for (size_t i = 0; i < names.size(); ++i) index[names[i]] = static_cast<int>(i);
+  for (size_t i = 0; i < targets.names.size(); ++i) targets.index[targets.names[i]] = static_cast<int>(i);
+  return targets;
+}
 
-  const int points = detail::design_points(options, p);
-  const int rounds = std::max(1, options.rounds);
-  Progress progress{options, "design"};
-  for (const Experiment& e : measured.experiments) progress.plan(e, rounds * points);
-  std::vector<FitParameter> box = parameters;
-  Eigen::VectorXd x_best(p);
-  for (int i = 0; i < p; ++i) x_best[i] = std::clamp(result.start[i], parameters[i].lowest(), parameters[i].highest());
-  Surrogate full_range;  // of round 1, over the whole parameter box: drawn in the contour maps
-  Eigen::MatrixXd all_points(0, p), all_values(0, static_cast<Eigen::Index>(names.size()));
-  const auto add_point = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
-    all_points.conservativeResize(all_points.rows() + 1, p);
-    all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
-    all_points.row(all_points.rows() - 1) = x.transpose();
-    all_values.row(all_values.rows() - 1) = v.transpose();
-  };
-  // A box `share` of the last box wide around x, inside the limits (at a limit it keeps its width).
-  const auto zoom = [&](const Eigen::VectorXd& x, const std::vector<FitParameter>& last, double share) {
-    std::vector<FitParameter> next = last;
-    for (int i = 0; i < p; ++i) {
-      const double lowest = parameters[i].lowest(), highest = parameters[i].highest();
-      const double half = 0.5 * share * (last[i].max - last[i].min);
-      const double lo = std::max(lowest, x[i] - half), hi = std::min(highest, x[i] + half);
-      next[i].min = lo, next[i].max = hi;
-      if (hi - lo < 2 * half) {
-        if (lo == lowest) next[i].max = std::min(highest, lo + 2 * half);
-        else next[i].min = std::max(lowest, hi - 2 * half);
-      }
+/// The design's simulations planned, the first box (the parameters' own) and the start as the
+/// last optimum, before any point is simulated.
+Search start_search(const Fit& fit, const std::vector<double>& start, Progress& progress) {
+  for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.rounds * fit.points);
+  Search search;
+  search.box = fit.parameters;
+  search.x_best.resize(fit.p);
+  for (int i = 0; i < fit.p; ++i) search.x_best[i] = std::clamp(start[i], fit.parameters[i].lowest(), fit.parameters[i].highest());
+  search.all_points.resize(0, fit.p);
+  search.all_values.resize(0, static_cast<Eigen::Index>(fit.targets.names.size()));
+  return search;
+}
+
+/// A box `share` of the last box wide around x, inside the limits (at a limit it keeps its width).
+std::vector<FitParameter> zoom(const std::vector<FitParameter>& parameters, const Eigen::VectorXd& x, const std::vector<FitParameter>& last,
+                               double share) {
+  const int p = static_cast<int>(parameters.size());
+  std::vector<FitParameter> next = last;
+  for (int i = 0; i < p; ++i) {
+    const double lowest = parameters[i].lowest(), highest = parameters[i].highest();
+    const double half = 0.5 * share * (last[i].max - last[i].min);
+    const double lo = std::max(lowest, x[i] - half), hi = std::min(highest, x[i] + half);
+    next[i].min = lo, next[i].max = hi;
+    if (hi - lo < 2 * half) {
+      if (lo == lowest) next[i].max = std::min(highest, lo + 2 * half);
+      else next[i].min = std::max(lowest, hi - 2 * half);
     }
-    return next;
-  };
-  // Known points: data from the start, where they hold a value of every term, unless the walls'
-  // first stage gave a wall pair another value than they were simulated with (a cohesive
-  // candidate holds the rebound down, so its drops ask for a livelier wall).
+  }
+  return next;
+}
+
+/// Known points: data from the start, where they hold a value of every term, unless the walls'
+/// first stage gave a wall pair another value than they were simulated with (a cohesive
+/// candidate holds the rebound down, so its drops ask for a livelier wall).
+void feed_known_points(const Fit& fit, const EarlierPoints& earlier, const std::vector<std::string>& moved, Search& search, CalibrationResult& result) {
+  const std::vector<std::string>& names = fit.targets.names;
   int known = 0;
   if (!moved.empty() && !earlier.known.empty()) {
     const bool one = earlier.known.size() == 1;
     result.words.push_back(fmt::format("The {} point{} simulated before {} left out: the drops gave {} a new value ({}).", earlier.known.size(),
                                        one ? "" : "s", one ? "was" : "were", moved.size() == 1 ? "a wall pair" : "wall pairs", join(moved)));
-    if (options.progress) options.progress("calibrate: " + result.words.back());
+    if (fit.options.progress) fit.options.progress("calibrate: " + result.words.back());
   }
   for (const SimulatedPoint& point : earlier.known) {
-    if (!moved.empty() || static_cast<int>(point.x.size()) != p) continue;
+    if (!moved.empty() || static_cast<int>(point.x.size()) != fit.p) continue;
     Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
     for (size_t i = 0; i < names.size(); ++i) {
       const auto it = point.values.find(names[i]);
       v[static_cast<Eigen::Index>(i)] = it == point.values.end() ? kNaN : it->second;
     }
-    if (v.allFinite()) add_point(Eigen::Map<const Eigen::VectorXd>(point.x.data(), p), v), ++known;
+    if (v.allFinite()) search.add_point(Eigen::Map<const Eigen::VectorXd>(point.x.data(), fit.p), v), ++known;
   }
   if (known > 0) {
     result.words.push_back(fmt::format("{} point{} simulated before, with a model this one equals there, fed the surrogate beside the "
                                        "design's own.",
                                        known, known == 1 ? "" : "s"));
-    if (options.progress) options.progress("calibrate: " + result.words.back());
+    if (fit.options.progress) fit.options.progress("calibrate: " + result.words.back());
   }
-  // One round: a Latin hypercube in `box`, every experiment at every point as one batch (common
-  // random numbers: the same packing seed everywhere); the surrogate over every point simulated so
-  // far inside the box; its optimum from several starts. A point whose simulation fails is
-  // skipped; bad input (CaseError) stops the calibration.
-  // The points the first round takes from `include`: inside the box, at most all but one.
+}
+
+/// The points the first round takes from `include`: inside the box, at most all but one.
+std::vector<Eigen::VectorXd> included_points(const Fit& fit, const EarlierPoints& earlier) {
   std::vector<Eigen::VectorXd> included;
   for (const std::vector<double>& x : earlier.include) {
-    if (static_cast<int>(x.size()) != p || static_cast<int>(included.size()) + 1 >= points) continue;
+    if (static_cast<int>(x.size()) != fit.p || static_cast<int>(included.size()) + 1 >= fit.points) continue;
     bool inside = true;
-    for (int i = 0; i < p; ++i) inside = inside && x[i] >= parameters[i].min && x[i] <= parameters[i].max;
-    if (inside) included.push_back(Eigen::Map<const Eigen::VectorXd>(x.data(), p));
+    for (int i = 0; i < fit.p; ++i) inside = inside && x[i] >= fit.parameters[i].min && x[i] <= fit.parameters[i].max;
+    if (inside) included.push_back(Eigen::Map<const Eigen::VectorXd>(x.data(), fit.p));
   }
-  const auto design_round = [&](int round) {
-    const int own = round == 0 ? points - static_cast<int>(included.size()) : points;
-    Eigen::MatrixXd design(points, p);
-    design.topRows(own) = latin_hypercube(box, own, options.seed + 7919u * static_cast<std::uint64_t>(round));
-    for (int k = own; k < points; ++k) design.row(k) = included[k - own].transpose();
-    Eigen::MatrixXd values(points, static_cast<Eigen::Index>(names.size()));
-    values.setConstant(kNaN);
-    std::vector<MaterialModel> models;
-    for (int k = 0; k < points; ++k) models.push_back(with_values(model, parameters, design.row(k).transpose()));
-    const size_t n_experiments = measured.experiments.size();
-    std::vector<Job> jobs;
-    for (int k = 0; k < points; ++k)
-      for (const Experiment& e : measured.experiments) jobs.push_back({&models[k], &e.setup, options.seed});
-    const std::vector<BatchOutcome> outcomes = run_batch(
-        jobs, options,
-        [&](size_t j, const BatchOutcome& b) {
-          const size_t k = j / n_experiments;
-          const Experiment& e = measured.experiments[j % n_experiments];
-          if (b.error == BatchOutcome::Error::input) return;
-          if (b.error != BatchOutcome::Error::none && options.progress)
-            options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, b.message));
-          progress.step(e, fmt::format("round {} point {} {}{}", round + 1, k + 1, e.id, b.stored ? ", stored" : ""), b.stored ? 0.0 : b.outcome.wall_seconds);
-        },
-        [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
-    for (int k = 0; k < points; ++k) {
-      bool ok = true;
-      for (size_t x = 0; x < n_experiments; ++x) {
-        const BatchOutcome& b = outcomes[k * n_experiments + x];
-        if (b.error == BatchOutcome::Error::input) rethrow(b);
-        if (b.error == BatchOutcome::Error::not_run) throw std::logic_error("calibration: the batch runner left a design simulation not run");
-        ++result.simulations;
-        if (b.error != BatchOutcome::Error::none) {
-          ok = false;
-          continue;
-        }
-        for (const auto& [obs, v] : b.outcome.observables) {
-          const auto it = index.find(measured.experiments[x].id + "/" + obs);
-          if (it != index.end()) values(k, it->second) = v;
-        }
-      }
-      // Every round's points feed the later surrogates when they lie in their box.
-      if (ok && values.row(k).allFinite()) add_point(design.row(k).transpose(), values.row(k).transpose());
-    }
-    std::vector<int> inside;
-    for (int k = 0; k < all_points.rows(); ++k) {
-      bool in = true;
-      for (int i = 0; i < p; ++i) in = in && all_points(k, i) >= box[i].min - 1e-12 && all_points(k, i) <= box[i].max + 1e-12;
-      if (in) inside.push_back(k);
-    }
-    if (static_cast<int>(inside.size()) < basis_size(p))
-      throw std::runtime_error(fmt::format("calibration: only {} of {} design points simulated; need {} for the surrogate", inside.size(), points, basis_size(p)));
-    Eigen::MatrixXd P(inside.size(), p), V(inside.size(), all_values.cols());
-    for (size_t r = 0; r < inside.size(); ++r) P.row(r) = all_points.row(inside[r]), V.row(r) = all_values.row(inside[r]);
-    result.surrogate = fit_surrogate(box, names, P, V, sigma);
-    if (round == 0) full_range = result.surrogate;
-    // Starts: the best design points, the centre of the box and the last optimum when inside.
-    SurrogateObjective objective{&result.surrogate, measured_values, sigma};
-    std::vector<std::pair<double, int>> ranked;
-    for (int r = 0; r < P.rows(); ++r) ranked.push_back({objective.chi2(P.row(r).transpose()), r});
-    std::sort(ranked.begin(), ranked.end());
-    std::vector<Eigen::VectorXd> starts = {from_unit(box, Eigen::VectorXd::Zero(p))};
-    bool last_inside = true;
-    for (int i = 0; i < p; ++i) last_inside = last_inside && x_best[i] >= box[i].min && x_best[i] <= box[i].max;
-    if (last_inside) starts.push_back(x_best);
-    for (int s = 0; s < std::min<int>(options.starts, static_cast<int>(ranked.size())); ++s) starts.push_back(P.row(ranked[s].second).transpose());
-    x_best = minimise(objective, starts);
-    result.surrogate_chi2 = objective.chi2(x_best);
-    if (options.progress)
-      options.progress(fmt::format("round {}: surrogate optimum {} (surrogate chi^2/n {:.2f})", round + 1,
-                                   [&] {
-                                     std::vector<std::string> v;
-                                     for (int i = 0; i < p; ++i) v.push_back(fmt::format("{} = {:.4g}", parameters[i].key, x_best[i]));
-                                     return join(v);
-                                   }(),
-                                   result.surrogate_chi2 / static_cast<double>(names.size())));
-  };
-  for (int round = 0; round < rounds; ++round) {
-    if (round > 0) box = zoom(x_best, parameters, 0.25);  // a quarter of each range around the last optimum
-    design_round(round);
-  }
+  return included;
+}
 
-  // Confirmation with real simulations (replicas, and more packings where the verdict depends on them).
-  const auto confirm = [&] {
-    const Comparison c = compare(with_values(model, parameters, x_best), measured, options);
-    result.simulations += c.simulations();
-    Eigen::VectorXd v(static_cast<Eigen::Index>(names.size()));
-    v.setConstant(kNaN);
-    for (const Term& t : c.terms)
-      if (const auto it = index.find(t.name()); it != index.end()) v[it->second] = t.simulated;
-    if (v.allFinite()) add_point(x_best, v);  // a point of the next surrogate, like a design point
-    return c;
-  };
-  result.after = confirm();
-  // Refinement: when the simulations miss what the surrogate predicted, or the optimum lies on an
-  // edge of the box that is not the parameter's limit, one more round in half the box around the
-  // best point simulated so far (the confirmed optimum or a design point), confirmed in turn.
-  const auto real_chi2 = [&](int row) { return ((all_values.row(row).transpose() - measured_values).array() / sigma.array()).square().sum(); };
-  for (int refine = 0; refine < options.refine_rounds; ++refine) {
-    const double real = result.after.chi2_per_n(), predicted = result.surrogate_chi2 / static_cast<double>(names.size());
-    const bool missed = real > options.fits_within_noise && real > 2 * predicted + 1;
-    std::vector<std::string> edges;
-    for (int i = 0; i < p; ++i) {
-      const double tol = 0.01 * (box[i].max - box[i].min);
-      if ((x_best[i] <= box[i].min + tol && box[i].min > parameters[i].lowest() + tol) || (x_best[i] >= box[i].max - tol && box[i].max < parameters[i].highest() - tol))
-        edges.push_back(parameters[i].key);
+/// The round's design points (points x p): a Latin hypercube in the box, and in the first round
+/// the points included from earlier simulations.
+Eigen::MatrixXd round_design(const Fit& fit, const Search& search, int round) {
+  const int own = round == 0 ? fit.points - static_cast<int>(search.included.size()) : fit.points;
+  Eigen::MatrixXd design(fit.points, fit.p);
+  design.topRows(own) = latin_hypercube(search.box, own, fit.options.seed + 7919u * static_cast<std::uint64_t>(round));
+  for (int k = own; k < fit.points; ++k) design.row(k) = search.included[k - own].transpose();
+  return design;
+}
+
+/// Every experiment at every design point as one batch; a point with a value of every term joins
+/// the points simulated so far.
+void simulate_design(const Fit& fit, const Eigen::MatrixXd& design, int round, Search& search, Progress& progress, CalibrationResult& result) {
+  const CalibrationOptions& options = fit.options;
+  const MeasurementSet& measured = fit.measured;
+  const int points = fit.points;
+  Eigen::MatrixXd values(points, static_cast<Eigen::Index>(fit.targets.names.size()));
+  values.setConstant(kNaN);
+  std::vector<MaterialModel> models;
+  for (int k = 0; k < points; ++k) models.push_back(with_values(fit.model, fit.parameters, design.row(k).transpose()));
+  const size_t n_experiments = measured.experiments.size();
+  std::vector<Job> jobs;
+  for (int k = 0; k < points; ++k)
+    for (const Experiment& e : measured.experiments) jobs.push_back({&models[k], &e.setup, options.seed});
+  const std::vector<BatchOutcome> outcomes = run_batch(
+      jobs, options,
+      [&](size_t j, const BatchOutcome& b) {
+        const size_t k = j / n_experiments;
+        const Experiment& e = measured.experiments[j % n_experiments];
+        if (b.error == BatchOutcome::Error::input) return;
+        if (b.error != BatchOutcome::Error::none && options.progress)
+          options.progress(fmt::format("design point {} skipped: {}: {}", k + 1, e.id, b.message));
+        progress.step(e, fmt::format("round {} point {} {}{}", round + 1, k + 1, e.id, b.stored ? ", stored" : ""), b.stored ? 0.0 : b.outcome.wall_seconds);
+      },
+      [](const BatchOutcome& b) { return b.error == BatchOutcome::Error::input; });
+  for (int k = 0; k < points; ++k) {
+    bool ok = true;
+    for (size_t x = 0; x < n_experiments; ++x) {
+      const BatchOutcome& b = outcomes[k * n_experiments + x];
+      if (b.error == BatchOutcome::Error::input) rethrow(b);
+      if (b.error == BatchOutcome::Error::not_run) throw std::logic_error("calibration: the batch runner left a design simulation not run");
+      ++result.simulations;
+      if (b.error != BatchOutcome::Error::none) {
+        ok = false;
+        continue;
+      }
+      for (const auto& [obs, v] : b.outcome.observables) {
+        const auto it = fit.targets.index.find(measured.experiments[x].id + "/" + obs);
+        if (it != fit.targets.index.end()) values(k, it->second) = v;
+      }
     }
+    // Every round's points feed the later surrogates when they lie in their box.
+    if (ok && values.row(k).allFinite()) search.add_point(design.row(k).transpose(), values.row(k).transpose());
+  }
+}
+
+/// The surrogate over every point simulated so far inside the box; returns those points (inside x p).
+Eigen::MatrixXd fit_round_surrogate(const Fit& fit, int round, Search& search, CalibrationResult& result) {
+  const int p = fit.p;
+  const std::vector<FitParameter>& box = search.box;
+  std::vector<int> inside;
+  for (int k = 0; k < search.all_points.rows(); ++k) {
+    bool in = true;
+    for (int i = 0; i < p; ++i) in = in && search.all_points(k, i) >= box[i].min - 1e-12 && search.all_points(k, i) <= box[i].max + 1e-12;
+    if (in) inside.push_back(k);
+  }
+  if (static_cast<int>(inside.size()) < basis_size(p))
+    throw std::runtime_error(fmt::format("calibration: only {} of {} design points simulated; need {} for the surrogate", inside.size(), fit.points, basis_size(p)));
+  Eigen::MatrixXd P(inside.size(), p), V(inside.size(), search.all_values.cols());
+  for (size_t r = 0; r < inside.size(); ++r) P.row(r) = search.all_points.row(inside[r]), V.row(r) = search.all_values.row(inside[r]);
+  result.surrogate = fit_surrogate(box, fit.targets.names, P, V, fit.targets.sigma);
+  if (round == 0) search.full_range = result.surrogate;
+  return P;
+}
+
+/// The surrogate's optimum from several starts, over the points P it was fitted to.
+void optimise_round(const Fit& fit, const Eigen::MatrixXd& P, int round, Search& search, CalibrationResult& result) {
+  const int p = fit.p;
+  const std::vector<FitParameter>& box = search.box;
+  // Starts: the best design points, the centre of the box and the last optimum when inside.
+  SurrogateObjective objective{&result.surrogate, fit.targets.measured_values, fit.targets.sigma};
+  std::vector<std::pair<double, int>> ranked;
+  for (int r = 0; r < P.rows(); ++r) ranked.push_back({objective.chi2(P.row(r).transpose()), r});
+  std::sort(ranked.begin(), ranked.end());
+  std::vector<Eigen::VectorXd> starts = {from_unit(box, Eigen::VectorXd::Zero(p))};
+  bool last_inside = true;
+  for (int i = 0; i < p; ++i) last_inside = last_inside && search.x_best[i] >= box[i].min && search.x_best[i] <= box[i].max;
+  if (last_inside) starts.push_back(search.x_best);
+  for (int s = 0; s < std::min<int>(fit.options.starts, static_cast<int>(ranked.size())); ++s) starts.push_back(P.row(ranked[s].second).transpose());
+  search.x_best = minimise(objective, starts);
+  result.surrogate_chi2 = objective.chi2(search.x_best);
+  if (fit.options.progress)
+    fit.options.progress(fmt::format("round {}: surrogate optimum {} (surrogate chi^2/n {:.2f})", round + 1,
+                                     [&] {
+                                       std::vector<std::string> v;
+                                       for (int i = 0; i < p; ++i) v.push_back(fmt::format("{} = {:.4g}", fit.parameters[i].key, search.x_best[i]));
+                                       return join(v);
+                                     }(),
+                                     result.surrogate_chi2 / static_cast<double>(fit.targets.names.size())));
+}
+
+/// One round: a Latin hypercube in `box`, every experiment at every point as one batch (common
+/// random numbers: the same packing seed everywhere); the surrogate over every point simulated so
+/// far inside the box; its optimum from several starts. A point whose simulation fails is
+/// skipped; bad input (CaseError) stops the calibration.
+void design_round(const Fit& fit, int round, Search& search, Progress& progress, CalibrationResult& result) {
+  const Eigen::MatrixXd design = round_design(fit, search, round);
+  simulate_design(fit, design, round, search, progress, result);
+  const Eigen::MatrixXd P = fit_round_surrogate(fit, round, search, result);
+  optimise_round(fit, P, round, search, result);
+}
+
+/// The surrogate rounds: the first over the parameters' own box, each later one around the last optimum.
+void run_rounds(const Fit& fit, Search& search, Progress& progress, CalibrationResult& result) {
+  for (int round = 0; round < fit.rounds; ++round) {
+    if (round > 0) search.box = zoom(fit.parameters, search.x_best, fit.parameters, 0.25);  // a quarter of each range around the last optimum
+    design_round(fit, round, search, progress, result);
+  }
+}
+
+/// Confirmation with real simulations (replicas, and more packings where the verdict depends on them).
+Comparison confirm_optimum(const Fit& fit, Search& search, CalibrationResult& result) {
+  const Comparison c = compare(with_values(fit.model, fit.parameters, search.x_best), fit.measured, fit.options);
+  result.simulations += c.simulations();
+  Eigen::VectorXd v(static_cast<Eigen::Index>(fit.targets.names.size()));
+  v.setConstant(kNaN);
+  for (const Term& t : c.terms)
+    if (const auto it = fit.targets.index.find(t.name()); it != fit.targets.index.end()) v[it->second] = t.simulated;
+  if (v.allFinite()) search.add_point(search.x_best, v);  // a point of the next surrogate, like a design point
+  return c;
+}
+
+/// chi^2 of the simulations at the point simulated in row `row`.
+double simulated_chi2(const Targets& targets, const Search& search, int row) {
+  return ((search.all_values.row(row).transpose() - targets.measured_values).array() / targets.sigma.array()).square().sum();
+}
+
+/// Keys whose optimum lies on an edge of the box that is not the parameter's limit.
+std::vector<std::string> edges_reached(const Fit& fit, const Search& search) {
+  const std::vector<FitParameter>& box = search.box;
+  std::vector<std::string> edges;
+  for (int i = 0; i < fit.p; ++i) {
+    const double tol = 0.01 * (box[i].max - box[i].min);
+    if ((search.x_best[i] <= box[i].min + tol && box[i].min > fit.parameters[i].lowest() + tol) ||
+        (search.x_best[i] >= box[i].max - tol && box[i].max < fit.parameters[i].highest() - tol))
+      edges.push_back(fit.parameters[i].key);
+  }
+  return edges;
+}
+
+/// The point simulated so far whose simulations lie nearest the measurements (the optimum when none was).
+Eigen::VectorXd best_simulated(const Fit& fit, const Search& search) {
+  int best_row = 0;
+  for (int r = 1; r < search.all_points.rows(); ++r)
+    if (simulated_chi2(fit.targets, search, r) < simulated_chi2(fit.targets, search, best_row)) best_row = r;
+  return search.all_points.rows() > 0 ? Eigen::VectorXd(search.all_points.row(best_row).transpose()) : search.x_best;
+}
+
+/// Refinement: when the simulations miss what the surrogate predicted, or the optimum lies on an
+/// edge of the box that is not the parameter's limit, one more round in half the box around the
+/// best point simulated so far (the confirmed optimum or a design point), confirmed in turn.
+void refine_around_best(const Fit& fit, Search& search, Progress& progress, CalibrationResult& result) {
+  const CalibrationOptions& options = fit.options;
+  for (int refine = 0; refine < options.refine_rounds; ++refine) {
+    const double real = result.after.chi2_per_n(), predicted = result.surrogate_chi2 / static_cast<double>(fit.targets.names.size());
+    const bool missed = real > options.fits_within_noise && real > 2 * predicted + 1;
+    const std::vector<std::string> edges = edges_reached(fit, search);
     if (!missed && edges.empty()) break;
     if (result.after.chi2 > options.no_rival_above_chi2 && result.surrogate_chi2 > options.no_rival_above_chi2) {
       result.words.push_back(fmt::format("Not refined: the simulations at the surrogate's optimum give chi^2 {:.1f} and the surrogate predicted "
@@ -531,39 +657,44 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
       if (options.progress) options.progress("calibrate: " + result.words.back());
       break;
     }
-    int best_row = 0;
-    for (int r = 1; r < all_points.rows(); ++r)
-      if (real_chi2(r) < real_chi2(best_row)) best_row = r;
-    const Eigen::VectorXd centre = all_points.rows() > 0 ? Eigen::VectorXd(all_points.row(best_row).transpose()) : x_best;
+    const Eigen::VectorXd centre = best_simulated(fit, search);
     const std::string why = missed ? fmt::format("the simulations at the surrogate's optimum give chi^2/n {:.2f} where it predicted {:.2f}", real, predicted)
                                    : fmt::format("the optimum lies on the edge of the searched box in {}", join(edges));
     const Comparison kept_after = result.after;
     const Surrogate kept_surrogate = result.surrogate;
-    const Eigen::VectorXd kept_x = x_best;
+    const Eigen::VectorXd kept_x = search.x_best;
     const double kept_chi2 = result.surrogate_chi2;
-    box = missed ? zoom(centre, box, 0.5) : zoom(x_best, box, 1.0);
+    search.box = missed ? zoom(fit.parameters, centre, search.box, 0.5) : zoom(fit.parameters, search.x_best, search.box, 1.0);
     if (options.progress) options.progress(fmt::format("calibrate: {}: one more round around the best point simulated so far", why));
-    const int n_experiments = static_cast<int>(measured.experiments.size());
-    for (const Experiment& e : measured.experiments) progress.plan(e, points);
-    if (detail::CommandProgress::shared().active()) detail::CommandProgress::shared().plan_more(n_experiments * (points + std::max(1, options.replicas)));
-    x_best = centre;
-    design_round(rounds + refine);
-    result.after = confirm();
+    const int n_experiments = static_cast<int>(fit.measured.experiments.size());
+    for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.points);
+    if (detail::CommandProgress::shared().active()) detail::CommandProgress::shared().plan_more(n_experiments * (fit.points + std::max(1, options.replicas)));
+    search.x_best = centre;
+    design_round(fit, fit.rounds + refine, search, progress, result);
+    result.after = confirm_optimum(fit, search, result);
     if (result.after.chi2 <= kept_after.chi2) {
       result.words.push_back(fmt::format("One more surrogate round: {}; refined, the simulations give chi^2/n {:.2f}.", why, result.after.chi2_per_n()));
     } else {
       result.words.push_back(fmt::format("One more surrogate round: {}; its optimum simulated gives chi^2/n {:.2f}, so the first optimum is kept.", why,
                                          result.after.chi2_per_n()));
-      result.after = kept_after, result.surrogate = kept_surrogate, x_best = kept_x, result.surrogate_chi2 = kept_chi2;
+      result.after = kept_after, result.surrogate = kept_surrogate, search.x_best = kept_x, result.surrogate_chi2 = kept_chi2;
       break;
     }
   }
-  for (int i = 0; i < p; ++i) result.value.push_back(x_best[i]);
-  result.fitted = with_values(model, parameters, x_best);
+}
 
-  // Uncertainty and identifiability from the surrogate's Jacobian at the optimum.
+/// The optimum as the result's values, and the model fitted with them.
+void keep_optimum(const Fit& fit, const Eigen::VectorXd& x_best, CalibrationResult& result) {
+  for (int i = 0; i < fit.p; ++i) result.value.push_back(x_best[i]);
+  result.fitted = with_values(fit.model, fit.parameters, x_best);
+}
+
+/// Uncertainty and identifiability from the surrogate's Jacobian at the optimum.
+void estimate_uncertainty(const Fit& fit, const Eigen::VectorXd& x_best, CalibrationResult& result) {
+  const int p = fit.p;
+  const std::vector<FitParameter>& parameters = fit.parameters;
   const Eigen::MatrixXd J = result.surrogate.jacobian(x_best);
-  const Eigen::VectorXd w = sigma.cwiseInverse().cwiseAbs2();
+  const Eigen::VectorXd w = fit.targets.sigma.cwiseInverse().cwiseAbs2();
   const Eigen::MatrixXd F = J.transpose() * w.asDiagonal() * J;
   Eigen::VectorXd half(p);
   for (int i = 0; i < p; ++i) half[i] = 0.5 * (parameters[i].highest() - parameters[i].lowest());
@@ -601,16 +732,25 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   }
   for (int i = 0; i < p; ++i)
     if (flagged[i]) result.unidentified.push_back(parameters[i].key);
+}
 
-  result.wall_seconds = seconds_since(t0);
-  for (Eigen::Index r = 0; r < all_points.rows(); ++r) {
+/// Every point simulated, with the simulated value of each term.
+void record_points(const Fit& fit, const Search& search, CalibrationResult& result) {
+  const std::vector<std::string>& names = fit.targets.names;
+  for (Eigen::Index r = 0; r < search.all_points.rows(); ++r) {
     SimulatedPoint point;
-    for (int i = 0; i < p; ++i) point.x.push_back(all_points(r, i));
-    for (size_t t = 0; t < names.size(); ++t) point.values[names[t]] = all_values(r, static_cast<Eigen::Index>(t));
+    for (int i = 0; i < fit.p; ++i) point.x.push_back(search.all_points(r, i));
+    for (size_t t = 0; t < names.size(); ++t) point.values[names[t]] = search.all_values(r, static_cast<Eigen::Index>(t));
     result.points.push_back(std::move(point));
   }
+}
 
-  // Words.
+/// Words: the fitted values, how far the fit came, correlations, identifiability, implausible
+/// values and surrogates that miss their points.
+void describe_fit(const Fit& fit, const std::string& budget_words, CalibrationResult& result) {
+  const int p = fit.p;
+  const std::vector<FitParameter>& parameters = fit.parameters;
+  const std::vector<std::string>& names = fit.targets.names;
   std::vector<std::string> fitted;
   for (int i = 0; i < p; ++i)
     fitted.push_back(fmt::format("{} = {:.4g} +- {:.2g} (start {:.4g}, range [{:g}, {:g}]{})", parameters[i].key, result.value[i], result.sigma[i],
@@ -623,7 +763,7 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   result.words.push_back(fmt::format("chi^2/n from {:.2f} at the start to {:.2f} at the fit (real simulations, n = {}); the surrogate predicted {:.2f}.",
                                      result.before.chi2_per_n(), result.after.chi2_per_n(), result.after.n,
                                      result.surrogate_chi2 / static_cast<double>(names.size())));
-  if (result.after.chi2_per_n() <= options.fits_within_noise) result.words.push_back("The fitted model reproduces the measurements within their noise.");
+  if (result.after.chi2_per_n() <= fit.options.fits_within_noise) result.words.push_back("The fitted model reproduces the measurements within their noise.");
   for (int i = 0; i < p; ++i)
     for (int j = i + 1; j < p; ++j)
       if (std::abs(result.correlation[i][j]) > 0.9)
@@ -635,11 +775,15 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
                                        "differently (Fig. 5: two tests whose contours cross).",
                                        join(result.unidentified), result.condition));
   else result.words.push_back(fmt::format("All parameters are identified (condition number {:.3g}).", result.condition));
-  result.implausible = implausible_fits(model, parameters, result.value, result.sigma, result.words);
+  result.implausible = implausible_fits(fit.model, parameters, result.value, result.sigma, result.words);
   for (size_t t = 0; t < names.size(); ++t)
     if (result.surrogate.fit_rms[t] > 1.0)
       result.words.push_back(fmt::format("The surrogate of {} misses its design points by {:.1f} sigma RMS: it is not quadratic over the box.", names[t],
                                          result.surrogate.fit_rms[t]));
+}
+
+/// The contour map of the first two parameters.
+void draw_contours(int p, const Surrogate& full_range, CalibrationResult& result) {
   if (p >= 2) {
     // The maps span the full range (round 1's surrogate), so every measured contour appears;
     // the result keeps the last round's surrogate.
@@ -647,6 +791,39 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
     wide.surrogate = full_range;
     result.contours.push_back(contour_map(wide, 0, 1));
   }
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
+                            const CalibrationOptions& given, const Comparison* before, const EarlierPoints& earlier) {
+  const Clock::time_point t0 = Clock::now();
+  CalibrationOptions options = given;  // a budget may reduce it
+  CalibrationResult result;
+  choose_parameters(given_model, parameters, result);
+  const int p = static_cast<int>(parameters.size());
+  const WallStage walls = fit_walls_stage(given_model, measured, parameters, earlier, options, result);
+
+  const int n = static_cast<int>(measured.experiments.size());
+  const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
+  compare_start(given_model, measured, options, before, result);
+  const std::string budget_words = plan_for_budget(given, t0, command, n, p, result.before, options);
+  const Targets targets = numeric_targets(result.before);
+
+  const Fit fit{walls.first.model, measured, parameters, options, targets, p, detail::design_points(options, p), std::max(1, options.rounds)};
+  Progress progress{options, "design"};
+  Search search = start_search(fit, result.start, progress);
+  feed_known_points(fit, earlier, walls.moved, search, result);
+  search.included = included_points(fit, earlier);
+  run_rounds(fit, search, progress, result);
+  result.after = confirm_optimum(fit, search, result);
+  refine_around_best(fit, search, progress, result);
+  keep_optimum(fit, search.x_best, result);
+  estimate_uncertainty(fit, search.x_best, result);
+  result.wall_seconds = seconds_since(t0);
+  record_points(fit, search, result);
+  describe_fit(fit, budget_words, result);
+  draw_contours(p, search.full_range, result);
   return result;
 }
 
