@@ -167,20 +167,29 @@ bool same_cycle(const Triangle& a, const Triangle& b) {
   return a == b || a == Triangle{b[1], b[2], b[0]} || a == Triangle{b[2], b[0], b[1]};
 }
 
-}  // namespace
+using Severity = MeshIssue::Severity;
 
-MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
-  using Severity = MeshIssue::Severity;
-  MeshReport report;
-  report.source = mesh.source;
-  report.triangles_in = mesh.triangles.size();
+/// Counts over the distinct edges, shared by the phases from the edge check to the final measures.
+struct EdgeCensus {
+  std::vector<EdgeUse> uses;            // of the triangles as oriented once check_orientable has run
+  std::vector<bool> on_open_edge;       // (n_triangles) touches a border or non-manifold edge
+  std::int64_t border_edges = 0;        // used by one triangle
+  std::int64_t non_manifold_edges = 0;  // used by more than two triangles
+  std::int64_t disagreeing = 0;         // manifold edges whose two triangles face opposite ways
+};
+
+/// The caller's triangles, each remembering its own index; no points yet.
+Work start_work(const TriangleMesh& mesh) {
   Work work;
   work.triangles = mesh.triangles;
   work.original.resize(mesh.triangles.size());
   std::iota(work.original.begin(), work.original.end(), 0);
-  const auto n_vertices = std::int64_t(mesh.vertices.size());
+  return work;
+}
 
-  // Indices outside the vertex array: the triangle cannot be drawn at all.
+/// Indices outside the vertex array: the triangle cannot be drawn at all.
+void remove_out_of_range(const TriangleMesh& mesh, Work& work, MeshReport& report) {
+  const auto n_vertices = std::int64_t(mesh.vertices.size());
   std::vector<bool> out_of_range(work.triangles.size(), false);
   for (std::size_t t = 0; t < work.triangles.size(); ++t)
     for (std::int32_t v : work.triangles[t]) out_of_range[t] = out_of_range[t] || v < 0 || v >= n_vertices;
@@ -189,8 +198,11 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
               fmt::format("{} referred to vertices that do not exist; removed",
                           counted(std::int64_t(removed.size()), "triangle")),
               std::int64_t(removed.size()), removed);
+}
 
-  // Non-finite coordinates poison every predicate below: fatal, and nothing else is checked.
+/// Non-finite coordinates poison every predicate below: fatal, and nothing else is checked.
+/// Returns true (with the report finished) when a triangle uses such a vertex.
+bool stop_if_non_finite(const TriangleMesh& mesh, const Work& work, MeshReport& report) {
   std::vector<std::int32_t> touching_non_finite;
   std::int64_t non_finite = 0;
   std::vector<bool> vertex_bad(mesh.vertices.size(), false);
@@ -203,35 +215,36 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     if (vertex_bad[tri[0]] || vertex_bad[tri[1]] || vertex_bad[tri[2]]) touching_non_finite.push_back(work.original[t]);
   }
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) non_finite += vertex_bad[v];
-  if (!touching_non_finite.empty()) {
-    add_issue(report, Severity::fatal,
-              fmt::format("{} with non-finite coordinates (NaN or infinity), used by {}",
-                          counted(non_finite, "vertex", "vertices"),
-                          counted(std::int64_t(touching_non_finite.size()), "triangle")),
-              non_finite, touching_non_finite);
-    report.triangles_out = mesh.triangles.size();
-    report.vertices_out = mesh.vertices.size();
-    return report;
-  }
+  if (touching_non_finite.empty()) return false;
+  add_issue(report, Severity::fatal,
+            fmt::format("{} with non-finite coordinates (NaN or infinity), used by {}",
+                        counted(non_finite, "vertex", "vertices"),
+                        counted(std::int64_t(touching_non_finite.size()), "triangle")),
+            non_finite, touching_non_finite);
+  report.triangles_out = mesh.triangles.size();
+  report.vertices_out = mesh.vertices.size();
+  return true;
+}
 
-  // Points at identical positions become one vertex
-  // (CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup).
+/// Points at identical positions become one vertex
+/// (CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup).
+void join_duplicate_points(const TriangleMesh& mesh, Work& work, MeshReport& report) {
   work.points.reserve(mesh.vertices.size());
   for (const auto& x : mesh.vertices) work.points.emplace_back(x[0], x[1], x[2]);
-  {
-    Soup soup(work.triangles.size());
-    for (std::size_t t = 0; t < soup.size(); ++t)
-      for (int k = 0; k < 3; ++k) soup[t][k] = std::size_t(work.triangles[t][k]);
-    const std::size_t merged = CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup(work.points, soup);
-    for (std::size_t t = 0; t < soup.size(); ++t)
-      for (int k = 0; k < 3; ++k) work.triangles[t][k] = std::int32_t(soup[t][k]);
-    if (merged > 0)
-      add_issue(report, Severity::repaired,
-                fmt::format("{} at identical positions joined", counted(std::int64_t(merged), "vertex", "vertices")),
-                std::int64_t(merged), {});
-  }
+  Soup soup(work.triangles.size());
+  for (std::size_t t = 0; t < soup.size(); ++t)
+    for (int k = 0; k < 3; ++k) soup[t][k] = std::size_t(work.triangles[t][k]);
+  const std::size_t merged = CGAL::Polygon_mesh_processing::merge_duplicate_points_in_polygon_soup(work.points, soup);
+  for (std::size_t t = 0; t < soup.size(); ++t)
+    for (int k = 0; k < 3; ++k) work.triangles[t][k] = std::int32_t(soup[t][k]);
+  if (merged > 0)
+    add_issue(report, Severity::repaired,
+              fmt::format("{} at identical positions joined", counted(std::int64_t(merged), "vertex", "vertices")),
+              std::int64_t(merged), {});
+}
 
-  // Degenerate triangles: a repeated vertex, or three collinear points (CGAL::collinear, exact).
+/// Degenerate triangles: a repeated vertex, or three collinear points (CGAL::collinear, exact).
+void remove_degenerate(Work& work, MeshReport& report) {
   std::vector<bool> degenerate(work.triangles.size(), false);
   for (std::size_t t = 0; t < work.triangles.size(); ++t) {
     const auto& [a, b, c] = work.triangles[t];
@@ -242,63 +255,69 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
               fmt::format("{} removed (zero area: repeated or collinear vertices)",
                           counted(std::int64_t(removed.size()), "degenerate triangle")),
               std::int64_t(removed.size()), removed);
+}
 
-  // Duplicate triangles: the same three vertices in any order; the first one is kept.
-  {
-    std::vector<std::pair<Triangle, std::int32_t>> sorted(work.triangles.size());
-    for (std::size_t t = 0; t < sorted.size(); ++t) {
-      sorted[t] = {work.triangles[t], std::int32_t(t)};
-      std::sort(sorted[t].first.begin(), sorted[t].first.end());
-    }
-    std::sort(sorted.begin(), sorted.end());
-    std::vector<bool> duplicate(work.triangles.size(), false);
-    for (std::size_t k = 1; k < sorted.size(); ++k)
-      duplicate[sorted[k].second] = sorted[k].first == sorted[k - 1].first;
-    if (const auto removed = work.remove(duplicate); !removed.empty())
-      add_issue(report, Severity::repaired,
-                fmt::format("{} removed (same three vertices as another triangle)",
-                            counted(std::int64_t(removed.size()), "duplicate triangle")),
-                std::int64_t(removed.size()), removed);
+/// Duplicate triangles: the same three vertices in any order; the first one is kept.
+void remove_duplicates(Work& work, MeshReport& report) {
+  std::vector<std::pair<Triangle, std::int32_t>> sorted(work.triangles.size());
+  for (std::size_t t = 0; t < sorted.size(); ++t) {
+    sorted[t] = {work.triangles[t], std::int32_t(t)};
+    std::sort(sorted[t].first.begin(), sorted[t].first.end());
   }
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<bool> duplicate(work.triangles.size(), false);
+  for (std::size_t k = 1; k < sorted.size(); ++k)
+    duplicate[sorted[k].second] = sorted[k].first == sorted[k - 1].first;
+  if (const auto removed = work.remove(duplicate); !removed.empty())
+    add_issue(report, Severity::repaired,
+              fmt::format("{} removed (same three vertices as another triangle)",
+                          counted(std::int64_t(removed.size()), "duplicate triangle")),
+              std::int64_t(removed.size()), removed);
+}
 
-  // Nothing left to be a wall.
-  if (work.triangles.empty()) {
-    add_issue(report, Severity::fatal,
-              fmt::format("no triangles left after repair (all {} were invalid, degenerate or duplicates)",
-                          report.triangles_in),
-              0, {});
-    mesh.vertices.clear();
-    mesh.triangles.clear();
-    return report;
-  }
+/// Nothing left to be a wall: fatal, and the mesh is emptied. Returns true (with the report
+/// finished) when no triangle is left.
+bool stop_if_empty(TriangleMesh& mesh, const Work& work, MeshReport& report) {
+  if (!work.triangles.empty()) return false;
+  add_issue(report, Severity::fatal,
+            fmt::format("no triangles left after repair (all {} were invalid, degenerate or duplicates)",
+                        report.triangles_in),
+            0, {});
+  mesh.vertices.clear();
+  mesh.triangles.clear();
+  return true;
+}
+
+/// Edges: a border edge has one triangle, a manifold edge two, a non-manifold edge more.
+/// Reports the non-manifold edges and the open border loops.
+EdgeCensus check_edges(const Work& work, MeshReport& report) {
   const std::size_t n_triangles = work.triangles.size();
-
-  // Edges: a border edge has one triangle, a manifold edge two, a non-manifold edge more.
-  std::vector<EdgeUse> uses = edge_uses(work.triangles);
-  std::vector<bool> on_open_edge(n_triangles, false);  // touches a border or non-manifold edge
+  EdgeCensus edges;
+  edges.uses = edge_uses(work.triangles);
+  edges.on_open_edge.assign(n_triangles, false);
+  const std::vector<EdgeUse>& uses = edges.uses;
   std::vector<std::int32_t> border_triangles, non_manifold_triangles;
-  std::int64_t border_edges = 0, non_manifold_edges = 0;
   UnionFind border_vertices(work.points.size());
   for_each_edge(uses, [&](std::size_t first, std::size_t last) {
     if (last - first == 2) return;
-    for (std::size_t u = first; u < last; ++u) on_open_edge[uses[u].triangle] = true;
+    for (std::size_t u = first; u < last; ++u) edges.on_open_edge[uses[u].triangle] = true;
     if (last - first == 1) {
-      ++border_edges;
+      ++edges.border_edges;
       border_vertices.join(std::int32_t(uses[first].key >> 32), std::int32_t(uses[first].key & 0xffffffffu));
       border_triangles.push_back(work.original[uses[first].triangle]);
     } else {
-      ++non_manifold_edges;
+      ++edges.non_manifold_edges;
       for (std::size_t u = first; u < last; ++u) non_manifold_triangles.push_back(work.original[uses[u].triangle]);
     }
   });
-  if (non_manifold_edges > 0)
+  if (edges.non_manifold_edges > 0)
     add_issue(report, Severity::warning,
               fmt::format("{} (shared by more than two triangles): contact works, but the surface "
                           "has no single inside there; check for internal walls or touching parts",
-                          counted(non_manifold_edges, "non-manifold edge")),
-              non_manifold_edges, non_manifold_triangles);
+                          counted(edges.non_manifold_edges, "non-manifold edge")),
+              edges.non_manifold_edges, non_manifold_triangles);
   // Border loops: connected sets of border edges (loops touching at one vertex count as one).
-  if (border_edges > 0) {
+  if (edges.border_edges > 0) {
     std::vector<std::int32_t> roots;
     for_each_edge(uses, [&](std::size_t first, std::size_t last) {
       if (last - first == 1) roots.push_back(border_vertices.find(std::int32_t(uses[first].key >> 32)));
@@ -308,158 +327,182 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     add_issue(report, Severity::info,
               fmt::format("{} ({}); normal for chutes and plates, a leak only for a "
                           "closed container",
-                          counted(loops, "open border loop"), counted(border_edges, "border edge")),
+                          counted(loops, "open border loop"), counted(edges.border_edges, "border edge")),
               loops, border_triangles);
   }
+  return edges;
+}
 
-  // Consistent orientation within each manifold patch (CGAL::Polygon_mesh_processing::orient_polygon_soup,
-  // Gueziec et al. 2001); points it duplicates to cut non-manifold vertices are mapped back after.
+/// Consistent orientation within each manifold patch (CGAL::Polygon_mesh_processing::orient_polygon_soup,
+/// Gueziec et al. 2001); points it duplicates to cut non-manifold vertices are mapped back after.
+std::vector<Triangle> orient_with_cgal(const Work& work) {
+  const std::size_t n_triangles = work.triangles.size();
   std::vector<Triangle> oriented(n_triangles);
-  {
-    std::vector<Point> points = work.points;
-    Soup soup(n_triangles);
-    for (std::size_t t = 0; t < n_triangles; ++t)
-      for (int k = 0; k < 3; ++k) soup[t][k] = std::size_t(work.triangles[t][k]);
-    CGAL::Polygon_mesh_processing::orient_polygon_soup(points, soup);
-    std::map<Point, std::int32_t> index_of;  // only needed when points were duplicated
-    if (points.size() > work.points.size())
-      for (std::size_t v = 0; v < work.points.size(); ++v) index_of.emplace(work.points[v], std::int32_t(v));
-    for (std::size_t t = 0; t < n_triangles; ++t)
-      for (int k = 0; k < 3; ++k)
-        oriented[t][k] = soup[t][k] < work.points.size() ? std::int32_t(soup[t][k]) : index_of.at(points[soup[t][k]]);
-  }
-  // Patches: triangles joined through manifold edges. A closed patch faces outward (positive
-  // volume); an open one keeps the orientation most of its triangles came with.
-  // Rejected: CGAL::Polygon_mesh_processing::orient_to_bound_a_volume, which handles nested
-  // shells but needs the whole mesh closed; here a shell inside another is also turned outward.
-  {
-    UnionFind patches(n_triangles);
-    for_each_edge(uses, [&](std::size_t first, std::size_t last) {
-      if (last - first == 2) patches.join(uses[first].triangle, uses[first + 1].triangle);
-    });
-    // Triangles sorted by patch, then each patch [begin, end) in turn.
-    std::vector<std::int32_t> by_patch(n_triangles), roots(n_triangles);
-    for (std::size_t t = 0; t < n_triangles; ++t) roots[t] = patches.find(std::int32_t(t));
-    std::iota(by_patch.begin(), by_patch.end(), 0);
-    std::stable_sort(by_patch.begin(), by_patch.end(),
-                     [&](std::int32_t a, std::int32_t b) { return roots[a] < roots[b]; });
-    std::vector<std::int32_t> flipped_triangles;
-    for (std::size_t begin = 0, end = 0; begin < n_triangles; begin = end) {
-      while (end < n_triangles && roots[by_patch[end]] == roots[by_patch[begin]]) ++end;
-      const std::vector<std::int32_t> patch(by_patch.begin() + begin, by_patch.begin() + end);
-      const bool closed = std::none_of(patch.begin(), patch.end(), [&](std::int32_t t) { return on_open_edge[t]; });
-      const auto n_flipped = std::count_if(patch.begin(), patch.end(),
-                                           [&](std::int32_t t) { return !same_cycle(oriented[t], work.triangles[t]); });
-      const bool turn =
-          closed ? signed_volume(work.points, oriented, patch) < 0 : 2 * std::size_t(n_flipped) > patch.size();
-      // Unflipped triangles keep their exact corner order; flipped ones swap their last two corners.
-      for (std::int32_t t : patch) {
-        const Triangle& input = work.triangles[t];
-        const bool flip = same_cycle(oriented[t], input) == turn;
-        oriented[t] = flip ? Triangle{input[0], input[2], input[1]} : input;
-        if (flip) flipped_triangles.push_back(work.original[t]);
-      }
+  std::vector<Point> points = work.points;
+  Soup soup(n_triangles);
+  for (std::size_t t = 0; t < n_triangles; ++t)
+    for (int k = 0; k < 3; ++k) soup[t][k] = std::size_t(work.triangles[t][k]);
+  CGAL::Polygon_mesh_processing::orient_polygon_soup(points, soup);
+  std::map<Point, std::int32_t> index_of;  // only needed when points were duplicated
+  if (points.size() > work.points.size())
+    for (std::size_t v = 0; v < work.points.size(); ++v) index_of.emplace(work.points[v], std::int32_t(v));
+  for (std::size_t t = 0; t < n_triangles; ++t)
+    for (int k = 0; k < 3; ++k)
+      oriented[t][k] = soup[t][k] < work.points.size() ? std::int32_t(soup[t][k]) : index_of.at(points[soup[t][k]]);
+  return oriented;
+}
+
+/// Patches: triangles joined through manifold edges. A closed patch faces outward (positive
+/// volume); an open one keeps the orientation most of its triangles came with.
+/// Rejected: CGAL::Polygon_mesh_processing::orient_to_bound_a_volume, which handles nested
+/// shells but needs the whole mesh closed; here a shell inside another is also turned outward.
+void orient_patches(Work& work, const EdgeCensus& edges, std::vector<Triangle> oriented, MeshReport& report) {
+  const std::size_t n_triangles = work.triangles.size();
+  const std::vector<EdgeUse>& uses = edges.uses;
+  UnionFind patches(n_triangles);
+  for_each_edge(uses, [&](std::size_t first, std::size_t last) {
+    if (last - first == 2) patches.join(uses[first].triangle, uses[first + 1].triangle);
+  });
+  // Triangles sorted by patch, then each patch [begin, end) in turn.
+  std::vector<std::int32_t> by_patch(n_triangles), roots(n_triangles);
+  for (std::size_t t = 0; t < n_triangles; ++t) roots[t] = patches.find(std::int32_t(t));
+  std::iota(by_patch.begin(), by_patch.end(), 0);
+  std::stable_sort(by_patch.begin(), by_patch.end(),
+                   [&](std::int32_t a, std::int32_t b) { return roots[a] < roots[b]; });
+  std::vector<std::int32_t> flipped_triangles;
+  for (std::size_t begin = 0, end = 0; begin < n_triangles; begin = end) {
+    while (end < n_triangles && roots[by_patch[end]] == roots[by_patch[begin]]) ++end;
+    const std::vector<std::int32_t> patch(by_patch.begin() + begin, by_patch.begin() + end);
+    const bool closed =
+        std::none_of(patch.begin(), patch.end(), [&](std::int32_t t) { return edges.on_open_edge[t]; });
+    const auto n_flipped = std::count_if(patch.begin(), patch.end(),
+                                         [&](std::int32_t t) { return !same_cycle(oriented[t], work.triangles[t]); });
+    const bool turn =
+        closed ? signed_volume(work.points, oriented, patch) < 0 : 2 * std::size_t(n_flipped) > patch.size();
+    // Unflipped triangles keep their exact corner order; flipped ones swap their last two corners.
+    for (std::int32_t t : patch) {
+      const Triangle& input = work.triangles[t];
+      const bool flip = same_cycle(oriented[t], input) == turn;
+      oriented[t] = flip ? Triangle{input[0], input[2], input[1]} : input;
+      if (flip) flipped_triangles.push_back(work.original[t]);
     }
-    std::sort(flipped_triangles.begin(), flipped_triangles.end());
-    work.triangles = oriented;
-    if (!flipped_triangles.empty())
-      add_issue(report, Severity::repaired,
-                fmt::format("{} flipped so that neighbours agree in orientation (closed parts facing outward)",
-                            counted(std::int64_t(flipped_triangles.size()), "triangle")),
-                std::int64_t(flipped_triangles.size()), flipped_triangles);
   }
-  // Manifold edges whose two triangles still disagree: a non-orientable (Moebius-like) surface.
-  uses = edge_uses(work.triangles);
-  std::int64_t disagreeing = 0;
+  std::sort(flipped_triangles.begin(), flipped_triangles.end());
+  work.triangles = oriented;
+  if (!flipped_triangles.empty())
+    add_issue(report, Severity::repaired,
+              fmt::format("{} flipped so that neighbours agree in orientation (closed parts facing outward)",
+                          counted(std::int64_t(flipped_triangles.size()), "triangle")),
+              std::int64_t(flipped_triangles.size()), flipped_triangles);
+}
+
+/// Manifold edges whose two triangles still disagree: a non-orientable (Moebius-like) surface.
+/// Recounts the edge uses of the oriented triangles first.
+void check_orientable(const Work& work, EdgeCensus& edges, MeshReport& report) {
+  edges.uses = edge_uses(work.triangles);
+  const std::vector<EdgeUse>& uses = edges.uses;
   std::vector<std::int32_t> disagreeing_triangles;
   for_each_edge(uses, [&](std::size_t first, std::size_t last) {
     if (last - first != 2 || uses[first].forward != uses[first + 1].forward) return;
-    ++disagreeing;
+    ++edges.disagreeing;
     disagreeing_triangles.push_back(work.original[uses[first].triangle]);
   });
-  if (disagreeing > 0)
+  if (edges.disagreeing > 0)
     add_issue(report, Severity::warning,
               fmt::format("{} where neighbouring triangles face opposite ways and cannot be reoriented "
                           "(non-orientable surface)",
-                          counted(disagreeing, "edge")),
-              disagreeing, disagreeing_triangles);
+                          counted(edges.disagreeing, "edge")),
+              edges.disagreeing, disagreeing_triangles);
+}
 
-  // Self-intersections: candidate pairs from overlapping bounding boxes (CGAL::box_self_intersection_d),
-  // then exact tests. Rejected: PMP::self_intersections, which needs a Surface_mesh (no non-manifold
-  // edges); CGAL 5.6's triangle_soup_self_intersections is not in Debian bookworm's 5.5.
-  {
-    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::int32_t,
-                                                          CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
-    std::vector<Box> boxes;
-    boxes.reserve(n_triangles);
-    for (std::size_t t = 0; t < n_triangles; ++t) {
-      const auto& tri = work.triangles[t];
-      boxes.emplace_back(work.points[tri[0]].bbox() + work.points[tri[1]].bbox() + work.points[tri[2]].bbox(),
-                         std::int32_t(t));
-    }
-    std::vector<const Box*> box_pointers;
-    for (const Box& box : boxes) box_pointers.push_back(&box);
-    std::int64_t pairs = 0;
-    std::vector<std::int32_t> crossing;
-    const auto test = [&](const Box* a, const Box* b) {
-      if (!triangles_intersect(work.points, work.triangles[a->info()], work.triangles[b->info()])) return;
-      ++pairs;
-      if (crossing.size() < 4 * kMaxExamples) {
-        crossing.push_back(work.original[a->info()]);
-        crossing.push_back(work.original[b->info()]);
-      }
-    };
-    CGAL::box_self_intersection_d<CGAL::Sequential_tag>(box_pointers.begin(), box_pointers.end(), test,
-                                                        std::ptrdiff_t(2000));
-    std::sort(crossing.begin(), crossing.end());
-    crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
-    if (pairs > 0)
-      add_issue(report, Severity::warning,
-                fmt::format("{} intersecting (self-intersections): particles can be trapped or "
-                            "leak where surfaces cross; union the parts or separate them in CAD",
-                            counted(pairs, "pair of triangles", "pairs of triangles")),
-                pairs, crossing);
+/// Self-intersections: candidate pairs from overlapping bounding boxes (CGAL::box_self_intersection_d),
+/// then exact tests. Rejected: PMP::self_intersections, which needs a Surface_mesh (no non-manifold
+/// edges); CGAL 5.6's triangle_soup_self_intersections is not in Debian bookworm's 5.5.
+void check_self_intersections(const Work& work, MeshReport& report) {
+  const std::size_t n_triangles = work.triangles.size();
+  using Box =
+      CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::int32_t, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+  std::vector<Box> boxes;
+  boxes.reserve(n_triangles);
+  for (std::size_t t = 0; t < n_triangles; ++t) {
+    const auto& tri = work.triangles[t];
+    boxes.emplace_back(work.points[tri[0]].bbox() + work.points[tri[1]].bbox() + work.points[tri[2]].bbox(),
+                       std::int32_t(t));
   }
-
-  // Edge lengths over distinct edges, and each triangle's longest edge against the particle size.
-  const auto length = [&](std::int32_t a, std::int32_t b) {
-    return std::sqrt(CGAL::squared_distance(work.points[a], work.points[b]));
+  std::vector<const Box*> box_pointers;
+  for (const Box& box : boxes) box_pointers.push_back(&box);
+  std::int64_t pairs = 0;
+  std::vector<std::int32_t> crossing;
+  const auto test = [&](const Box* a, const Box* b) {
+    if (!triangles_intersect(work.points, work.triangles[a->info()], work.triangles[b->info()])) return;
+    ++pairs;
+    if (crossing.size() < 4 * kMaxExamples) {
+      crossing.push_back(work.original[a->info()]);
+      crossing.push_back(work.original[b->info()]);
+    }
   };
-  {
-    std::vector<double> lengths;
-    for_each_edge(uses, [&](std::size_t first, std::size_t) {
-      lengths.push_back(length(std::int32_t(uses[first].key >> 32), std::int32_t(uses[first].key & 0xffffffffu)));
-    });
-    std::sort(lengths.begin(), lengths.end());
-    report.edge_min = lengths.front();
-    report.edge_max = lengths.back();
-    report.edge_median = lengths[lengths.size() / 2];
-  }
-  if (particle_diameter > 0) {
-    std::vector<std::int32_t> coarse, fine;
-    for (std::size_t t = 0; t < n_triangles; ++t) {
-      const auto& [a, b, c] = work.triangles[t];
-      const double longest = std::max({length(a, b), length(b, c), length(c, a)});
-      if (longest > kCoarseTriangle * particle_diameter) coarse.push_back(work.original[t]);
-      if (longest < particle_diameter / kFineTriangle) fine.push_back(work.original[t]);
-    }
-    if (!coarse.empty())
-      add_issue(report, Severity::info,
-                fmt::format("{} with an edge longer than {} particle diameters ({:.4g} m): fine for contact, "
-                            "coarse for wear maps",
-                            counted(std::int64_t(coarse.size()), "triangle"), kCoarseTriangle,
-                            kCoarseTriangle * particle_diameter),
-                std::int64_t(coarse.size()), coarse);
-    if (!fine.empty())
-      add_issue(
-          report, Severity::info,
-          fmt::format("{} smaller than 1/{} particle diameter (longest edge < {:.4g} m): more "
-                      "triangles than contact needs; decimating would speed up the search",
-                      counted(std::int64_t(fine.size()), "triangle"), kFineTriangle, particle_diameter / kFineTriangle),
-          std::int64_t(fine.size()), fine);
-  }
+  CGAL::box_self_intersection_d<CGAL::Sequential_tag>(box_pointers.begin(), box_pointers.end(), test,
+                                                      std::ptrdiff_t(2000));
+  std::sort(crossing.begin(), crossing.end());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  if (pairs > 0)
+    add_issue(report, Severity::warning,
+              fmt::format("{} intersecting (self-intersections): particles can be trapped or "
+                          "leak where surfaces cross; union the parts or separate them in CAD",
+                          counted(pairs, "pair of triangles", "pairs of triangles")),
+              pairs, crossing);
+}
 
-  // Compact: keep only the vertices the triangles use, in their original order.
+/// Length of the edge between points `a` and `b` [m].
+double edge_length(const std::vector<Point>& points, std::int32_t a, std::int32_t b) {
+  return std::sqrt(CGAL::squared_distance(points[a], points[b]));
+}
+
+/// Edge lengths over distinct edges: shortest, longest and median.
+void measure_edges(const Work& work, const EdgeCensus& edges, MeshReport& report) {
+  const std::vector<EdgeUse>& uses = edges.uses;
+  std::vector<double> lengths;
+  for_each_edge(uses, [&](std::size_t first, std::size_t) {
+    lengths.push_back(edge_length(work.points, std::int32_t(uses[first].key >> 32),
+                                  std::int32_t(uses[first].key & 0xffffffffu)));
+  });
+  std::sort(lengths.begin(), lengths.end());
+  report.edge_min = lengths.front();
+  report.edge_max = lengths.back();
+  report.edge_median = lengths[lengths.size() / 2];
+}
+
+/// Each triangle's longest edge against the particle size (skipped when the size is unknown).
+void check_triangle_sizes(const Work& work, double particle_diameter, MeshReport& report) {
+  if (!(particle_diameter > 0)) return;
+  const std::size_t n_triangles = work.triangles.size();
+  std::vector<std::int32_t> coarse, fine;
+  for (std::size_t t = 0; t < n_triangles; ++t) {
+    const auto& [a, b, c] = work.triangles[t];
+    const double longest =
+        std::max({edge_length(work.points, a, b), edge_length(work.points, b, c), edge_length(work.points, c, a)});
+    if (longest > kCoarseTriangle * particle_diameter) coarse.push_back(work.original[t]);
+    if (longest < particle_diameter / kFineTriangle) fine.push_back(work.original[t]);
+  }
+  if (!coarse.empty())
+    add_issue(report, Severity::info,
+              fmt::format("{} with an edge longer than {} particle diameters ({:.4g} m): fine for contact, "
+                          "coarse for wear maps",
+                          counted(std::int64_t(coarse.size()), "triangle"), kCoarseTriangle,
+                          kCoarseTriangle * particle_diameter),
+              std::int64_t(coarse.size()), coarse);
+  if (!fine.empty())
+    add_issue(
+        report, Severity::info,
+        fmt::format("{} smaller than 1/{} particle diameter (longest edge < {:.4g} m): more "
+                    "triangles than contact needs; decimating would speed up the search",
+                    counted(std::int64_t(fine.size()), "triangle"), kFineTriangle, particle_diameter / kFineTriangle),
+        std::int64_t(fine.size()), fine);
+}
+
+/// Compact: keep only the vertices the triangles use, in their original order.
+void write_compacted(const Work& work, TriangleMesh& mesh) {
+  const std::size_t n_triangles = work.triangles.size();
   std::vector<std::int32_t> new_index(work.points.size(), -1);
   for (const auto& tri : work.triangles)
     for (std::int32_t v : tri) new_index[v] = 0;
@@ -472,11 +515,13 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
   mesh.triangles.resize(n_triangles);
   for (std::size_t t = 0; t < n_triangles; ++t)
     for (int k = 0; k < 3; ++k) mesh.triangles[t][k] = new_index[work.triangles[t][k]];
+}
 
-  // Measures of the repaired mesh.
+/// Measures of the repaired mesh: counts, closedness, bounding box, area.
+void measure_repaired(const TriangleMesh& mesh, const Work& work, const EdgeCensus& edges, MeshReport& report) {
   report.triangles_out = mesh.triangles.size();
   report.vertices_out = mesh.vertices.size();
-  report.closed = border_edges == 0 && non_manifold_edges == 0 && disagreeing == 0;
+  report.closed = edges.border_edges == 0 && edges.non_manifold_edges == 0 && edges.disagreeing == 0;
   report.bbox_min = report.bbox_max = mesh.vertices.front();
   for (const auto& x : mesh.vertices)
     for (int axis = 0; axis < 3; ++axis) {
@@ -485,8 +530,10 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
     }
   for (const auto& [a, b, c] : work.triangles)
     report.area += std::sqrt(CGAL::squared_area(work.points[a], work.points[b], work.points[c]));
+}
 
-  // Units: a wall is between a millimetre and a hundred metres across.
+/// Units: a wall is between a millimetre and a hundred metres across.
+void check_units(MeshReport& report) {
   const double diagonal = std::hypot(report.bbox_max[0] - report.bbox_min[0], report.bbox_max[1] - report.bbox_min[1],
                                      report.bbox_max[2] - report.bbox_min[2]);  // [m]
   if (diagonal > kLargestPlausible)
@@ -497,6 +544,30 @@ MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
         report, Severity::warning,
         fmt::format("the mesh is {:.4g} m across; is it in metres already? check unit_scale (1 for metres)", diagonal),
         1, {});
+}
+
+}  // namespace
+
+MeshReport check_and_repair(TriangleMesh& mesh, double particle_diameter) {
+  MeshReport report;
+  report.source = mesh.source;
+  report.triangles_in = mesh.triangles.size();
+  Work work = start_work(mesh);
+  remove_out_of_range(mesh, work, report);
+  if (stop_if_non_finite(mesh, work, report)) return report;
+  join_duplicate_points(mesh, work, report);
+  remove_degenerate(work, report);
+  remove_duplicates(work, report);
+  if (stop_if_empty(mesh, work, report)) return report;
+  EdgeCensus edges = check_edges(work, report);
+  orient_patches(work, edges, orient_with_cgal(work), report);
+  check_orientable(work, edges, report);
+  check_self_intersections(work, report);
+  measure_edges(work, edges, report);
+  check_triangle_sizes(work, particle_diameter, report);
+  write_compacted(work, mesh);
+  measure_repaired(mesh, work, edges, report);
+  check_units(report);
   return report;
 }
 
