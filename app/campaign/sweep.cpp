@@ -197,8 +197,56 @@ YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k)
   return copy;
 }
 
-int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
-  namespace fs = std::filesystem;
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- the phases of run_sweep ------------------------------------------------------------------
+
+/// How this rank runs the sweep: the plan, the options, where progress is told, and the sizes
+/// taken once at the start.
+struct SweepRank {
+  const SweepPlan& plan;
+  const SweepOptions& options;
+  std::ostream& log;
+  const mpi::World& world;
+  size_t n;         ///< variants of the sweep
+  int threads;      ///< per variant
+  int parallel;     ///< variants at once on this rank
+  std::string who;  ///< "rank 1: " under MPI, "" otherwise
+};
+
+/// What a variant's child process is started with: this program, and this process's environment
+/// without the MPI launcher's variables.
+struct ChildProgram {
+  std::string self;
+  std::vector<std::string> environment;
+  std::vector<char*> envp;  ///< into environment, then nullptr
+};
+
+/// A variant's child process while it runs.
+struct RunningVariant {
+  pid_t pid;
+  size_t variant;
+  std::chrono::steady_clock::time_point started;
+};
+
+/// This rank's variants as they run, and once they have.
+struct RankRuns {
+  std::vector<RunningVariant> running;
+  std::vector<int> status;   ///< per variant of the sweep: exit status (127: not started or lost), -1 until known
+  std::vector<size_t> mine;  ///< the variants this rank ran, in the order it started them
+  size_t done = 0;
+  double busy_seconds = 0;
+};
+
+/// Every variant's result on rank 0, as the ranks that ran them reported it.
+struct VariantResults {
+  std::vector<std::string> metrics_text, messages, images;  ///< per variant
+};
+
+/// This rank's share of the variants, the threads of each and how many run at once.
+SweepRank size_this_rank(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
   const mpi::World& world = mpi::world();
   const size_t n = plan.variants.size();
   // Under MPI rank 0 hands the variants out one at a time to whichever rank has a free slot; a
@@ -208,114 +256,148 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
   const int threads = options.threads > 0 ? options.threads : (static_cast<int>(share) >= cores ? 1 : cores);
   const int parallel = plan.parallel > 0 ? plan.parallel : std::max(1, cores / threads);
   const std::string who = world.active() ? fmt::format("rank {}: ", world.rank) : "";
+  return {plan, options, log, world, n, threads, parallel, who};
+}
+
+/// Makes the variants' folder and says how the sweep runs.
+void announce(const SweepRank& sweep) {
+  const SweepOptions& options = sweep.options;
+  const mpi::World& world = sweep.world;
+  std::ostream& log = sweep.log;
+  const size_t n = sweep.n;
+  const int threads = sweep.threads, parallel = sweep.parallel;
   fs::create_directories(options.out + "/variants");
   if (!world.active())
     log << fmt::format("sweep: {} variants of {}, {} at a time with {} thread(s) each\n", n, options.case_path, parallel, threads);
   else {
     if (world.rank == 0) log << fmt::format("sweep: {} variants of {} over {} MPI ranks\n", n, options.case_path, world.size);
-    log << fmt::format("{}{} at a time with {} thread(s) each\n", who, parallel, threads) << std::flush;
+    log << fmt::format("{}{} at a time with {} thread(s) each\n", sweep.who, parallel, threads) << std::flush;
   }
-  const std::string self = fs::read_symlink("/proc/self/exe").string();
-  // The children are plain processes: without the launcher's variables they never join the MPI job.
-  std::vector<std::string> environment = mpi::child_environment();
-  std::vector<char*> envp;
-  for (auto& e : environment) envp.push_back(e.data());
-  envp.push_back(nullptr);
+}
 
-  struct Running {
-    pid_t pid;
-    size_t variant;
-    std::chrono::steady_clock::time_point started;
-  };
-  std::vector<Running> running;
-  std::vector<int> status(n, -1);
-  std::vector<size_t> mine;  // the variants this rank ran, in the order it started them
-  mpi::WorkQueue queue(n);
+/// This program and the environment its children run with.
+void find_child_program(ChildProgram& child) {
+  child.self = fs::read_symlink("/proc/self/exe").string();
+  // The children are plain processes: without the launcher's variables they never join the MPI job.
+  child.environment = mpi::child_environment();
+  for (auto& e : child.environment) child.envp.push_back(e.data());
+  child.envp.push_back(nullptr);
+}
+
+/// Starts variant k as `demdesign run CASE --variant k` in its folder. The sweep owns its variants'
+/// folders: a sweep run again replaces what its variants wrote there (--overwrite).
+void start_variant(const SweepRank& sweep, const ChildProgram& child, RankRuns& runs, size_t k) {
+  const SweepPlan& plan = sweep.plan;
+  const SweepOptions& options = sweep.options;
+  const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+  fs::create_directories(dir);
+  std::vector<std::string> args = {child.self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
+                                   "--threads", std::to_string(sweep.threads), "--quiet", "--overwrite"};
+  if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
+  if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  // The child's output goes to its log file; no shell is involved.
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  const std::string log_path = dir + "/log.txt";
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int err = posix_spawn(&pid, child.self.c_str(), &files, nullptr, argv.data(), child.envp.data());
+  posix_spawn_file_actions_destroy(&files);
+  runs.mine.push_back(k);
+  if (err != 0) {
+    sweep.log << fmt::format("{}  {} could not be started: {}\n", sweep.who, plan.name(k), std::strerror(err));
+    runs.status[k] = 127;
+    ++runs.done;
+  } else {
+    sweep.log << fmt::format("{}  {} started: {}\n", sweep.who, plan.name(k), plan.label(k)) << std::flush;
+    runs.running.push_back({pid, k, std::chrono::steady_clock::now()});
+  }
+}
+
+/// Free slots take the next variants; true when one was started. `exhausted` becomes true when
+/// the queue has none left.
+bool fill_free_slots(const SweepRank& sweep, const ChildProgram& child, mpi::WorkQueue& queue, bool& exhausted, RankRuns& runs) {
+  bool progressed = false;
+  while (!exhausted && static_cast<int>(runs.running.size()) < sweep.parallel) {
+    const long item = queue.next();
+    if (item == mpi::WorkQueue::kWait) break;
+    if (item == mpi::WorkQueue::kNone) {
+      exhausted = true;
+      break;
+    }
+    start_variant(sweep, child, runs, static_cast<size_t>(item));
+    progressed = true;
+  }
+  return progressed;
+}
+
+/// Takes the child `pid` that ended with `wstatus` off the running variants and tells how far
+/// the sweep is; nothing when it is not one of them.
+void variant_finished(const SweepRank& sweep, pid_t pid, int wstatus, RankRuns& runs) {
+  const SweepPlan& plan = sweep.plan;
+  std::vector<RunningVariant>& running = runs.running;
+  std::vector<int>& status = runs.status;
+  const auto it = std::find_if(running.begin(), running.end(), [&](const RunningVariant& r) { return r.pid == pid; });
+  if (it == running.end()) return;
+  const size_t v = it->variant;
+  status[v] = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->started).count();
+  runs.busy_seconds += took;
+  running.erase(it);
+  ++runs.done;
+  const size_t done = runs.done, n = sweep.n;
+  const std::string count = sweep.world.active() ? fmt::format("{} done on this rank", done)
+                                                 : fmt::format("{}/{} done, about {} left", done, n,
+                                                               format_seconds(runs.busy_seconds / done * static_cast<double>(n - done) / sweep.parallel));
+  sweep.log << fmt::format("{}  {} {} in {} ({}){}\n", sweep.who, plan.name(v), status[v] == 0 ? "finished" : "FAILED", format_seconds(took), count,
+                           status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", sweep.options.out, plan.name(v)))
+            << std::flush;
+}
+
+/// Runs the variants this rank is handed, `parallel` at a time, until none is left (and, on
+/// rank 0, every other rank has been told so).
+RankRuns run_variants(const SweepRank& sweep, const ChildProgram& child) {
+  RankRuns runs;
+  runs.status.assign(sweep.n, -1);
+  mpi::WorkQueue queue(sweep.n);
   bool exhausted = false;
-  size_t done = 0;
-  double busy_seconds = 0;
-  // Starts variant k as `demdesign run CASE --variant k` in its folder. The sweep owns its variants'
-  // folders: a sweep run again replaces what its variants wrote there (--overwrite).
-  const auto start_variant = [&](size_t k) {
-    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
-    fs::create_directories(dir);
-    std::vector<std::string> args = {self, "run", options.case_path, "--variant", std::to_string(k), "--out", dir,
-                                     "--threads", std::to_string(threads), "--quiet", "--overwrite"};
-    if (options.duration >= 0) args.insert(args.end(), {"--duration", fmt::format("{:.17g}", options.duration)});
-    if (options.max_steps >= 0) args.insert(args.end(), {"--max-steps", std::to_string(options.max_steps)});
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    // The child's output goes to its log file; no shell is involved.
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    const std::string log_path = dir + "/log.txt";
-    posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
-    pid_t pid = 0;
-    const int err = posix_spawn(&pid, self.c_str(), &files, nullptr, argv.data(), envp.data());
-    posix_spawn_file_actions_destroy(&files);
-    mine.push_back(k);
-    if (err != 0) {
-      log << fmt::format("{}  {} could not be started: {}\n", who, plan.name(k), std::strerror(err));
-      status[k] = 127;
-      ++done;
-    } else {
-      log << fmt::format("{}  {} started: {}\n", who, plan.name(k), plan.label(k)) << std::flush;
-      running.push_back({pid, k, std::chrono::steady_clock::now()});
-    }
-  };
   for (;;) {
-    bool progressed = false;
-    // Free slots take the next variants.
-    while (!exhausted && static_cast<int>(running.size()) < parallel) {
-      const long item = queue.next();
-      if (item == mpi::WorkQueue::kWait) break;
-      if (item == mpi::WorkQueue::kNone) {
-        exhausted = true;
-        break;
-      }
-      start_variant(static_cast<size_t>(item));
-      progressed = true;
-    }
+    bool progressed = fill_free_slots(sweep, child, queue, exhausted, runs);
     progressed = queue.serve() || progressed;  // rank 0 answers the other ranks
-    if (exhausted && running.empty() && queue.all_told()) break;
+    if (exhausted && runs.running.empty() && queue.all_told()) break;
     // Without MPI wait for a variant to finish; under MPI look, and keep asking and answering.
     int wstatus = 0;
-    const pid_t pid = running.empty() ? 0 : waitpid(-1, &wstatus, world.active() ? WNOHANG : 0);
+    const pid_t pid = runs.running.empty() ? 0 : waitpid(-1, &wstatus, sweep.world.active() ? WNOHANG : 0);
     if (pid < 0 && errno == EINTR) continue;
     if (pid < 0) {
       // No child to wait for (cannot happen with variants running): count them as failed.
-      for (const Running& r : running) status[r.variant] = 127, ++done;
-      running.clear();
+      for (const RunningVariant& r : runs.running) runs.status[r.variant] = 127, ++runs.done;
+      runs.running.clear();
       continue;
     }
     if (pid == 0) {
       if (!progressed) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
     }
-    const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
-    if (it == running.end()) continue;
-    const size_t v = it->variant;
-    status[v] = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
-    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->started).count();
-    busy_seconds += took;
-    running.erase(it);
-    ++done;
-    const std::string count = world.active() ? fmt::format("{} done on this rank", done)
-                                             : fmt::format("{}/{} done, about {} left", done, n,
-                                                           format_seconds(busy_seconds / done * static_cast<double>(n - done) / parallel));
-    log << fmt::format("{}  {} {} in {} ({}){}\n", who, plan.name(v), status[v] == 0 ? "finished" : "FAILED", format_seconds(took), count,
-                       status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", options.out, plan.name(v)))
-        << std::flush;
+    variant_finished(sweep, pid, wstatus, runs);
   }
+  return runs;
+}
 
+/// Every rank's record of the variants it ran, on rank 0 (collective; other ranks get none).
+std::vector<std::string> gather_results(const SweepRank& sweep, const RankRuns& runs) {
+  const SweepPlan& plan = sweep.plan;
+  const std::vector<int>& status = runs.status;
   // What rank 0 needs of each variant this rank ran: exit status, metrics.csv as text, why it
   // failed (the last lines of its log) and its last flow image; gathered over MPI, so rank 0
   // ranks the variants even when the other ranks' folders are not on its file system.
   mpi::ByteWriter record;
-  for (const size_t k : mine) {
-    const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
+  for (const size_t k : runs.mine) {
+    const std::string dir = fmt::format("{}/variants/{}", sweep.options.out, plan.name(k));
     std::string metrics, message, image;
     if (status[k] == 0) {
       std::ifstream in(dir + "/report/metrics.csv");
@@ -335,9 +417,15 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     }
     record.u64(k), record.u64(static_cast<std::uint64_t>(status[k])), record.str(metrics), record.str(message), record.str(image);
   }
-  const std::vector<std::string> records = mpi::gather(record.bytes());
-  if (world.rank != 0) return 0;  // rank 0 reports the campaign and gives its exit status
-  std::vector<std::string> metrics_text(n), messages(n), images(n);
+  return mpi::gather(record.bytes());
+}
+
+/// Rank 0: every variant's result from the ranks' records, its exit status into `status`.
+VariantResults read_results(const std::vector<std::string>& records, size_t n, std::vector<int>& status) {
+  VariantResults results{std::vector<std::string>(n), std::vector<std::string>(n), std::vector<std::string>(n)};
+  std::vector<std::string>& metrics_text = results.metrics_text;
+  std::vector<std::string>& messages = results.messages;
+  std::vector<std::string>& images = results.images;
   for (const std::string& bytes : records) {
     mpi::ByteReader in(bytes);
     while (!in.done()) {
@@ -347,13 +435,21 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
       metrics_text[k] = in.str(), messages[k] = in.str(), images[k] = in.str();
     }
   }
+  return results;
+}
 
-  // The comparison: each variant's metrics (from its report) and its last flow image.
+/// The comparison: each variant's metrics (from its report) and its last flow image.
+report::SweepReportInput comparison_input(const SweepRank& sweep, const std::vector<int>& status, const VariantResults& results) {
+  const SweepPlan& plan = sweep.plan;
+  const SweepOptions& options = sweep.options;
+  const std::vector<std::string>& metrics_text = results.metrics_text;
+  const std::vector<std::string>& messages = results.messages;
+  const std::vector<std::string>& images = results.images;
   report::SweepReportInput input;
   input.case_path = options.case_path, input.version = DEMDESIGN_VERSION;
   input.title = fmt::format("Design sweep: {}", fs::path(options.case_path).filename().string());
   for (const SweepCriterion& c : plan.criteria) input.criteria.push_back({c.metric, !c.minimize, c.weight});
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < sweep.n; ++k) {
     const std::string dir = fmt::format("{}/variants/{}", options.out, plan.name(k));
     report::SweepVariant v;
     v.name = plan.name(k);
@@ -372,8 +468,12 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
     }
     input.variants.push_back(std::move(v));
   }
-  // A criterion no variant reports is a typo in the case, not a tie: say so.
-  for (const SweepCriterion& c : plan.criteria) {
+  return input;
+}
+
+/// A criterion no variant reports is a typo in the case, not a tie: say so.
+void warn_of_unknown_criteria(const SweepRank& sweep, const report::SweepReportInput& input) {
+  for (const SweepCriterion& c : sweep.plan.criteria) {
     const bool known = std::any_of(input.variants.begin(), input.variants.end(), [&](const report::SweepVariant& v) {
       return std::any_of(v.metrics.values.begin(), v.metrics.values.end(), [&](const auto& kv) { return kv.first == c.metric; });
     });
@@ -384,36 +484,66 @@ int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& 
         for (const auto& kv : v.metrics.values) names += (names.empty() ? "" : ", ") + kv.first;
         break;
       }
-    log << fmt::format("warning: sweep.rank_by metric '{}' is not in any variant's metrics.csv (it scores 0 everywhere); "
-                       "metrics: {}\n", c.metric, names);
+    sweep.log << fmt::format("warning: sweep.rank_by metric '{}' is not in any variant's metrics.csv (it scores 0 everywhere); "
+                             "metrics: {}\n", c.metric, names);
   }
-  if (plan.samples > 0) {
-    const UncertaintySummary summary = summarise_uncertainty(plan, input.variants, input.criteria, options.out + "/report");
-    input.extra_html = summary.html;
-    input.title = fmt::format("Design runs with calibration uncertainty: {}", fs::path(options.case_path).filename().string());
-    log << fmt::format("calibration uncertainty ({} parameter sets per design): median [90 % band]\n", plan.samples);
-    for (const std::string& note : plan.held) log << "  " << note << "\n";
-    for (const KpiBand& b : summary.bands)
-      if (b.p95 != b.p05 || b.median != 0)
-        log << fmt::format("  {}{:<34} {:.4g} [{:.4g}, {:.4g}]{}\n", b.design.empty() ? "" : b.design + ": ", b.metric, b.median, b.p05, b.p95,
-                           std::isfinite(b.run_noise) ? fmt::format("  (run noise {:.2g})", b.run_noise) : "");
-    for (const Beats& x : summary.beats)
-      if (x.probability > 0.5) log << fmt::format("  P({} beats {} on {}) = {:.2f} over {} parameter sets\n", x.a, x.b, x.metric, x.probability, x.pairs);
-  }
-  if (!plan.bias_runs.empty()) {
-    const BiasSummary summary = summarise_bias_check(plan, input.variants, options.out + "/report");
-    input.extra_html = summary.html;
-    input.title = fmt::format("What the scalings cost: {}", fs::path(options.case_path).filename().string());
-    log << "bias check: each KPI as the case runs against the checks\n";
-    for (const KpiShift& s : summary.shifts)
-      log << fmt::format("  {}{}{}\n", s.design.empty() ? "" : s.design + ": ", s.sensitive ? "SENSITIVE: " : "", s.words);
-  }
-  report::write_sweep_report(input, options.out + "/report");
+}
+
+/// With `uncertainty:`: each KPI's band over the parameter sets, on the page and in the log.
+void report_uncertainty(const SweepRank& sweep, report::SweepReportInput& input) {
+  const SweepPlan& plan = sweep.plan;
+  std::ostream& log = sweep.log;
+  const UncertaintySummary summary = summarise_uncertainty(plan, input.variants, input.criteria, sweep.options.out + "/report");
+  input.extra_html = summary.html;
+  input.title = fmt::format("Design runs with calibration uncertainty: {}", fs::path(sweep.options.case_path).filename().string());
+  log << fmt::format("calibration uncertainty ({} parameter sets per design): median [90 % band]\n", plan.samples);
+  for (const std::string& note : plan.held) log << "  " << note << "\n";
+  for (const KpiBand& b : summary.bands)
+    if (b.p95 != b.p05 || b.median != 0)
+      log << fmt::format("  {}{:<34} {:.4g} [{:.4g}, {:.4g}]{}\n", b.design.empty() ? "" : b.design + ": ", b.metric, b.median, b.p05, b.p95,
+                         std::isfinite(b.run_noise) ? fmt::format("  (run noise {:.2g})", b.run_noise) : "");
+  for (const Beats& x : summary.beats)
+    if (x.probability > 0.5) log << fmt::format("  P({} beats {} on {}) = {:.2f} over {} parameter sets\n", x.a, x.b, x.metric, x.probability, x.pairs);
+}
+
+/// With `bias_check:`: how each KPI moves under the checks, on the page and in the log.
+void report_bias_check(const SweepRank& sweep, report::SweepReportInput& input) {
+  std::ostream& log = sweep.log;
+  const BiasSummary summary = summarise_bias_check(sweep.plan, input.variants, sweep.options.out + "/report");
+  input.extra_html = summary.html;
+  input.title = fmt::format("What the scalings cost: {}", fs::path(sweep.options.case_path).filename().string());
+  log << "bias check: each KPI as the case runs against the checks\n";
+  for (const KpiShift& s : summary.shifts)
+    log << fmt::format("  {}{}{}\n", s.design.empty() ? "" : s.design + ": ", s.sensitive ? "SENSITIVE: " : "", s.words);
+}
+
+/// Writes the comparison report into OUT/report and tells the ranking.
+void write_and_rank(const SweepRank& sweep, const report::SweepReportInput& input) {
+  report::write_sweep_report(input, sweep.options.out + "/report");
   const auto ranked = report::rank_variants(input);
-  log << fmt::format("sweep report: {}/report/sweep.html\nranking:\n", options.out);
+  sweep.log << fmt::format("sweep report: {}/report/sweep.html\nranking:\n", sweep.options.out);
   for (size_t r = 0; r < ranked.size(); ++r)
-    log << fmt::format("  {}. {} ({}) score {:.3f}\n", r + 1, input.variants[ranked[r].variant].name, plan.label(ranked[r].variant), ranked[r].score);
-  return std::all_of(status.begin(), status.end(), [](int s) { return s == 0; }) ? 0 : 1;
+    sweep.log << fmt::format("  {}. {} ({}) score {:.3f}\n", r + 1, input.variants[ranked[r].variant].name, sweep.plan.label(ranked[r].variant),
+                             ranked[r].score);
+}
+
+}  // namespace
+
+int run_sweep(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
+  const SweepRank sweep = size_this_rank(plan, options, log);
+  announce(sweep);
+  ChildProgram child;
+  find_child_program(child);
+  RankRuns runs = run_variants(sweep, child);
+  const std::vector<std::string> records = gather_results(sweep, runs);
+  if (sweep.world.rank != 0) return 0;  // rank 0 reports the campaign and gives its exit status
+  const VariantResults results = read_results(records, sweep.n, runs.status);
+  report::SweepReportInput input = comparison_input(sweep, runs.status, results);
+  warn_of_unknown_criteria(sweep, input);
+  if (plan.samples > 0) report_uncertainty(sweep, input);
+  if (!plan.bias_runs.empty()) report_bias_check(sweep, input);
+  write_and_rank(sweep, input);
+  return std::all_of(runs.status.begin(), runs.status.end(), [](int s) { return s == 0; }) ? 0 : 1;
 }
 
 }  // namespace dem::app
