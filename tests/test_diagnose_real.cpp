@@ -88,6 +88,7 @@ CalibrationOptions real_options() {
   CalibrationOptions o;
   o.replicas = 2;
   o.size_factor = 0.5;
+  o.correct_size = false;  // the measurements are synthesised at this size
   o.threads = 1;
   o.parallel = 2;  // two simulations at once (the outcomes do not depend on it)
   o.rounds = 1;

@@ -99,6 +99,11 @@ struct CalibrationOptions {
   /// measurements are then of the apparatus as simulated). A diagnosis that shrinks the apparatus
   /// to fit its budget measures it (diagnose()).
   std::map<std::string, SizeShift> size_shift;
+  /// diagnose with size_factor < 1: the measurements are of the full-size apparatus; the model as
+  /// it is is compared at both sizes first and the shrinking corrected (size_shift), and the
+  /// model named is compared at full size. false: the measurements are of the apparatus as
+  /// shrunk (synthetic data made at that size), nothing is corrected.
+  bool correct_size = true;
   double rayleigh_fraction = 0; ///< the virtual tests' time step (TestOptions); 0: their rule
   int threads = 0;              ///< OpenMP threads of each simulation; 0: default (1 when parallel > 1)
   /// Simulations of a batch run at once in this process when no `batch` runner is set, each on
@@ -439,6 +444,11 @@ struct Diagnosis {
   /// full size, the simulations then carrying size_shift (CalibrationOptions::size_shift).
   double size_factor = 1.0;
   std::map<std::string, SizeShift> size_shift;
+  /// diagnose with size_factor < 1: the measurements are of the full-size apparatus; the model as
+  /// it is is compared at both sizes first and the shrinking corrected (size_shift), and the
+  /// model named is compared at full size. false: the measurements are of the apparatus as
+  /// shrunk (synthetic data made at that size), nothing is corrected.
+  bool correct_size = true;
   /// Shrunk diagnoses: the best candidate's fitted model compared at full size, on which its grade
   /// rests (empty runs when none was checked).
   Comparison full_size;

@@ -229,7 +229,9 @@ class Progress {
     if (command.active()) {
       // Beyond this phase: the command's other planned simulations at the mean cost of one.
       const int beyond = std::max(command.left() - static_cast<int>(planned_.size()), 0);
-      const double all = left + beyond * costs.pass_mean(size_tag()) / workers(options_, static_cast<size_t>(beyond));
+      double all = left + beyond * costs.pass_mean(size_tag()) / workers(options_, static_cast<size_t>(beyond));
+      // A budgeted command's first comparison comes before its plan, which fits the budget.
+      if (options_.budget_seconds > 0) all = std::min(all, std::max(left, options_.budget_seconds - command.elapsed()));
       line += fmt::format("; {}: simulation {} of about {}, {} elapsed, about {} left", command.what(), command.done(), command.done() + command.left(),
                           duration_text(command.elapsed()), std::isfinite(all) ? duration_text(all) : std::string("? s"));
     }
