@@ -163,11 +163,16 @@ PlateStress plate_stress(const State& s, double area) {
   return p;
 }
 
-/// A run through the phases: one state, a model per phase (same particles and walls).
+/// A run through the phases: one state, a model per phase (same particles and walls), and what
+/// the phases measure on the way.
 struct Run {
   Model model;
   State state;
   Workspace work;
+  double dt = 0;                // [s] the first phase's time step; every phase's step counts use it
+  std::int64_t free_count = 0;  // particles not glued to a plate
+  double free_mass = 0;         // [kg] of those, without mass scaling
+  double sample_height = 0;     // [m] between the tops of the glued layers, once consolidated
   void start(const CaseSpec& spec) {
     model = compile(spec);
     state = initial_state(model);
@@ -182,29 +187,51 @@ struct Run {
   }
 };
 
-}  // namespace
+/// The set-up's figures.
+struct ShearSetup {
+  double length = 0, width = 0;     // [m] cell periods asked for
+  double preshear = 0, normal = 0;  // [Pa] pre-shear and normal stress
+  double speed = 0;                 // [m/s] shear velocity
+};
 
-SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup& setup, const TestOptions& options) {
-  const auto clock = std::chrono::steady_clock::now();
+/// What every phase of a run reads: the cell, the stresses and speeds, the mass scaling.
+struct ShearPlan {
+  const MaterialModel& material;
+  const TestOptions& options;
+  const Cell& cell;
+  double preshear, normal, speed;  // [Pa], [Pa], [m/s]
+  double d50, height, area;        // [m] d50 and sample height aimed at, [m^2] cell area
+  double density, rate;            // [kg/m^3] particle density, [1/s] shear rate
+  double mass_scaling;             // [-]
+  double servo_speed;              // [m/s] the servo's speed limit in consolidation and pre-shear
+};
+
+/// The peak of the shear phase.
+struct Peak {
+  double stress = 0;  // [Pa] largest smoothed shear stress
+  double at = 0;      // [m] shear displacement there
+  double normal = 0;  // [Pa] plate normal stress there
+  bool passed = false;
+};
+
+/// Reads and checks the set-up.
+ShearSetup read_setup(const MaterialModel& material, const TestSetup& setup) {
   const detail::SetupReader read(material, setup);
-  const double length = read.number("cell_length", 1e-4, 10.0, "m");
-  const double width = read.number("cell_width", 1e-4, 10.0, "m");
-  const double preshear = read.number("preshear_stress", 1.0, 1e8, "Pa");
-  const double normal = read.number("normal_stress", 1.0, 1e8, "Pa");
-  const double speed = read.number("shear_velocity", 1e-9, 10.0, "m/s");
-  if (normal > preshear)
+  ShearSetup asked;
+  asked.length = read.number("cell_length", 1e-4, 10.0, "m");
+  asked.width = read.number("cell_width", 1e-4, 10.0, "m");
+  asked.preshear = read.number("preshear_stress", 1.0, 1e8, "Pa");
+  asked.normal = read.number("normal_stress", 1.0, 1e8, "Pa");
+  asked.speed = read.number("shear_velocity", 1e-9, 10.0, "m/s");
+  if (asked.normal > asked.preshear)
     read.fail("normal_stress", fmt::format("{:g} Pa exceeds preshear_stress = {:g} Pa; a yield locus point is sheared at or below its "
-                                           "pre-shear stress", normal, preshear));
+                                           "pre-shear stress", asked.normal, asked.preshear));
   read.finish();
-  if (options.validate_only) return {};
-  const Sizes sizes = sizes_of(material);
-  const double d50 = sizes.d50;
+  return asked;
+}
 
-  // Cell: the set-up's area times size_factor, at least three neighbour cells per period (the
-  // engine's rule; the reach of the contact law comes from a trial compile).
-  Cell cell;
-  cell.d_glue = d50;
-  const double height = 10 * d50;  // [m] sample height aimed at
+/// [-] A clump's bounding diameter over its equivalent diameter, roughly; 1 for spheres.
+double bounding_factor(const MaterialModel& material) {
   double bounding = 1.0;
   if (!material.shape.empty()) {
     const auto& t = material.shape[0];
@@ -214,13 +241,25 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
     for (size_t k = 0; k < t.radii.size(); ++k) reach = std::max(reach, t.centres[k].norm() + t.radii[k]);
     bounding = std::max(1.0, reach / r_eq);
   }
-  cell.length = std::max(length * options.size_factor, 1e-6);
-  cell.width = std::max(width * options.size_factor, 1e-6);
+  return bounding;
+}
+
+/// Cell: the set-up's area times size_factor, at least three neighbour cells per period (the
+/// engine's rule; the reach of the contact law comes from a trial compile); the free particles
+/// and the region they are placed in.
+Cell size_cell(const MaterialModel& material, const TestOptions& options, const ShearSetup& asked, const Sizes& sizes,
+               double height) {
+  const double d50 = sizes.d50;
+  Cell cell;
+  cell.d_glue = d50;
+  const double bounding = bounding_factor(material);
+  cell.length = std::max(asked.length * options.size_factor, 1e-6);
+  cell.width = std::max(asked.width * options.size_factor, 1e-6);
   {
     Cell trial = cell;
     trial.length = trial.width = 100 * sizes.largest * bounding;
     trial.top_start = 10 * height, trial.count = 1, trial.fill_low = d50 * 1.5, trial.fill_high = 9 * height;
-    const Model probe = compile(shear_case(material, options, trial, 1.0, preshear, 1.0, 0.0));
+    const Model probe = compile(shear_case(material, options, trial, 1.0, asked.preshear, 1.0, 0.0));
     const double minimum = 3.05 * (2 * probe.radius_max + probe.interaction_range + probe.skin);
     cell.length = std::max(cell.length, minimum);
     cell.width = std::max(cell.width, minimum);
@@ -234,58 +273,88 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
   cell.fill_low = 1.05 * d50;
   cell.fill_high = cell.fill_low + fill_height;
   cell.top_start = cell.fill_high + 1.05 * d50;
+  return cell;
+}
 
-  // Mass scaling for a quasi-static shear (I = 8e-4 at the lower normal stress).
+/// The loading of every phase, with the mass scaling for a quasi-static shear (I = 8e-4 at the
+/// lower normal stress).
+ShearPlan plan_loading(const MaterialModel& material, const TestOptions& options, const ShearSetup& asked, const Cell& cell,
+                       double d50, double height) {
+  const double area = cell.length * cell.width;
   const double density = material.particle.density;
-  const double rate = speed / height;  // [1/s]
+  const double rate = asked.speed / height;  // [1/s]
   const double scaling_for_I =
-      std::pow(kTargetInertialNumber * std::sqrt(normal / density) / (rate * d50), 2);
+      std::pow(kTargetInertialNumber * std::sqrt(asked.normal / density) / (rate * d50), 2);
   const double mass_scaling = std::max({material.mass_scaling, scaling_for_I, 1.0});
-  const double servo_speed = 4 * speed;
+  const double servo_speed = 4 * asked.speed;
+  return {material, options, cell, asked.preshear, asked.normal, asked.speed, d50, height, area, density, rate, mass_scaling,
+          servo_speed};
+}
 
-  SimulatedOutcome out;
-  Run run;
-  run.start(shear_case(material, options, cell, mass_scaling, preshear, servo_speed, 0.0));
+/// The case of one phase of the run: the servo target, its speed limit and the plate's tangential velocity.
+CaseSpec phase_case(const ShearPlan& plan, double target, double max_speed, double velocity) {
+  return shear_case(plan.material, plan.options, plan.cell, plan.mass_scaling, target, max_speed, velocity);
+}
+
+/// [m] between the glued layers' centre planes.
+double glued_gap(const ShearPlan& plan, const State& state) {
+  return (state.walls.pz[1] - 0.5 * plan.cell.d_glue) - (state.walls.pz[0] + 0.5 * plan.cell.d_glue);
+}
+
+/// A progress line to stdout when options.progress.
+void progress(const ShearPlan& plan, const std::string& line) {
+  if (plan.options.progress) fmt::print("  direct_shear: {}\n", line);
+}
+
+/// Holding a stress: both plates' stresses, averaged over a check interval (the plate moving
+/// 0.02 H at full servo speed), within 8 % of the target for 3 intervals in a row. (The servo
+/// is a proportional controller; on a stiff packing it chatters about a mean a few % low.)
+bool hold(const ShearPlan& plan, Run& run, double target, double max_time) {
+  const double area = plan.area, dt = run.dt;
+  const std::int64_t check = std::max<std::int64_t>(1, std::llround(0.02 * plan.height / plan.servo_speed / dt));
+  int good = 0;
+  const double until = run.state.time + max_time;
+  while (good < 3 && run.state.time < until) {
+    double top = 0, bottom = 0;
+    for (std::int64_t k = 0; k < check; ++k) {
+      step(run.model, run.state, run.work);
+      const PlateStress p = plate_stress(run.state, area);
+      top += p.top / check, bottom += p.bottom / check;
+    }
+    good = std::abs(top / target - 1) < 0.08 && std::abs(bottom / target - 1) < 0.08 ? good + 1 : 0;
+  }
+  return good >= 3;
+}
+
+/// The fill: the servo plate closing on it at the pre-shear stress; the free particles counted.
+void start_run(const ShearPlan& plan, Run& run, SimulatedOutcome& out) {
+  run.start(phase_case(plan, plan.preshear, plan.servo_speed, 0.0));
   std::int64_t free_count = 0;
   double free_mass = 0;
   for (size_t p = 0; p < run.state.size(); ++p)
-    if (run.state.attached[p] < 0) ++free_count, free_mass += 1.0 / run.state.inv_mass[p] / mass_scaling;
+    if (run.state.attached[p] < 0) ++free_count, free_mass += 1.0 / run.state.inv_mass[p] / plan.mass_scaling;
+  run.free_count = free_count, run.free_mass = free_mass;
   out.particles = static_cast<std::int64_t>(run.state.size());
-  const double dt = run.model.dt;
-  auto glued_gap = [&] {  // [m] between the glued layers' centre planes
-    return (run.state.walls.pz[1] - 0.5 * cell.d_glue) - (run.state.walls.pz[0] + 0.5 * cell.d_glue);
-  };
-  auto progress = [&](const std::string& line) {
-    if (options.progress) fmt::print("  direct_shear: {}\n", line);
-  };
+  run.dt = run.model.dt;
+}
 
-  // Holding a stress: both plates' stresses, averaged over a check interval (the plate moving
-  // 0.02 H at full servo speed), within 8 % of the target for 3 intervals in a row. (The servo
-  // is a proportional controller; on a stiff packing it chatters about a mean a few % low.)
-  auto hold = [&](double target, double max_time) {
-    const std::int64_t check = std::max<std::int64_t>(1, std::llround(0.02 * height / servo_speed / dt));
-    int good = 0;
-    const double until = run.state.time + max_time;
-    while (good < 3 && run.state.time < until) {
-      double top = 0, bottom = 0;
-      for (std::int64_t k = 0; k < check; ++k) {
-        step(run.model, run.state, run.work);
-        const PlateStress p = plate_stress(run.state, area);
-        top += p.top / check, bottom += p.bottom / check;
-      }
-      good = std::abs(top / target - 1) < 0.08 && std::abs(bottom / target - 1) < 0.08 ? good + 1 : 0;
-    }
-    return good >= 3;
-  };
-  const bool consolidated = hold(preshear, 3 * (cell.top_start - height) / servo_speed + 20 * height / servo_speed);
+/// Consolidation at the pre-shear stress; the bulk density between the glued layers' tops.
+void consolidate(const ShearPlan& plan, Run& run, SimulatedOutcome& out) {
+  const double height = plan.height, servo_speed = plan.servo_speed, preshear = plan.preshear;
+  const bool consolidated = hold(plan, run, preshear, 3 * (plan.cell.top_start - height) / servo_speed + 20 * height / servo_speed);
   if (!consolidated) out.flags.push_back("not_consolidated");
-  const double sample_height = glued_gap() - cell.d_glue;  // between the tops of the glued layers
-  out.observables["bulk_density"] = free_mass / (area * sample_height);
-  progress(fmt::format("consolidated at {:g} Pa{}: height {:.2f} d50, bulk density {:.0f} kg/m^3, t = {:.3g} s", preshear,
-                       consolidated ? "" : " (not within 8 %)", sample_height / d50, out.observables["bulk_density"], run.state.time));
+  run.sample_height = glued_gap(plan, run.state) - plan.cell.d_glue;  // between the tops of the glued layers
+  out.observables["bulk_density"] = run.free_mass / (plan.area * run.sample_height);
+  progress(plan, fmt::format("consolidated at {:g} Pa{}: height {:.2f} d50, bulk density {:.0f} kg/m^3, t = {:.3g} s", preshear,
+                             consolidated ? "" : " (not within 8 %)", run.sample_height / plan.d50, out.observables["bulk_density"],
+                             run.state.time));
+}
 
-  // Pre-shear until the window means settle; sample every 1/50 window.
-  run.switch_to(shear_case(material, options, cell, mass_scaling, preshear, servo_speed, speed));
+/// Pre-shear until the window means settle; sample every 1/50 window. The steady shear stress,
+/// and the stress tensor over the last window against the plates.
+void preshear_to_steady(const ShearPlan& plan, Run& run, SimulatedOutcome& out) {
+  const double height = plan.height, speed = plan.speed, area = plan.area, dt = run.dt;
+  run.switch_to(phase_case(plan, plan.preshear, plan.servo_speed, speed));
   const double window = 0.1 * height;  // [m] of shear displacement
   const std::int64_t sample_steps = std::max<std::int64_t>(1, std::llround(window / 50 / speed / dt));
   std::vector<double> means;
@@ -301,7 +370,7 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
     const PlateStress p = plate_stress(run.state, area);
     shear_sum += p.shear, normal_sum += p.normal, ++samples;
     // The tensor over the sample between the glued centre planes, in the last window.
-    const Eigen::Matrix3d sigma = contact_stress(run.model, run.state, run.work, area * glued_gap());
+    const Eigen::Matrix3d sigma = contact_stress(run.model, run.state, run.work, area * glued_gap(plan, run.state));
     tensor_sum += sigma, plate_sum.shear += p.shear, plate_sum.normal += p.normal, ++tensor_samples;
     if (samples < 50) continue;
     means.push_back(shear_sum / samples);
@@ -323,22 +392,32 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
   out.notes.push_back(fmt::format(
       "pre-shear at {:g} Pa: steady after {:.2f} H of displacement; stress tensor (Eq. 5) agrees with the plates to "
       "{:.1f} % (normal: {:.0f} vs {:.0f} Pa) and {:.1f} % (shear: {:.0f} vs {:.0f} Pa), mean over the last window",
-      preshear, shifted / height, 100 * std::abs(tensor(2, 2) / plate_normal - 1), tensor(2, 2), plate_normal,
+      plan.preshear, shifted / height, 100 * std::abs(tensor(2, 2) / plate_normal - 1), tensor(2, 2), plate_normal,
       100 * std::abs(-tensor(0, 2) / plate_shear - 1), -tensor(0, 2), plate_shear));
-  progress(out.notes.back());
+  progress(plan, out.notes.back());
+}
 
-  // Unload to the normal stress with the plate at rest, then shear past the peak. The servo's
-  // speed limit scales with its target: the same gain per pascal as in pre-shear (a gain per
-  // relative error would chatter at the lower stress and hold it too high).
-  const double unload_speed = servo_speed * normal / preshear;
-  run.switch_to(shear_case(material, options, cell, mass_scaling, normal, unload_speed, 0.0));
-  if (!hold(normal, 20 * height / unload_speed)) out.flags.push_back("not_unloaded");
-  progress(fmt::format("unloaded to {:g} Pa at t = {:.3g} s", normal, run.state.time));
-  run.switch_to(shear_case(material, options, cell, mass_scaling, normal, unload_speed, speed));
+/// Unload to the normal stress with the plate at rest. The servo's speed limit scales with its
+/// target: the same gain per pascal as in pre-shear (a gain per relative error would chatter at
+/// the lower stress and hold it too high). Returns that speed limit [m/s].
+double unload(const ShearPlan& plan, Run& run, SimulatedOutcome& out) {
+  const double normal = plan.normal;
+  const double unload_speed = plan.servo_speed * normal / plan.preshear;
+  run.switch_to(phase_case(plan, normal, unload_speed, 0.0));
+  if (!hold(plan, run, normal, 20 * plan.height / unload_speed)) out.flags.push_back("not_unloaded");
+  progress(plan, fmt::format("unloaded to {:g} Pa at t = {:.3g} s", normal, run.state.time));
+  return unload_speed;
+}
+
+/// Shear at the normal stress past the peak of the smoothed shear stress.
+Peak shear_past_peak(const ShearPlan& plan, Run& run, double unload_speed, SimulatedOutcome& out) {
+  const double height = plan.height, speed = plan.speed, area = plan.area, dt = run.dt;
+  run.switch_to(phase_case(plan, plan.normal, unload_speed, speed));
   const double smooth = 0.02 * height;  // [m]
   const std::int64_t smooth_steps = std::max<std::int64_t>(1, std::llround(smooth / 10 / speed / dt));
   double peak = -1e300, peak_at = 0, peak_normal = 0, window_normal = 0;
-  shifted = 0, shear_sum = 0, samples = 0;
+  double shifted = 0, shear_sum = 0;
+  int samples = 0;
   bool passed = false;
   while (!passed && shifted < 0.6 * height) {
     for (std::int64_t k = 0; k < smooth_steps; ++k) step(run.model, run.state, run.work);
@@ -353,16 +432,45 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
   }
   if (!passed) out.flags.push_back("no_peak");
   out.observables["peak_shear_stress"] = peak;
-  const double inertial = rate * d50 / std::sqrt(normal / (density * mass_scaling));
+  Peak found;
+  found.stress = peak, found.at = peak_at, found.normal = peak_normal, found.passed = passed;
+  return found;
+}
+
+/// The shear phase's note, and the cell's with the inertial number reached.
+void report_shear(const ShearPlan& plan, const Run& run, const Peak& peak, SimulatedOutcome& out) {
+  const double d50 = plan.d50, normal = plan.normal, rate = plan.rate, mass_scaling = plan.mass_scaling;
+  const double inertial = rate * d50 / std::sqrt(normal / (plan.density * mass_scaling));
   out.notes.push_back(fmt::format(
-      "shear at {:g} Pa: peak {:.0f} Pa after {:.3f} H (plate normal stress there {:.0f} Pa){}", normal, peak,
-      peak_at / height, peak_normal, passed ? "" : "; no peak within 0.6 H (largest value reported)"));
+      "shear at {:g} Pa: peak {:.0f} Pa after {:.3f} H (plate normal stress there {:.0f} Pa){}", normal, peak.stress,
+      peak.at / plan.height, peak.normal, peak.passed ? "" : "; no peak within 0.6 H (largest value reported)"));
   out.notes.push_back(fmt::format(
       "cell {:.4g} x {:.4g} m, sample {:.2f} d50 high, {} free + {} glued particles, d50 {:.4g} m; mass scaling {:g}, "
       "inertial number {:.2g} at {:g} Pa (shear rate {:.3g} 1/s)",
-      cell.length, cell.width, sample_height / d50, free_count, out.particles - free_count, d50, mass_scaling, inertial,
-      normal, rate));
-  progress(out.notes.back());
+      plan.cell.length, plan.cell.width, run.sample_height / d50, run.free_count, out.particles - run.free_count, d50,
+      mass_scaling, inertial, normal, rate));
+  progress(plan, out.notes.back());
+}
+
+}  // namespace
+
+SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup& setup, const TestOptions& options) {
+  const auto clock = std::chrono::steady_clock::now();
+  const ShearSetup asked = read_setup(material, setup);
+  if (options.validate_only) return {};
+  const Sizes sizes = sizes_of(material);
+  const double height = 10 * sizes.d50;  // [m] sample height aimed at
+  const Cell cell = size_cell(material, options, asked, sizes, height);
+  const ShearPlan plan = plan_loading(material, options, asked, cell, sizes.d50, height);
+
+  SimulatedOutcome out;
+  Run run;
+  start_run(plan, run, out);
+  consolidate(plan, run, out);
+  preshear_to_steady(plan, run, out);
+  const double unload_speed = unload(plan, run, out);
+  const Peak peak = shear_past_peak(plan, run, unload_speed, out);
+  report_shear(plan, run, peak, out);
   out.simulated_seconds = run.state.time;
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
   if (options.on_final) options.on_final(run.model, run.state);

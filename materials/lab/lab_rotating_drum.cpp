@@ -66,34 +66,69 @@ double surface_angle(const State& s, double d50, double half_depth, bool periodi
   return std::abs(std::atan(fit_line(x, z).second)) * 180 / std::numbers::pi;
 }
 
-}  // namespace
+/// The drum the set-up asks for, scaled by size_factor, and the figures every phase reads.
+struct Drum {
+  double diameter = 0, depth_asked = 0;  // [m] as asked, times size_factor
+  double fill = 0;                       // [-] fill_fraction
+  double rpm = 0;                        // [rev/min]
+  double poured = 0;                     // [-] poured solid fraction
+  bool periodic = false;                 // `ends: periodic`
+  std::string wall_material;
+  SizeFigures size;
+  double radius = 0, d50 = 0;            // [m]
+  double spacing = 0;                    // [m] lattice pitch: 1.05 largest bounding diameters
+  double omega = 0, revolution = 0;      // [rad/s], [s]
+  double depth = 0;                      // [m] depth_asked, raised for a periodic slice
+};
 
-SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
-  const Clock clock;
-  const SetupReader read(model, setup);
+/// How the drum is filled: the particle count, and whether a packing inlet pours them.
+struct Fill {
+  std::int64_t count = 0;
+  bool poured = false;
+};
+
+/// What the samples over the revolution add up.
+struct DrumSamples {
+  double angle_sum = 0;    // [deg] of the fitted samples
+  double carried_sum = 0;  // [-] wall layer speed over wall speed, of all samples
+  int used = 0;            // samples whose surface could be fitted
+};
+
+constexpr int kSamples = 24;  // over the revolution after spin-up
+
+/// Reads and checks the set-up.
+Drum read_drum(const SetupReader& read, const MaterialModel& model, const TestOptions& options) {
+  Drum drum;
   const double scale = options.size_factor;
-  const double diameter = scale * read.number("drum_diameter", 1e-3, 20.0, "m");
-  const double depth_asked = scale * read.number("drum_depth", 1e-3, 20.0, "m");
-  const double fill = read.number("fill_fraction", 0.05, 0.7, "-");
-  const double rpm = read.number("rpm", 0.01, 1000.0, "rev/min");
-  const double poured = read.number("poured_solid_fraction", 0.6, 0.2, 0.74, "-");
-  const bool periodic = read.word("ends", "walls", {"walls", "periodic"}) == "periodic";
-  const std::string wall_material = read.wall("wall");
-  const SizeFigures size = size_figures(model);
-  const double radius = 0.5 * diameter, d50 = size.d50, spacing = 1.05 * size.largest * size.bounding_factor;
-  const double omega = rpm * 2 * std::numbers::pi / 60, revolution = 60 / rpm;
+  drum.diameter = scale * read.number("drum_diameter", 1e-3, 20.0, "m");
+  drum.depth_asked = scale * read.number("drum_depth", 1e-3, 20.0, "m");
+  drum.fill = read.number("fill_fraction", 0.05, 0.7, "-");
+  drum.rpm = read.number("rpm", 0.01, 1000.0, "rev/min");
+  drum.poured = read.number("poured_solid_fraction", 0.6, 0.2, 0.74, "-");
+  drum.periodic = read.word("ends", "walls", {"walls", "periodic"}) == "periodic";
+  drum.wall_material = read.wall("wall");
+  drum.size = size_figures(model);
+  const SizeFigures& size = drum.size;
+  drum.radius = 0.5 * drum.diameter, drum.d50 = size.d50, drum.spacing = 1.05 * size.largest * size.bounding_factor;
+  drum.omega = drum.rpm * 2 * std::numbers::pi / 60, drum.revolution = 60 / drum.rpm;
   // A periodic slice must span three neighbour cells of the engine (2 x largest radius + skin
   // of half the smallest radius + interaction range, model.cpp's check); with 10 % for a
   // bridge's or neck's reach. The angle is per unit depth, so a thicker slice changes only the
   // count: a size factor never makes the drum invalid.
   const double min_periodic_depth = 3.0 * 1.1 * (size.largest * size.bounding_factor + 0.25 * size.largest);
-  const double depth = periodic ? std::max(depth_asked, min_periodic_depth) : depth_asked;
-  if (radius < 3 * spacing)
+  drum.depth = drum.periodic ? std::max(drum.depth_asked, min_periodic_depth) : drum.depth_asked;
+  if (drum.radius < 3 * drum.spacing)
     read.fail("drum_diameter", fmt::format("{:g} m (x size_factor {:g}) holds fewer than six particles across; make it at least {:g} m",
-                                           diameter / scale, scale, 6 * spacing / scale));
+                                           drum.diameter / scale, scale, 6 * drum.spacing / scale));
   read.finish();
-  if (options.validate_only) return {};
+  return drum;
+}
 
+/// The case without its particles: the turning drum and its domain.
+CaseSpec drum_case(const MaterialModel& model, const TestOptions& options, const Drum& drum) {
+  const double radius = drum.radius, depth = drum.depth, omega = drum.omega;
+  const bool periodic = drum.periodic;
+  const std::string& wall_material = drum.wall_material;
   CaseSpec spec = base_case(model, options, {wall_material}, "rotating_drum");
   // The drum about the y axis, its surface turning at omega about +y (v = omega y x r); an end
   // plate turns about its own normal, so the back one (normal -y) at -omega.
@@ -112,9 +147,16 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   spec.simulation.domain_min = Vec3(-radius - 0.01, -0.5 * depth - (periodic ? 0.0 : 0.01), -radius - 0.01);
   spec.simulation.domain_max = Vec3(radius + 0.01, 0.5 * depth + (periodic ? 0.0 : 0.01), radius + 0.01);
   spec.simulation.periodic[1] = periodic;
+  return spec;
+}
 
-  // The fill: the lowest sites of a jittered cubic lattice inside the drum.
-  const auto count = static_cast<std::int64_t>(std::ceil(fill * std::numbers::pi * radius * radius * depth * poured / size.mean_volume));
+/// The fill: the lowest sites of a jittered cubic lattice inside the drum, or a packing inlet
+/// when the lattice has too few.
+Fill add_fill(const MaterialModel& model, const TestOptions& options, const Drum& drum, CaseSpec& spec) {
+  const double radius = drum.radius, depth = drum.depth, spacing = drum.spacing;
+  const bool periodic = drum.periodic;
+  const auto count =
+      static_cast<std::int64_t>(std::ceil(drum.fill * std::numbers::pi * radius * radius * depth * drum.poured / drum.size.mean_volume));
   const int layers = std::max(1, static_cast<int>(std::floor((periodic ? depth : depth - spacing) / spacing + (periodic ? 0 : 1))));
   const double sy = periodic ? depth / layers : spacing;
   ParticleSetSpec set = particle_box(model, 0, Vec3::Zero(), Vec3::Zero());
@@ -143,47 +185,82 @@ SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& 
   } else {
     spec.particles.push_back(set);
   }
+  Fill made;
+  made.count = count, made.poured = poured_fill;
+  return made;
+}
+
+/// A poured fill: until the count is in, then the time to fall across the drum. Returns the
+/// time [s] the fill took.
+double pour(Runner& run, const SetupReader& read, const Drum& drum, const Fill& fill, SimulatedOutcome& out) {
+  const std::int64_t count = fill.count;
+  const double fall = std::sqrt(2 * drum.diameter / 9.81), cap = 40 * fall;
+  if (!run.advance_until([&] { return run.state.inlets[0].inserted >= count; }, cap, 0.25 * fall))
+    read.fail("fill_fraction", fmt::format("{:g}: {} of {} particles poured into the drum in {:.2g} s; use a smaller fill", drum.fill,
+                                           run.state.inlets[0].inserted, count, cap));
+  run.advance_until([] { return false; }, run.state.time + fall, fall);
+  const double filled = run.state.time;
+  out.notes.push_back(fmt::format("poured in {:.2g} s (clumps leave a lattice too few sites)", filled));
+  return filled;
+}
+
+/// How fast the wall layer moves along the wall, as a share of the wall speed.
+double wall_layer_share(const State& state, const Drum& drum) {
+  const double radius = drum.radius, spacing = drum.spacing, omega = drum.omega;
+  double along = 0;
+  int n = 0;
+  for (size_t p = 0; p < state.size(); ++p) {
+    const double x = state.x[p], z = state.z[p], rho = std::hypot(x, z);
+    if (rho < radius - spacing || rho == 0) continue;
+    along += (state.vx[p] * z - state.vz[p] * x) / rho, ++n;  // omega along +y: v = w y x r
+  }
+  return n ? along / n / (omega * radius) : 0.0;
+}
+
+/// Spin-up, then 24 samples over one revolution.
+DrumSamples sample_revolution(Runner& run, const Drum& drum, double filled) {
+  const double revolution = drum.revolution;
+  run.advance_until([] { return false; }, filled + revolution, revolution);
+  DrumSamples sum;
+  for (int k = 1; k <= kSamples; ++k) {
+    run.advance_until([] { return false; }, filled + revolution * (1 + double(k) / kSamples), revolution);
+    const double angle = surface_angle(run.state, drum.d50, 0.5 * drum.depth, drum.periodic);
+    if (angle >= 0) sum.angle_sum += angle, ++sum.used;
+    sum.carried_sum += wall_layer_share(run.state, drum);
+  }
+  return sum;
+}
+
+/// The dynamic angle, the slipping flag and the notes.
+void report_angle(const Drum& drum, const DrumSamples& sum, SimulatedOutcome& out) {
+  const double carried = sum.carried_sum / kSamples;
+  out.observables["dynamic_angle_deg"] = sum.used ? sum.angle_sum / sum.used : 0.0;
+  if (carried < 0.5) out.flags.push_back("slipping");
+  if (drum.depth > drum.depth_asked)
+    out.notes.push_back(fmt::format("periodic depth {:.4g} m raised to {:.4g} m, three neighbour cells", drum.depth_asked, drum.depth));
+  out.notes.push_back(
+      fmt::format("wall layer moves at {:.0f} % of the wall speed; {} of {} samples fitted", 100 * carried, sum.used, kSamples));
+}
+
+}  // namespace
+
+SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
+  const Clock clock;
+  const SetupReader read(model, setup);
+  const Drum drum = read_drum(read, model, options);
+  if (options.validate_only) return {};
+
+  CaseSpec spec = drum_case(model, options, drum);
+  const Fill fill = add_fill(model, options, drum, spec);
 
   SimulatedOutcome out;
   Runner run(spec);
-  const std::int64_t particles = poured_fill ? count : static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
-  progress(options, fmt::format("rotating_drum: {} particles, {:.3g} m drum at {:g} rpm", particles, diameter, rpm));
-  // A poured fill: until the count is in, then the time to fall across the drum.
-  double filled = 0;
-  if (poured_fill) {
-    const double fall = std::sqrt(2 * diameter / 9.81), cap = 40 * fall;
-    if (!run.advance_until([&] { return run.state.inlets[0].inserted >= count; }, cap, 0.25 * fall))
-      read.fail("fill_fraction", fmt::format("{:g}: {} of {} particles poured into the drum in {:.2g} s; use a smaller fill", fill,
-                                             run.state.inlets[0].inserted, count, cap));
-    run.advance_until([] { return false; }, run.state.time + fall, fall);
-    filled = run.state.time;
-    out.notes.push_back(fmt::format("poured in {:.2g} s (clumps leave a lattice too few sites)", filled));
-  }
-  // Spin-up, then 24 samples over one revolution.
-  run.advance_until([] { return false; }, filled + revolution, revolution);
-  const int samples = 24;
-  double angle_sum = 0, carried_sum = 0;
-  int used = 0;
-  for (int k = 1; k <= samples; ++k) {
-    run.advance_until([] { return false; }, filled + revolution * (1 + double(k) / samples), revolution);
-    const double angle = surface_angle(run.state, d50, 0.5 * depth, periodic);
-    if (angle >= 0) angle_sum += angle, ++used;
-    // How fast the wall layer moves along the wall, as a share of the wall speed.
-    double along = 0;
-    int n = 0;
-    for (size_t p = 0; p < run.state.size(); ++p) {
-      const double x = run.state.x[p], z = run.state.z[p], rho = std::hypot(x, z);
-      if (rho < radius - spacing || rho == 0) continue;
-      along += (run.state.vx[p] * z - run.state.vz[p] * x) / rho, ++n;  // omega along +y: v = w y x r
-    }
-    carried_sum += n ? along / n / (omega * radius) : 0.0;
-  }
-  const double carried = carried_sum / samples;
-  out.observables["dynamic_angle_deg"] = used ? angle_sum / used : 0.0;
-  if (carried < 0.5) out.flags.push_back("slipping");
-  if (depth > depth_asked)
-    out.notes.push_back(fmt::format("periodic depth {:.4g} m raised to {:.4g} m, three neighbour cells", depth_asked, depth));
-  out.notes.push_back(fmt::format("wall layer moves at {:.0f} % of the wall speed; {} of {} samples fitted", 100 * carried, used, samples));
+  const std::int64_t particles =
+      fill.poured ? fill.count : static_cast<std::int64_t>(run.state.bodies.size() ? run.state.bodies.size() : run.state.size());
+  progress(options, fmt::format("rotating_drum: {} particles, {:.3g} m drum at {:g} rpm", particles, drum.diameter, drum.rpm));
+  const double filled = fill.poured ? pour(run, read, drum, fill, out) : 0.0;
+  const DrumSamples samples = sample_revolution(run, drum, filled);
+  report_angle(drum, samples, out);
   finish(out, run, clock, particles, options);
   return out;
 }
