@@ -17,148 +17,206 @@
 
 namespace dem::equipment::detail {
 
-Generated belt_conveyor(MapReader& reader, const EquipmentSpec& spec) {
-  const Materials materials = read_materials(reader);
-  const double length = reader.number("length", 8.0, 1.0, 500.0, "m");
-  const double width = reader.number("width", 0.8, 0.3, 3.0, "m");
-  const double speed = reader.number("speed", 2.0, 0.05, 10.0, "m/s");
-  const double trough = radians(reader.number("troughing_angle_deg", 30.0, 0.0, 45.0, "deg"));
-  const double inclination = reader.number("inclination_deg", 0.0, -20.0, 20.0, "deg");
-  const double pulley_radius = 0.5 * reader.number("pulley_diameter", 0.5, 0.1, 2.0, "m");
-  const double belt_thickness = reader.number("belt_thickness", 0.015, 0.0, 0.1, "m");
-  const double load_height = reader.number("load_height", 0.1, 0.01, 1.0, "m");
-  const double transition = reader.number("transition_length", std::min(0.8, 0.3 * length), 0.0, 0.5 * length, "m");
+namespace {
+
+/// A belt conveyor's parameters as read (defaults filled in), and the tilt and roll widths that
+/// follow from them.
+struct ConveyorLayout {
+  Materials materials;
+  double length = 0, width = 0;                                                    // [m]
+  double speed = 0;                                                                // [m/s]
+  double trough = 0;                                                               // [rad] wing angle
+  double inclination = 0;                                                          // [deg]
+  double pulley_radius = 0, belt_thickness = 0, load_height = 0, transition = 0;  // [m]
+  double spacing = 0, roll_radius = 0;                                             // [m] idlers
+  double skirt_width = 0, skirt_start = 0, skirt_length = 0, skirt_height = 0;    // [m]
+  double margin = 0;                                                               // [m]
+  double tilt_angle = 0;                                                           // [rad]
+  Eigen::Matrix3d tilt = Eigen::Matrix3d::Identity();  // raises the head end: x -> (cos, 0, sin)
+  Vec3 along = Vec3::UnitX();                          // belt direction, tilted
+  double centre = 0, wing = 0;                         // [m] centre roll and wing widths across
+};
+
+/// Reads every parameter (the reader records the keys, in this order, for the case-key reference),
+/// then derives the tilt and the roll widths.
+ConveyorLayout read_layout(MapReader& reader) {
+  ConveyorLayout c;
+  c.materials = read_materials(reader);
+  c.length = reader.number("length", 8.0, 1.0, 500.0, "m");
+  c.width = reader.number("width", 0.8, 0.3, 3.0, "m");
+  c.speed = reader.number("speed", 2.0, 0.05, 10.0, "m/s");
+  c.trough = radians(reader.number("troughing_angle_deg", 30.0, 0.0, 45.0, "deg"));
+  c.inclination = reader.number("inclination_deg", 0.0, -20.0, 20.0, "deg");
+  c.pulley_radius = 0.5 * reader.number("pulley_diameter", 0.5, 0.1, 2.0, "m");
+  c.belt_thickness = reader.number("belt_thickness", 0.015, 0.0, 0.1, "m");
+  c.load_height = reader.number("load_height", 0.1, 0.01, 1.0, "m");
+  c.transition = reader.number("transition_length", std::min(0.8, 0.3 * c.length), 0.0, 0.5 * c.length, "m");
   MapReader idler = sub_map(reader, "idler");
-  const double spacing = idler.number("spacing", 1.2, 0.3, 5.0, "m");
-  const double roll_radius = 0.5 * idler.number("roll_diameter", 0.127, 0.05, 0.3, "m");
+  c.spacing = idler.number("spacing", 1.2, 0.3, 5.0, "m");
+  c.roll_radius = 0.5 * idler.number("roll_diameter", 0.127, 0.05, 0.3, "m");
   idler.finish();
   MapReader skirt = sub_map(reader, "skirt");
-  const double skirt_width = skirt.number("width", 2.0 / 3.0 * width, 0.1, width, "m");
-  const double skirt_start = skirt.number("start", 0.2, 0.0, 0.5 * length, "m");
-  const double skirt_length = skirt.number("length", std::min(2.0, 0.4 * length), 0.1, length - skirt_start, "m");
-  const double skirt_height = skirt.number("height", 0.3, 0.05, 2.0, "m");
+  c.skirt_width = skirt.number("width", 2.0 / 3.0 * c.width, 0.1, c.width, "m");
+  c.skirt_start = skirt.number("start", 0.2, 0.0, 0.5 * c.length, "m");
+  c.skirt_length = skirt.number("length", std::min(2.0, 0.4 * c.length), 0.1, c.length - c.skirt_start, "m");
+  c.skirt_height = skirt.number("height", 0.3, 0.05, 2.0, "m");
   skirt.finish();
-  const double margin = reader.number("margin", 0.5, 0.0, 10.0, "m");
-  const SourceLocation& where = spec.location;
-  const double tilt_angle = radians(inclination);
-  Eigen::Matrix3d tilt;  // raises the head end: x -> (cos, 0, sin)
-  tilt << std::cos(tilt_angle), 0, -std::sin(tilt_angle), 0, 1, 0, std::sin(tilt_angle), 0, std::cos(tilt_angle);
-  const Vec3 along = tilt * Vec3::UnitX();
-  const double centre = kCentreRollFraction * width, wing = 0.5 * (width - centre);
+  c.margin = reader.number("margin", 0.5, 0.0, 10.0, "m");
 
-  Generated out;
-  out.camera = "side";
-  // Belt: profile across, x along; wings flatten over the transition.
-  {
-    MeshBuilder belt;
-    const auto profile = trough_profile(width, trough, kCell);
-    const int across = static_cast<int>(profile.size()) - 1, pieces = segments(length, kCell);
-    belt.grid([&](double w, double u) {
-      const double x = w * length;
-      const auto [y, h] = profile[static_cast<size_t>(std::lround(u * across))];
-      const double angle = transition > 0 ? trough * std::clamp((length - x) / transition, 0.0, 1.0) : trough;
-      if (std::abs(y) <= 0.5 * centre + 1e-12) return Vec3(x, y, 0);
-      const double distance = (std::abs(y) - 0.5 * centre) / std::max(std::cos(trough), 1e-12);
-      return Vec3(x, std::copysign(0.5 * centre + distance * std::cos(angle), y), distance * std::sin(angle));
-    }, pieces, across);
-    belt.transform(tilt, Vec3::Zero());
-    MeshWallSpec wall = belt.wall("belt", materials.belt, where);
-    wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
-    wall.surface.velocity = speed * along;
-    out.meshes.push_back(std::move(wall));
-  }
-  // Head and tail pulleys: omega = V / R_p about +y moves the top +x (omega y x R z = omega R x).
-  for (const double x : {0.0, length}) {
+  c.tilt_angle = radians(c.inclination);
+  c.tilt << std::cos(c.tilt_angle), 0, -std::sin(c.tilt_angle), 0, 1, 0, std::sin(c.tilt_angle), 0,
+      std::cos(c.tilt_angle);
+  c.along = c.tilt * Vec3::UnitX();
+  c.centre = kCentreRollFraction * c.width, c.wing = 0.5 * (c.width - c.centre);
+  return c;
+}
+
+/// Belt: profile across, x along; wings flatten over the transition.
+void add_belt(const ConveyorLayout& c, const SourceLocation& where, Generated& out) {
+  MeshBuilder belt;
+  const auto profile = trough_profile(c.width, c.trough, kCell);
+  const int across = static_cast<int>(profile.size()) - 1, pieces = segments(c.length, kCell);
+  belt.grid([&](double w, double u) {
+    const double x = w * c.length;
+    const auto [y, h] = profile[static_cast<size_t>(std::lround(u * across))];
+    const double angle = c.transition > 0 ? c.trough * std::clamp((c.length - x) / c.transition, 0.0, 1.0) : c.trough;
+    if (std::abs(y) <= 0.5 * c.centre + 1e-12) return Vec3(x, y, 0);
+    const double distance = (std::abs(y) - 0.5 * c.centre) / std::max(std::cos(c.trough), 1e-12);
+    return Vec3(x, std::copysign(0.5 * c.centre + distance * std::cos(angle), y), distance * std::sin(angle));
+  }, pieces, across);
+  belt.transform(c.tilt, Vec3::Zero());
+  MeshWallSpec wall = belt.wall("belt", c.materials.belt, where);
+  wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
+  wall.surface.velocity = c.speed * c.along;
+  out.meshes.push_back(std::move(wall));
+}
+
+/// Head and tail pulleys: omega = V / R_p about +y moves the top +x (omega y x R z = omega R x).
+void add_pulleys(const ConveyorLayout& c, const SourceLocation& where, Generated& out) {
+  for (const double x : {0.0, c.length}) {
     MeshBuilder pulley;
-    cylinder(pulley, Vec3(x, -0.5 * width, -pulley_radius), Vec3(x, 0.5 * width, -pulley_radius), pulley_radius,
-             segments(2 * kPi * pulley_radius, 0.08, 24), true);
-    pulley.transform(tilt, Vec3::Zero());
-    MeshWallSpec wall = pulley.wall(x > 0 ? "head_pulley" : "tail_pulley", materials.belt, where);
+    cylinder(pulley, Vec3(x, -0.5 * c.width, -c.pulley_radius), Vec3(x, 0.5 * c.width, -c.pulley_radius),
+             c.pulley_radius, segments(2 * kPi * c.pulley_radius, 0.08, 24), true);
+    pulley.transform(c.tilt, Vec3::Zero());
+    MeshWallSpec wall = pulley.wall(x > 0 ? "head_pulley" : "tail_pulley", c.materials.belt, where);
     wall.surface.kind = SurfaceVelocitySpec::Kind::rotation;
     wall.surface.axis = Vec3::UnitY();
-    wall.surface.point = tilt * Vec3(x, 0, -pulley_radius);
-    wall.surface.angular_speed = speed / pulley_radius;
+    wall.surface.point = c.tilt * Vec3(x, 0, -c.pulley_radius);
+    wall.surface.angular_speed = c.speed / c.pulley_radius;
     out.meshes.push_back(std::move(wall));
   }
-  // Idler rolls under the troughed part: centre roll and two wing rolls per station.
-  {
-    MeshBuilder rolls;
-    const double below = belt_thickness + roll_radius;  // [m] roll axis below the belt surface
-    for (double x = spacing; x < length - transition - 0.5 * spacing + 1e-9; x += spacing) {
-      const Vec3 down(0, 0, -below);
-      cylinder(rolls, Vec3(x, -0.5 * centre, 0) + down, Vec3(x, 0.5 * centre, 0) + down, roll_radius, 12, true);
-      for (const int side : {-1, 1}) {
-        const Vec3 inner(x, side * 0.5 * centre, 0);
-        const Vec3 outward(0, side * std::cos(trough), std::sin(trough));
-        const Vec3 normal(0, -side * std::sin(trough), std::cos(trough));  // belt surface normal on the wing
-        cylinder(rolls, inner - below * normal, inner + wing * outward - below * normal, roll_radius, 12, true);
-      }
+}
+
+/// Idler rolls under the troughed part: centre roll and two wing rolls per station.
+void add_idlers(const ConveyorLayout& c, const SourceLocation& where, Generated& out) {
+  MeshBuilder rolls;
+  const double below = c.belt_thickness + c.roll_radius;  // [m] roll axis below the belt surface
+  for (double x = c.spacing; x < c.length - c.transition - 0.5 * c.spacing + 1e-9; x += c.spacing) {
+    const Vec3 down(0, 0, -below);
+    cylinder(rolls, Vec3(x, -0.5 * c.centre, 0) + down, Vec3(x, 0.5 * c.centre, 0) + down, c.roll_radius, 12, true);
+    for (const int side : {-1, 1}) {
+      const Vec3 inner(x, side * 0.5 * c.centre, 0);
+      const Vec3 outward(0, side * std::cos(c.trough), std::sin(c.trough));
+      const Vec3 normal(0, -side * std::sin(c.trough), std::cos(c.trough));  // belt surface normal on the wing
+      cylinder(rolls, inner - below * normal, inner + c.wing * outward - below * normal, c.roll_radius, 12, true);
     }
-    rolls.transform(tilt, Vec3::Zero());
-    if (!rolls.triangles.empty()) out.meshes.push_back(rolls.wall("idlers", materials.liner, where));
   }
-  // Skirts with a back plate at their start.
-  {
-    MeshBuilder skirts;
-    const double y = 0.5 * skirt_width;
-    const double bottom = trough_height(width, trough, y) + 0.01;
-    const double x0 = skirt_start, x1 = skirt_start + skirt_length, top = bottom + skirt_height;
-    skirts.quad(Vec3(x0, -y, bottom), Vec3(x1, -y, bottom), Vec3(x1, -y, top), Vec3(x0, -y, top));
-    skirts.quad(Vec3(x0, y, bottom), Vec3(x0, y, top), Vec3(x1, y, top), Vec3(x1, y, bottom));
-    skirts.quad(Vec3(x0, -y, 0.01), Vec3(x0, -y, top), Vec3(x0, y, top), Vec3(x0, y, 0.01));
-    skirts.transform(tilt, Vec3::Zero());
-    out.meshes.push_back(skirts.wall("skirts", materials.liner, where));
-  }
-  // Loading port between the skirts near the tail: 70 % of the belt width (inside the skirts),
-  // above the wing tops so that no particle is inserted into the belt, long enough to take a
-  // batch at the design rate; material arrives at belt speed, as from a loading chute.
-  const double port_x = skirt_start + 0.1;
-  {
-    const double half = std::min(0.35 * width, 0.5 * skirt_width - 0.02);
-    const double bottom = trough_height(width, trough, half) + 0.01;
-    const auto [lo, hi] = rotated_box(tilt, Vec3(port_x, -half, bottom),
-                                      Vec3(port_x + std::min(1.0, skirt_length - 0.2), half, bottom + 0.25));
-    out.ports.push_back({"loading", lo, hi, speed * along});
-  }
-  // Outlet: below and beyond the head pulley where the stream lands.
-  const Vec3 head = tilt * Vec3(length, 0, -pulley_radius);
+  rolls.transform(c.tilt, Vec3::Zero());
+  if (!rolls.triangles.empty()) out.meshes.push_back(rolls.wall("idlers", c.materials.liner, where));
+}
+
+/// Skirts with a back plate at their start.
+void add_skirts(const ConveyorLayout& c, const SourceLocation& where, Generated& out) {
+  MeshBuilder skirts;
+  const double y = 0.5 * c.skirt_width;
+  const double bottom = trough_height(c.width, c.trough, y) + 0.01;
+  const double x0 = c.skirt_start, x1 = c.skirt_start + c.skirt_length, top = bottom + c.skirt_height;
+  skirts.quad(Vec3(x0, -y, bottom), Vec3(x1, -y, bottom), Vec3(x1, -y, top), Vec3(x0, -y, top));
+  skirts.quad(Vec3(x0, y, bottom), Vec3(x0, y, top), Vec3(x1, y, top), Vec3(x1, y, bottom));
+  skirts.quad(Vec3(x0, -y, 0.01), Vec3(x0, -y, top), Vec3(x0, y, top), Vec3(x0, y, 0.01));
+  skirts.transform(c.tilt, Vec3::Zero());
+  out.meshes.push_back(skirts.wall("skirts", c.materials.liner, where));
+}
+
+/// Loading port between the skirts near the tail: 70 % of the belt width (inside the skirts),
+/// above the wing tops so that no particle is inserted into the belt, long enough to take a
+/// batch at the design rate; material arrives at belt speed, as from a loading chute.
+void add_loading_port(const ConveyorLayout& c, Generated& out) {
+  const double port_x = c.skirt_start + 0.1;
+  const double half = std::min(0.35 * c.width, 0.5 * c.skirt_width - 0.02);
+  const double bottom = trough_height(c.width, c.trough, half) + 0.01;
+  const auto [lo, hi] = rotated_box(c.tilt, Vec3(port_x, -half, bottom),
+                                    Vec3(port_x + std::min(1.0, c.skirt_length - 0.2), half, bottom + 0.25));
+  out.ports.push_back({"loading", lo, hi, c.speed * c.along});
+}
+
+/// Outlet: below and beyond the head pulley (axis at `head`) where the stream lands.
+void add_discharge_outlet(const ConveyorLayout& c, const Vec3& head, Generated& out) {
   OutletSpec discharge;
   discharge.name = "discharge";
-  discharge.region_min = Vec3(head.x() - pulley_radius, -0.5 * width - 0.5, head.z() - 1.5);
-  discharge.region_max = Vec3(head.x() + 0.6 * speed + 1.0, 0.5 * width + 0.5, head.z() - pulley_radius - 0.1);
+  discharge.region_min = Vec3(head.x() - c.pulley_radius, -0.5 * c.width - 0.5, head.z() - 1.5);
+  discharge.region_max = Vec3(head.x() + 0.6 * c.speed + 1.0, 0.5 * c.width + 0.5, head.z() - c.pulley_radius - 0.1);
   out.outlets.push_back(discharge);
+}
+
+/// Sensors: flow across the belt halfway along it; load in the loading zone between the skirts.
+void add_sensors(const ConveyorLayout& c, Generated& out) {
   SensorSpec on_belt;
   on_belt.kind = SensorSpec::Kind::plane, on_belt.name = "on_belt";
-  on_belt.point = tilt * Vec3(0.5 * length, 0, 0), on_belt.normal = along;
-  std::tie(on_belt.region_min, on_belt.region_max) =
-      rotated_box(tilt, Vec3(0.5 * length - 0.1, -0.5 * width, -0.05), Vec3(0.5 * length + 0.1, 0.5 * width, 0.6));
+  on_belt.point = c.tilt * Vec3(0.5 * c.length, 0, 0), on_belt.normal = c.along;
+  std::tie(on_belt.region_min, on_belt.region_max) = rotated_box(
+      c.tilt, Vec3(0.5 * c.length - 0.1, -0.5 * c.width, -0.05), Vec3(0.5 * c.length + 0.1, 0.5 * c.width, 0.6));
   out.sensors.push_back(on_belt);
   SensorSpec loading;
   loading.kind = SensorSpec::Kind::box, loading.name = "loading_zone", loading.across = Vec3::UnitY();
   std::tie(loading.region_min, loading.region_max) =
-      rotated_box(tilt, Vec3(skirt_start, -0.5 * width, -0.05), Vec3(skirt_start + skirt_length, 0.5 * width, 0.5));
+      rotated_box(c.tilt, Vec3(c.skirt_start, -0.5 * c.width, -0.05),
+                  Vec3(c.skirt_start + c.skirt_length, 0.5 * c.width, 0.5));
   out.sensors.push_back(loading);
-  set_domain(out, margin, head.z() - 2.0);
+}
 
-  // CEMA discharge at the head pulley.
-  const double radius = pulley_radius + belt_thickness + 0.5 * load_height;  // [m]
-  const double ratio = speed * speed / (kGravity * radius);
-  const bool at_tangent = ratio >= std::cos(tilt_angle);
-  const double release = at_tangent ? tilt_angle : std::acos(std::min(ratio, 1.0));  // [rad] from vertical
+/// CEMA discharge at the head pulley, with the design values the report shows.
+void set_design(const ConveyorLayout& c, Generated& out) {
+  const double radius = c.pulley_radius + c.belt_thickness + 0.5 * c.load_height;  // [m]
+  const double ratio = c.speed * c.speed / (kGravity * radius);
+  const bool at_tangent = ratio >= std::cos(c.tilt_angle);
+  const double release = at_tangent ? c.tilt_angle : std::acos(std::min(ratio, 1.0));  // [rad] from vertical
   out.design = {
-      {"belt_speed_m_s", speed},
-      {"belt_width_m", width},
-      {"length_m", length},
-      {"troughing_angle_deg", trough * 180 / kPi},
-      {"inclination_deg", inclination},
-      {"pulley_diameter_m", 2 * pulley_radius},
+      {"belt_speed_m_s", c.speed},
+      {"belt_width_m", c.width},
+      {"length_m", c.length},
+      {"troughing_angle_deg", c.trough * 180 / kPi},
+      {"inclination_deg", c.inclination},
+      {"pulley_diameter_m", 2 * c.pulley_radius},
       {"discharge_radius_m", radius},
       {"discharge_ratio_v2_gr", ratio},
       {"discharge_at_tangent", at_tangent ? 1.0 : 0.0},
-      {"discharge_angle_from_vertical_deg", (at_tangent ? 0.0 - tilt_angle : release) * 180 / kPi},  // negative: before top dead centre
-      {"idler_spacing_m", spacing},
-      {"skirt_width_m", skirt_width},
+      {"discharge_angle_from_vertical_deg", (at_tangent ? 0.0 - c.tilt_angle : release) * 180 / kPi},  // negative: before top dead centre
+      {"idler_spacing_m", c.spacing},
+      {"skirt_width_m", c.skirt_width},
   };
+}
+
+}  // namespace
+
+Generated belt_conveyor(MapReader& reader, const EquipmentSpec& spec) {
+  const ConveyorLayout c = read_layout(reader);
+  const SourceLocation& where = spec.location;
+  Generated out;
+  out.camera = "side";
+
+  add_belt(c, where, out);
+  add_pulleys(c, where, out);
+  add_idlers(c, where, out);
+  add_skirts(c, where, out);
+
+  add_loading_port(c, out);
+  const Vec3 head = c.tilt * Vec3(c.length, 0, -c.pulley_radius);  // head pulley axis
+  add_discharge_outlet(c, head, out);
+  add_sensors(c, out);
+  set_domain(out, c.margin, head.z() - 2.0);
+
+  set_design(c, out);
   return out;
 }
 

@@ -161,117 +161,143 @@ void troughed_belt(MeshBuilder& mesh, double width, double x0, double x1, double
   }, along, across);
 }
 
-}  // namespace
+/// What every part of the chute is built from: its layout, the materials of its walls, where the
+/// case declares it, and the half widths its walls and sensors are placed at.
+struct ChuteBuild {
+  const TransferChuteLayout& layout;
+  const Materials& materials;
+  const SourceLocation& where;
+  double half;            // [m] half the chute width: the side plates' y
+  double receiving_half;  // [m] half the receiving belt's width
+};
 
-Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
-  const Materials materials = read_materials(reader);
-  const double margin = reader.number("margin", 0.5, 0.0, 10.0, "m");
-  const TransferChuteLayout c = read_layout(reader);
-  const SourceLocation& where = spec.location;
-  Generated out;
-  out.camera = "side";
-  const double half = 0.5 * c.chute_width;
+/// Feed belt, troughed, flattening linearly over the transition before the pulley.
+void add_feed_belt(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  MeshBuilder belt;
+  troughed_belt(belt, c.feed_width, -c.feed_length, 0.0, c.drop_height, c.feed_trough, [&](double x) {
+    return c.transition_length > 0 ? c.feed_trough * std::clamp(-x / c.transition_length, 0.0, 1.0) : c.feed_trough;
+  });
+  MeshWallSpec wall = belt.wall("feed_belt", chute.materials.belt, chute.where);
+  wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
+  wall.surface.velocity = Vec3(c.feed_speed, 0, 0);
+  out.meshes.push_back(std::move(wall));
+}
 
-  // Feed belt, troughed, flattening linearly over the transition before the pulley.
-  {
-    MeshBuilder belt;
-    troughed_belt(belt, c.feed_width, -c.feed_length, 0.0, c.drop_height, c.feed_trough, [&](double x) {
-      return c.transition_length > 0 ? c.feed_trough * std::clamp(-x / c.transition_length, 0.0, 1.0) : c.feed_trough;
-    });
-    MeshWallSpec wall = belt.wall("feed_belt", materials.belt, where);
-    wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
-    wall.surface.velocity = Vec3(c.feed_speed, 0, 0);
-    out.meshes.push_back(std::move(wall));
-  }
-  // Head pulley: omega = +V / R_p about +y moves its top (0, 0, R_p) at omega y x R z = +V x.
-  {
-    MeshBuilder pulley;
-    const double axis_z = c.drop_height - c.pulley_radius;
-    cylinder(pulley, Vec3(0, -0.5 * c.feed_width, axis_z), Vec3(0, 0.5 * c.feed_width, axis_z), c.pulley_radius,
-             segments(2 * kPi * c.pulley_radius, 0.08, 24), true);
-    MeshWallSpec wall = pulley.wall("head_pulley", materials.belt, where);
-    wall.surface.kind = SurfaceVelocitySpec::Kind::rotation;
-    wall.surface.axis = Vec3::UnitY();
-    wall.surface.point = Vec3(0, 0, axis_z);
-    wall.surface.angular_speed = c.feed_speed / c.pulley_radius;
-    out.meshes.push_back(std::move(wall));
-  }
-  // Hood arc from its top (90 deg) down to its end angle; roof from the chute back to the hood top.
-  {
-    MeshBuilder hood;
-    const double sweep = kPi / 2 - c.hood_end_angle;
-    hood.grid([&](double u, double w) {
-      const double angle = kPi / 2 - u * sweep;
-      return Vec3(c.hood_centre_x + c.hood_radius * std::cos(angle), -half + w * c.chute_width,
-                  c.hood_centre_z + c.hood_radius * std::sin(angle));
-    }, segments(sweep * c.hood_radius, kChuteCell, 8), segments(c.chute_width, kChuteCell));
-    const double roof = c.drop_height + c.hood_top_height;
-    if (c.hood_centre_x > c.side_x_min + 0.01) {
-      hood.quad(Vec3(c.side_x_min, -half, roof), Vec3(c.hood_centre_x, -half, roof), Vec3(c.hood_centre_x, half, roof),
-                Vec3(c.side_x_min, half, roof), kChuteCell);
-    }
-    out.meshes.push_back(hood.wall("hood", materials.liner, where));
-  }
-  // Spoon arc from its top edge (start angle) to the lip, and the back plate above its top edge.
-  {
-    MeshBuilder spoon;
-    spoon.grid([&](double u, double w) {
-      const double angle = c.spoon_start_angle * (1 - u) + c.spoon_exit_angle * u;  // back to lip
-      return Vec3(c.spoon_centre_x - c.spoon_radius * std::sin(angle), half - w * c.chute_width,
-                  c.spoon_centre_z - c.spoon_radius * std::cos(angle));
-    }, segments(c.spoon_start_angle * c.spoon_radius, kChuteCell, 6), segments(c.chute_width, kChuteCell));
-    spoon.quad(Vec3(c.spoon_top_x, -half, c.spoon_top_z), Vec3(c.spoon_top_x, half, c.spoon_top_z),
-               Vec3(c.spoon_top_x, half, c.back_plate_top), Vec3(c.spoon_top_x, -half, c.back_plate_top), kChuteCell);
-    out.meshes.push_back(spoon.wall("spoon", materials.liner, where));
-  }
-  // Side plates.
-  {
-    MeshBuilder sides;
-    for (const double y : {-half, half}) {
-      const Vec3 a(c.side_x_min, y, c.side_z_min), b(c.side_x_max, y, c.side_z_min);
-      const Vec3 d(c.side_x_min, y, c.side_z_max), e(c.side_x_max, y, c.side_z_max);
-      if (y < 0) sides.quad(a, b, e, d, kChuteCell);  // normals point into the chute
-      else sides.quad(a, d, e, b, kChuteCell);
-    }
-    out.meshes.push_back(sides.wall("side_plates", materials.liner, where));
-  }
-  // Receiving belt and skirts.
-  {
-    MeshBuilder belt;
-    troughed_belt(belt, c.receiving_width, c.receiving_x_min, c.receiving_x_max, 0.0, c.receiving_trough,
-                  [&](double) { return c.receiving_trough; });
-    MeshWallSpec wall = belt.wall("receiving_belt", materials.belt, where);
-    wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
-    wall.surface.velocity = Vec3(c.receiving_speed, 0, 0);
-    out.meshes.push_back(std::move(wall));
-  }
-  if (c.skirt_length > 0) {
-    MeshBuilder skirts;
-    const double y = 0.5 * c.skirt_width;
-    const double bottom = trough_height(c.receiving_width, c.receiving_trough, y) + 0.01;
-    const double x0 = c.spoon_lip_x - 0.05, x1 = c.spoon_lip_x + c.skirt_length;
-    skirts.quad(Vec3(x0, -y, bottom), Vec3(x1, -y, bottom), Vec3(x1, -y, bottom + c.skirt_height), Vec3(x0, -y, bottom + c.skirt_height), kChuteCell);
-    skirts.quad(Vec3(x0, y, bottom), Vec3(x0, y, bottom + c.skirt_height), Vec3(x1, y, bottom + c.skirt_height), Vec3(x1, y, bottom), kChuteCell);
-    out.meshes.push_back(skirts.wall("skirts", materials.liner, where));
-  }
+/// Head pulley: omega = +V / R_p about +y moves its top (0, 0, R_p) at omega y x R z = +V x.
+void add_head_pulley(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  MeshBuilder pulley;
+  const double axis_z = c.drop_height - c.pulley_radius;
+  cylinder(pulley, Vec3(0, -0.5 * c.feed_width, axis_z), Vec3(0, 0.5 * c.feed_width, axis_z), c.pulley_radius,
+           segments(2 * kPi * c.pulley_radius, 0.08, 24), true);
+  MeshWallSpec wall = pulley.wall("head_pulley", chute.materials.belt, chute.where);
+  wall.surface.kind = SurfaceVelocitySpec::Kind::rotation;
+  wall.surface.axis = Vec3::UnitY();
+  wall.surface.point = Vec3(0, 0, axis_z);
+  wall.surface.angular_speed = c.feed_speed / c.pulley_radius;
+  out.meshes.push_back(std::move(wall));
+}
 
-  // Feed port over the tail of the feed belt: 70 % of the belt width, above the wing tops (the
-  // particles drop into the trough), long enough to take a batch at the design rate (a box the
-  // belt empties every length / speed seconds holds about 30 % solid).
+/// Hood arc from its top (90 deg) down to its end angle; roof from the chute back to the hood top.
+void add_hood(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  const double half = chute.half;
+  MeshBuilder hood;
+  const double sweep = kPi / 2 - c.hood_end_angle;
+  hood.grid([&](double u, double w) {
+    const double angle = kPi / 2 - u * sweep;
+    return Vec3(c.hood_centre_x + c.hood_radius * std::cos(angle), -half + w * c.chute_width,
+                c.hood_centre_z + c.hood_radius * std::sin(angle));
+  }, segments(sweep * c.hood_radius, kChuteCell, 8), segments(c.chute_width, kChuteCell));
+  const double roof = c.drop_height + c.hood_top_height;
+  if (c.hood_centre_x > c.side_x_min + 0.01) {
+    hood.quad(Vec3(c.side_x_min, -half, roof), Vec3(c.hood_centre_x, -half, roof), Vec3(c.hood_centre_x, half, roof),
+              Vec3(c.side_x_min, half, roof), kChuteCell);
+  }
+  out.meshes.push_back(hood.wall("hood", chute.materials.liner, chute.where));
+}
+
+/// Spoon arc from its top edge (start angle) to the lip, and the back plate above its top edge.
+void add_spoon(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  const double half = chute.half;
+  MeshBuilder spoon;
+  spoon.grid([&](double u, double w) {
+    const double angle = c.spoon_start_angle * (1 - u) + c.spoon_exit_angle * u;  // back to lip
+    return Vec3(c.spoon_centre_x - c.spoon_radius * std::sin(angle), half - w * c.chute_width,
+                c.spoon_centre_z - c.spoon_radius * std::cos(angle));
+  }, segments(c.spoon_start_angle * c.spoon_radius, kChuteCell, 6), segments(c.chute_width, kChuteCell));
+  spoon.quad(Vec3(c.spoon_top_x, -half, c.spoon_top_z), Vec3(c.spoon_top_x, half, c.spoon_top_z),
+             Vec3(c.spoon_top_x, half, c.back_plate_top), Vec3(c.spoon_top_x, -half, c.back_plate_top), kChuteCell);
+  out.meshes.push_back(spoon.wall("spoon", chute.materials.liner, chute.where));
+}
+
+/// Side plates.
+void add_side_plates(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  const double half = chute.half;
+  MeshBuilder sides;
+  for (const double y : {-half, half}) {
+    const Vec3 a(c.side_x_min, y, c.side_z_min), b(c.side_x_max, y, c.side_z_min);
+    const Vec3 d(c.side_x_min, y, c.side_z_max), e(c.side_x_max, y, c.side_z_max);
+    if (y < 0) sides.quad(a, b, e, d, kChuteCell);  // normals point into the chute
+    else sides.quad(a, d, e, b, kChuteCell);
+  }
+  out.meshes.push_back(sides.wall("side_plates", chute.materials.liner, chute.where));
+}
+
+/// Receiving belt.
+void add_receiving_belt(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  MeshBuilder belt;
+  troughed_belt(belt, c.receiving_width, c.receiving_x_min, c.receiving_x_max, 0.0, c.receiving_trough,
+                [&](double) { return c.receiving_trough; });
+  MeshWallSpec wall = belt.wall("receiving_belt", chute.materials.belt, chute.where);
+  wall.surface.kind = SurfaceVelocitySpec::Kind::linear;
+  wall.surface.velocity = Vec3(c.receiving_speed, 0, 0);
+  out.meshes.push_back(std::move(wall));
+}
+
+/// Skirts on the receiving belt from just behind the spoon lip.
+void add_skirts(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  MeshBuilder skirts;
+  const double y = 0.5 * c.skirt_width;
+  const double bottom = trough_height(c.receiving_width, c.receiving_trough, y) + 0.01;
+  const double x0 = c.spoon_lip_x - 0.05, x1 = c.spoon_lip_x + c.skirt_length;
+  skirts.quad(Vec3(x0, -y, bottom), Vec3(x1, -y, bottom), Vec3(x1, -y, bottom + c.skirt_height), Vec3(x0, -y, bottom + c.skirt_height), kChuteCell);
+  skirts.quad(Vec3(x0, y, bottom), Vec3(x0, y, bottom + c.skirt_height), Vec3(x1, y, bottom + c.skirt_height), Vec3(x1, y, bottom), kChuteCell);
+  out.meshes.push_back(skirts.wall("skirts", chute.materials.liner, chute.where));
+}
+
+/// Feed port over the tail of the feed belt: 70 % of the belt width, above the wing tops (the
+/// particles drop into the trough), long enough to take a batch at the design rate (a box the
+/// belt empties every length / speed seconds holds about 30 % solid).
+void add_feed_port(const TransferChuteLayout& c, Generated& out) {
   const double port_half_width = 0.35 * c.feed_width;
   const double port_bottom = c.drop_height + trough_height(c.feed_width, c.feed_trough, port_half_width) + 0.01;
   const double port_length = std::min(1.0, 0.4 * c.feed_length);
   out.ports.push_back({"feed_belt", Vec3(-c.feed_length + 0.1, -port_half_width, port_bottom),
                        Vec3(-c.feed_length + 0.1 + port_length, port_half_width, port_bottom + c.feed_port_height),
                        Vec3(c.feed_speed, 0, 0)});
-  // Outlet beyond the end of the receiving belt.
-  const double belt_half = 0.5 * c.receiving_width;
+}
+
+/// Outlet beyond the end of the receiving belt.
+void add_discharge_outlet(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  const double belt_half = chute.receiving_half;
   OutletSpec discharge;
   discharge.name = "discharge";
   discharge.region_min = Vec3(c.receiving_x_max + 0.02, -belt_half - 0.5, -1.0);
   discharge.region_max = Vec3(c.receiving_x_max + 1.0, belt_half + 0.5, 0.6);
   out.outlets.push_back(discharge);
-  // Sensors: flow through the spoon lip and near the belt end; load on the belt after the lip.
+}
+
+/// Sensors: flow through the spoon lip and near the belt end; load on the belt after the lip.
+void add_sensors(const ChuteBuild& chute, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  const double half = chute.half, belt_half = chute.receiving_half;
   SensorSpec spoon_exit;
   spoon_exit.kind = SensorSpec::Kind::plane, spoon_exit.name = "spoon_exit";
   spoon_exit.point = Vec3(c.spoon_lip_x, 0, c.spoon_lip_height), spoon_exit.normal = Vec3::UnitX();
@@ -290,8 +316,10 @@ Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
   loading.region_min = Vec3(c.spoon_lip_x, -belt_half, -0.05);
   loading.region_max = Vec3(c.spoon_lip_x + std::min(1.0, c.receiving_x_max - c.spoon_lip_x - 0.4), belt_half, 0.5);
   out.sensors.push_back(loading);
+}
 
-  set_domain(out, margin, -1.0);
+/// The design values the report shows.
+void set_design(const TransferChuteLayout& c, Generated& out) {
   const double pulley_ratio = c.feed_speed * c.feed_speed /
                               (kGravity * (c.pulley_radius + 0.5 * c.load_height));  // CEMA V^2/(g r), r = R + a1
   out.design = {
@@ -313,6 +341,32 @@ Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
       {"chute_width_m", c.chute_width},
       {"skirt_width_m", c.skirt_width},
   };
+}
+
+}  // namespace
+
+Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
+  const Materials materials = read_materials(reader);
+  const double margin = reader.number("margin", 0.5, 0.0, 10.0, "m");
+  const TransferChuteLayout c = read_layout(reader);
+  const ChuteBuild chute{c, materials, spec.location, 0.5 * c.chute_width, 0.5 * c.receiving_width};
+  Generated out;
+  out.camera = "side";
+
+  add_feed_belt(chute, out);
+  add_head_pulley(chute, out);
+  add_hood(chute, out);
+  add_spoon(chute, out);
+  add_side_plates(chute, out);
+  add_receiving_belt(chute, out);
+  if (c.skirt_length > 0) add_skirts(chute, out);
+
+  add_feed_port(c, out);
+  add_discharge_outlet(chute, out);
+  add_sensors(chute, out);
+
+  set_domain(out, margin, -1.0);
+  set_design(c, out);
   return out;
 }
 
