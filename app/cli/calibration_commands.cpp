@@ -44,6 +44,33 @@ std::vector<std::string> split(const std::string& text) {
   }
   return out;
 }
+
+/// --budget: 30m, 2h, 900s or 900 (seconds).
+double wall_time_in_seconds(const std::string& budget) {
+  size_t used = 0;
+  double value = -1;
+  try {
+    value = std::stod(budget, &used);
+  } catch (const std::exception&) {
+  }
+  const std::string unit = budget.substr(used);
+  const double scale = unit.empty() || unit == "s" ? 1.0 : unit == "m" || unit == "min" ? 60.0 : unit == "h" ? 3600.0 : -1.0;
+  if (!(value > 0) || scale < 0) throw CaseError(fmt::format("--budget {}: write a wall time such as 30m, 2h or 900s", budget));
+  return value * scale;
+}
+
+/// Renders of final states: the model as compared, the fitted one, or the recommended one.
+const MaterialModel& shown_model(const std::string& command, const MaterialModel& model, const CalibrationResult& calibration,
+                                 const Diagnosis& diagnosis) {
+  const MaterialModel* shown = &model;
+  if (command == "calibrate") shown = &calibration.fitted;
+  if (command == "diagnose") {
+    shown = &diagnosis.base.fitted;
+    for (const auto& c : diagnosis.candidates)
+      if (c.name == diagnosis.recommended && c.confirmed) shown = &c.fit.fitted;
+  }
+  return *shown;
+}
 }  // namespace
 
 CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : render_(std::move(render)) {
@@ -163,29 +190,77 @@ int CalibrationCommands::run_test() {
   return 0;
 }
 
+/// What the phases of compare, calibrate and diagnose share.
+struct CalibrationCommands::Campaign {
+  std::string command;                          ///< compare, calibrate or diagnose
+  std::chrono::steady_clock::time_point t0;     ///< when the command started
+  MaterialModel model;                          ///< the material with the measurements' size, density and walls
+  MeasurementSet measured;
+  CalibrationOptions options;
+  std::vector<FitParameter> params;             ///< --params; empty: the material's tunable ranges
+  std::vector<std::string> keys;                ///< the fitted parameters' keys, for the ledger
+  std::string ledger_path;                      ///< OUT/ledger.yaml
+  report::CalibrationReportInput input;         ///< the report, filled as the phases go
+  Comparison comparison;                        ///< compare
+  CalibrationResult calibration;                ///< calibrate
+  Diagnosis diagnosis;                          ///< diagnose
+};
+
 int CalibrationCommands::run_measured(const std::string& command) {
-  const auto t0 = std::chrono::steady_clock::now();
-  MaterialModel model = read_material_model(material_);
-  const MeasurementSet measured = read_measurements(measurements_);
+  Campaign campaign;
+  campaign.command = command;
+  campaign.t0 = std::chrono::steady_clock::now();
+  read_campaign_inputs(campaign);
+  set_campaign_options(campaign);
+  start_campaign_report(campaign);
+  if (command == "compare") {
+    campaign.comparison = compare(campaign.model, campaign.measured, campaign.options);
+  } else if (command == "calibrate") {
+    campaign.calibration = calibrate(campaign.model, campaign.measured, campaign.params, campaign.options);
+  } else {
+    report_diagnosis_stages(campaign);
+    campaign.diagnosis = diagnose(campaign.model, campaign.measured, campaign.params, campaign.options);
+  }
+  // Rank 0 alone prints, renders and writes.
+  if (mpi::world().rank != 0) return 0;
+  if (command == "compare") print_comparison(campaign);
+  else if (command == "calibrate") record_calibration(campaign);
+  else record_diagnosis(campaign);
+  if (campaign.input.ledger.empty()) campaign.input.ledger = read_ledger(campaign.ledger_path);
+  const MaterialModel& shown = shown_model(command, campaign.model, campaign.calibration, campaign.diagnosis);
+  if (command != "compare") write_calibrated(campaign);
+  write_campaign_report(campaign, shown);
+  return 0;
+}
+
+/// The material with the measurements' size, density and walls at the command's stiffness, every
+/// experiment's set-up checked.
+void CalibrationCommands::read_campaign_inputs(Campaign& campaign) {
+  campaign.model = read_material_model(material_);
+  campaign.measured = read_measurements(measurements_);
   if (mpi::world().rank == 0)
-    for (const std::string& w : measured.warnings) std::cout << "warning: " << w << std::endl;
-  apply_measured(model, measured);
-  model.stiffness_scaling = stiffness_scaling_;
+    for (const std::string& w : campaign.measured.warnings) std::cout << "warning: " << w << std::endl;
+  apply_measured(campaign.model, campaign.measured);
+  campaign.model.stiffness_scaling = stiffness_scaling_;
   {  // every experiment's set-up checked before the first simulation
     TestOptions check;
     check.size_factor = size_factor_;
-    check_experiments(model, measured, check);
+    check_experiments(campaign.model, campaign.measured, check);
   }
   // Parameters fitted at one stiffness need not hold at another.
-  if (const auto& record = model.particle.calibration; record && mpi::world().rank == 0) {
+  if (const auto& record = campaign.model.particle.calibration; record && mpi::world().rank == 0) {
     const double ratio = stiffness_scaling_ / record->stiffness_scaling;
     if (ratio > 1.25 || ratio < 0.8)
       std::cout << fmt::format("note: {} was calibrated with its Young's modulus x {:g} in the virtual tests; this {} runs them at x {:g}: "
                                "parameters fitted at one stiffness need not hold at another (--stiffness-scaling {:g} repeats the calibration's)",
-                               material_, record->stiffness_scaling, command, stiffness_scaling_, record->stiffness_scaling)
+                               material_, record->stiffness_scaling, campaign.command, stiffness_scaling_, record->stiffness_scaling)
                 << std::endl;
   }
-  CalibrationOptions options;
+}
+
+/// The calibration's options from the command line.
+void CalibrationCommands::set_campaign_options(Campaign& campaign) {
+  CalibrationOptions& options = campaign.options;
   options.replicas = replicas_;
   options.rounds = rounds_;
   options.design_factor = design_factor_;
@@ -195,141 +270,136 @@ int CalibrationCommands::run_measured(const std::string& command) {
   options.size_factor = size_factor_;
   options.threads = threads_;
   options.parallel = parallel_ > 0 ? parallel_ : std::max(1, omp_get_num_procs());
-  if (!budget_.empty()) {
-    // 30m, 2h, 900s or 900 (seconds).
-    size_t used = 0;
-    double value = -1;
-    try {
-      value = std::stod(budget_, &used);
-    } catch (const std::exception&) {
-    }
-    const std::string unit = budget_.substr(used);
-    const double scale = unit.empty() || unit == "s" ? 1.0 : unit == "m" || unit == "min" ? 60.0 : unit == "h" ? 3600.0 : -1.0;
-    if (!(value > 0) || scale < 0) throw CaseError(fmt::format("--budget {}: write a wall time such as 30m, 2h or 900s", budget_));
-    options.budget_seconds = value * scale;
-  }
+  if (!budget_.empty()) options.budget_seconds = wall_time_in_seconds(budget_);
   if (!no_store_) options.store = (fs::path(out_) / "simulations").string();
   options.seed = static_cast<std::uint64_t>(seed_);
   // Every rank runs the same calibration in lockstep; the simulations of each batch (a design
   // round, the replicas of a comparison) are shared among the ranks and every rank gets every
   // outcome (app/campaign/mpi_campaign.h). Rank 0 alone prints, renders and writes.
-  const mpi::World& world = mpi::world();
   options.batch = mpi::calibration_batch_runner();
-  if (!quiet_ && world.rank == 0) options.progress = [](const std::string& line) { std::cout << line << std::endl; };
-  std::vector<FitParameter> params;
+  if (!quiet_ && mpi::world().rank == 0) options.progress = [](const std::string& line) { std::cout << line << std::endl; };
+}
+
+/// The parameters to fit, the output folder, and the report's heading.
+void CalibrationCommands::start_campaign_report(Campaign& campaign) {
   if (!params_.empty()) {
     try {
-      params = fit_parameters(model, split(params_));
+      campaign.params = fit_parameters(campaign.model, split(params_));
     } catch (const std::invalid_argument& e) {
       throw CaseError(fmt::format("--params: {}", e.what()));
     }
   }
-  if (world.rank == 0) fs::create_directories(out_);
-  const std::string ledger_path = (fs::path(out_) / "ledger.yaml").string();
-  report::CalibrationReportInput input;
-  input.title = fmt::format("{} {}", command, model.name);
+  if (mpi::world().rank == 0) fs::create_directories(out_);
+  campaign.ledger_path = (fs::path(out_) / "ledger.yaml").string();
+  report::CalibrationReportInput& input = campaign.input;
+  input.title = fmt::format("{} {}", campaign.command, campaign.model.name);
   input.material_path = material_, input.measurements_path = measurements_, input.version = "0.1.0";
-  input.measured = &measured;
-  Comparison comparison;
-  CalibrationResult calibration;
-  Diagnosis diagnosis;
-  std::vector<std::string> keys;
-  for (const auto& p : (params.empty() ? fit_parameters(model) : params)) keys.push_back(p.key);
-  if (command == "compare") {
-    comparison = compare(model, measured, options);
-    if (world.rank != 0) return 0;
-    input.comparison = &comparison;
-    std::cout << fmt::format("chi^2/n = {:.2f} over {} observations\n", comparison.chi2_per_n(), comparison.n);
-    for (const auto& t : comparison.terms)
-      std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured, t.sigma_measured,
-                               t.simulated, t.sigma_simulated, t.residual);
-    for (const auto& p : comparison.patterns) std::cout << "  " << p.words << "\n";
-    if (stiffness_check_ > 0) stiffness_check(model, measured, options, comparison);
-  } else if (command == "calibrate") {
-    calibration = calibrate(model, measured, params, options);
-    if (world.rank != 0) return 0;
-    input.calibration = &calibration;
-    for (const auto& w : calibration.words) std::cout << w << "\n";
-    input.ledger = append_ledger(ledger_path, model.name,
-                                 {ledger_entry(model, calibration.before, "start", keys), ledger_entry(calibration.fitted, calibration.after, "calibrated", keys)});
-  } else {
-    // What the diagnosis knows so far goes into the report folder at each stage: an interrupted
-    // diagnosis still shows it (the ledger is written once, at the end).
-    if (world.rank == 0)
-      options.on_partial = [&](const Diagnosis& partial, const std::string& stage) {
-        if (stage.rfind("the model as it is", 0) == 0) {
-          std::cout << fmt::format("the model as it is, calibrated: chi^2/n = {:.2f}\n", partial.base.after.chi2_per_n());
-          for (const auto& t : partial.base.after.terms)
-            std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured,
-                                     t.sigma_measured, t.simulated, t.sigma_simulated, t.residual);
-          std::cout << std::flush;
-        }
-        report::CalibrationReportInput so_far = input;
-        so_far.title = fmt::format("{} (in progress: {})", input.title, stage);
-        so_far.diagnosis = &partial;
-        so_far.ledger = read_ledger(ledger_path);
-        try {
-          report::write_calibration_report(so_far, out_);
-        } catch (const std::exception& e) {
-          std::cout << "partial report not written: " << e.what() << std::endl;
-        }
-      };
-    diagnosis = diagnose(model, measured, params, options);
-    if (world.rank != 0) return 0;
-    input.diagnosis = &diagnosis;
-    for (const auto& w : diagnosis.words) std::cout << w << "\n";
-    for (const auto& c : diagnosis.candidates) std::cout << "  " << c.words << "\n";
-    std::vector<LedgerEntry> entries = {ledger_entry(model, diagnosis.base.before, "start", keys),
-                                        ledger_entry(diagnosis.base.fitted, diagnosis.base.after, "calibrated", keys)};
-    for (const auto& c : diagnosis.candidates)
-      if (c.confirmed) {
-        std::vector<std::string> k = keys;
-        for (const auto& a : c.adds) k.push_back(a.key);
-        entries.push_back(ledger_entry(c.fit.fitted, c.fit.after, "+ " + c.name, k));
+  input.measured = &campaign.measured;
+  for (const auto& p : (campaign.params.empty() ? fit_parameters(campaign.model) : campaign.params)) campaign.keys.push_back(p.key);
+}
+
+/// What the diagnosis knows so far goes into the report folder at each stage: an interrupted
+/// diagnosis still shows it (the ledger is written once, at the end).
+void CalibrationCommands::report_diagnosis_stages(Campaign& campaign) {
+  if (mpi::world().rank == 0)
+    campaign.options.on_partial = [this, &campaign](const Diagnosis& partial, const std::string& stage) {
+      if (stage.rfind("the model as it is", 0) == 0) {
+        std::cout << fmt::format("the model as it is, calibrated: chi^2/n = {:.2f}\n", partial.base.after.chi2_per_n());
+        for (const auto& t : partial.base.after.terms)
+          std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured,
+                                   t.sigma_measured, t.simulated, t.sigma_simulated, t.residual);
+        std::cout << std::flush;
       }
-    // The verdict goes on the version it judges: the best candidate's, else the model as it is.
-    LedgerEntry* judged = &entries[1];
-    for (LedgerEntry& e : entries)
-      if (!diagnosis.best.empty() && e.label == "+ " + diagnosis.best) judged = &e;
-    judged->verdict = verdict_words(diagnosis.grade) + (diagnosis.best.empty() ? "" : ": " + diagnosis.best) +
-                      (diagnosis.confirm_next.empty() ? "" : "; confirm next: " + diagnosis.confirm_next);
-    std::cout << "verdict: " << judged->verdict << "\n";
-    input.ledger = append_ledger(ledger_path, model.name, entries);
-  }
-  if (input.ledger.empty()) input.ledger = read_ledger(ledger_path);
-  // Renders of final states: the model as compared, the fitted one, or the recommended one.
-  const MaterialModel* shown = &model;
-  if (command == "calibrate") shown = &calibration.fitted;
+      report::CalibrationReportInput so_far = campaign.input;
+      so_far.title = fmt::format("{} (in progress: {})", campaign.input.title, stage);
+      so_far.diagnosis = &partial;
+      so_far.ledger = read_ledger(campaign.ledger_path);
+      try {
+        report::write_calibration_report(so_far, out_);
+      } catch (const std::exception& e) {
+        std::cout << "partial report not written: " << e.what() << std::endl;
+      }
+    };
+}
+
+/// compare: chi^2/n, each observable against its measurement, the residual patterns, and the
+/// stiffness check when asked for.
+void CalibrationCommands::print_comparison(Campaign& campaign) {
+  const Comparison& comparison = campaign.comparison;
+  campaign.input.comparison = &comparison;
+  std::cout << fmt::format("chi^2/n = {:.2f} over {} observations\n", comparison.chi2_per_n(), comparison.n);
+  for (const auto& t : comparison.terms)
+    std::cout << fmt::format("  {:<28} measured {:>10.4g} +- {:<8.2g} simulated {:>10.4g} +- {:<8.2g} residual {:+.2f}\n", t.name(), t.measured, t.sigma_measured,
+                             t.simulated, t.sigma_simulated, t.residual);
+  for (const auto& p : comparison.patterns) std::cout << "  " << p.words << "\n";
+  if (stiffness_check_ > 0) stiffness_check(campaign.model, campaign.measured, campaign.options, comparison);
+}
+
+/// calibrate: the fit's words, and the material before and after it in the ledger.
+void CalibrationCommands::record_calibration(Campaign& campaign) {
+  const CalibrationResult& calibration = campaign.calibration;
+  campaign.input.calibration = &calibration;
+  for (const auto& w : calibration.words) std::cout << w << "\n";
+  campaign.input.ledger = append_ledger(campaign.ledger_path, campaign.model.name,
+                                        {ledger_entry(campaign.model, calibration.before, "start", campaign.keys),
+                                         ledger_entry(calibration.fitted, calibration.after, "calibrated", campaign.keys)});
+}
+
+/// diagnose: the diagnosis' words and candidates, and in the ledger the material before and after
+/// calibration, each confirmed candidate, and the verdict.
+void CalibrationCommands::record_diagnosis(Campaign& campaign) {
+  const Diagnosis& diagnosis = campaign.diagnosis;
+  const std::vector<std::string>& keys = campaign.keys;
+  campaign.input.diagnosis = &diagnosis;
+  for (const auto& w : diagnosis.words) std::cout << w << "\n";
+  for (const auto& c : diagnosis.candidates) std::cout << "  " << c.words << "\n";
+  std::vector<LedgerEntry> entries = {ledger_entry(campaign.model, diagnosis.base.before, "start", keys),
+                                      ledger_entry(diagnosis.base.fitted, diagnosis.base.after, "calibrated", keys)};
+  for (const auto& c : diagnosis.candidates)
+    if (c.confirmed) {
+      std::vector<std::string> k = keys;
+      for (const auto& a : c.adds) k.push_back(a.key);
+      entries.push_back(ledger_entry(c.fit.fitted, c.fit.after, "+ " + c.name, k));
+    }
+  // The verdict goes on the version it judges: the best candidate's, else the model as it is.
+  LedgerEntry* judged = &entries[1];
+  for (LedgerEntry& e : entries)
+    if (!diagnosis.best.empty() && e.label == "+ " + diagnosis.best) judged = &e;
+  judged->verdict = verdict_words(diagnosis.grade) + (diagnosis.best.empty() ? "" : ": " + diagnosis.best) +
+                    (diagnosis.confirm_next.empty() ? "" : "; confirm next: " + diagnosis.confirm_next);
+  std::cout << "verdict: " << judged->verdict << "\n";
+  campaign.input.ledger = append_ledger(campaign.ledger_path, campaign.model.name, entries);
+}
+
+/// The calibrated material as a library file a case can name (the fit, its uncertainty and its
+/// effects in one file): the calibration's, or the diagnosis' recommended model (the model as
+/// it is, calibrated, when nothing is recommended).
+void CalibrationCommands::write_calibrated(const Campaign& campaign) {
+  const std::string& command = campaign.command;
+  const Diagnosis& diagnosis = campaign.diagnosis;
+  const CalibrationResult* fit = command == "calibrate" ? &campaign.calibration : &diagnosis.base;
+  std::string note;
   if (command == "diagnose") {
-    shown = &diagnosis.base.fitted;
     for (const auto& c : diagnosis.candidates)
-      if (c.name == diagnosis.recommended && c.confirmed) shown = &c.fit.fitted;
+      if (c.name == diagnosis.recommended && c.confirmed) fit = &c.fit, note = "with " + c.name + ", the effect it recommended";
+    if (diagnosis.grade == Verdict::improves)
+      note = fmt::format("without {}, which improves the fit but does not explain it (the diagnosis' verdict)", diagnosis.best);
   }
-  // The calibrated material as a library file a case can name (the fit, its uncertainty and its
-  // effects in one file): the calibration's, or the diagnosis' recommended model (the model as
-  // it is, calibrated, when nothing is recommended).
-  if (command != "compare") {
-    const CalibrationResult* fit = command == "calibrate" ? &calibration : &diagnosis.base;
-    std::string note;
-    if (command == "diagnose") {
-      for (const auto& c : diagnosis.candidates)
-        if (c.name == diagnosis.recommended && c.confirmed) fit = &c.fit, note = "with " + c.name + ", the effect it recommended";
-      if (diagnosis.grade == Verdict::improves)
-        note = fmt::format("without {}, which improves the fit but does not explain it (the diagnosis' verdict)", diagnosis.best);
-    }
-    const std::string path = (fs::path(out_) / (fs::path(material_).stem().string() + "_calibrated.yaml")).string();
-    try {
-      write_calibrated_material(path, *fit, {command, measurements_, html::now_text().substr(0, 10), note});
-      std::cout << fmt::format("calibrated material: {} (a case names it as {{library: {}}})\n", path, fs::path(path).stem().string());
-    } catch (const std::invalid_argument& e) {
-      std::cout << fmt::format("calibrated material not written: {}\n", e.what());
-    }
+  const std::string path = (fs::path(out_) / (fs::path(material_).stem().string() + "_calibrated.yaml")).string();
+  try {
+    write_calibrated_material(path, *fit, {command, measurements_, html::now_text().substr(0, 10), note});
+    std::cout << fmt::format("calibrated material: {} (a case names it as {{library: {}}})\n", path, fs::path(path).stem().string());
+  } catch (const std::invalid_argument& e) {
+    std::cout << fmt::format("calibrated material not written: {}\n", e.what());
   }
-  if (!no_renders_) input.images = render_tests(*shown, measured, options);
-  input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::string html = report::write_calibration_report(input, out_);
-  std::cout << fmt::format("report: {} ({:.0f} s)\n", html, input.wall_seconds);
-  return 0;
+}
+
+/// Renders of `shown`'s final states, the wall time, and the report.
+void CalibrationCommands::write_campaign_report(Campaign& campaign, const MaterialModel& shown) {
+  if (!no_renders_) campaign.input.images = render_tests(shown, campaign.measured, campaign.options);
+  campaign.input.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - campaign.t0).count();
+  const std::string html = report::write_calibration_report(campaign.input, out_);
+  std::cout << fmt::format("report: {} ({:.0f} s)\n", html, campaign.input.wall_seconds);
 }
 
 void CalibrationCommands::stiffness_check(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options,

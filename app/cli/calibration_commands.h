@@ -30,8 +30,22 @@ class CalibrationCommands {
   int run();
 
  private:
+  /// What the phases of compare, calibrate and diagnose share (calibration_commands.cpp).
+  struct Campaign;
+
   int run_test();
+  /// compare, calibrate or diagnose: reads, simulates, prints and writes the report in OUT.
   int run_measured(const std::string& command);
+  // The phases of run_measured, in order.
+  void read_campaign_inputs(Campaign& campaign);
+  void set_campaign_options(Campaign& campaign);
+  void start_campaign_report(Campaign& campaign);
+  void report_diagnosis_stages(Campaign& campaign);
+  void print_comparison(Campaign& campaign);
+  void record_calibration(Campaign& campaign);
+  void record_diagnosis(Campaign& campaign);
+  void write_calibrated(const Campaign& campaign);
+  void write_campaign_report(Campaign& campaign, const materials::MaterialModel& shown);
 
   RenderFinal render_;
   CLI::App* test_ = nullptr;

@@ -192,52 +192,75 @@ int check_case(const std::string& path) {
   return 0;
 }
 
-int run_case(const RunArgs& args) {
-  std::string case_text;
-  YAML::Node root = load_case_yaml(args.case_path, &case_text);
-  const dem::app::SweepPlan plan = dem::app::read_sweep(root, args.case_path);
-  if (!plan.variants.empty() && args.variant < 0) {
-    dem::app::SweepOptions sweep;
-    sweep.case_path = args.case_path;
-    sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
-    sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
-    return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
-  }
-  if (args.variant >= 0) {
-    if (args.variant >= static_cast<long>(plan.variants.size()))
-      throw dem::CaseError(fmt::format("--variant {}: the case has {} sweep variants", args.variant, plan.variants.size()));
-    root = dem::app::variant_case(root, plan, static_cast<size_t>(args.variant));
-    case_text = fmt::format("# {} of {}: {}\n", plan.name(args.variant), args.case_path, plan.label(args.variant)) + YAML::Dump(root) + "\n";
-  }
-  // The record is the case as run: a duration given on the command line is written into it.
-  if (args.duration > 0) {
-    const std::string header = case_text.starts_with("# ") && args.variant >= 0 ? case_text.substr(0, case_text.find('\n') + 1) : "";
-    root["simulation"]["duration"] = args.duration;
-    case_text = header + fmt::format("# {} as run with --duration {:g}\n", args.case_path, args.duration) + YAML::Dump(root) + "\n";
-  }
-  dem::CaseSpec spec = dem::parse_case_node(root, args.case_path);
-  dem::equipment::expand_equipment(spec);
-  // The output folder before the case is compiled: refused when it holds another run's results
-  // (without --resume or --overwrite) or a file of the run's names that no run wrote, and locked
-  // while this run writes it (output/run_folder.h). What this program writes there after the run
-  // (the case as run, equipment meshes, renders, the report) is guarded as the run's own.
-  const std::vector<std::string> caller_outputs = {"case.yaml",           "meshes/*.stl",       "renders/frame_*.png",
-                                                   "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
-                                                   "report/*.csv",        "report/*.png",       "report/plots/*.png",
-                                                   "report/plots/*.gp",   "report/plots/*.tsv"};
-  std::shared_ptr<dem::RunFolder> folder;
+/// The case as it runs: its YAML (a sweep variant chosen, a duration given on the command line
+/// written in) and its record, the text written to OUT/case.yaml.
+struct CaseAsRun {
+  YAML::Node root;
+  std::string text;
+};
+
+/// The case file as written: its YAML and its text.
+CaseAsRun read_case_as_written(const std::string& path) {
+  std::string text;
+  YAML::Node root = load_case_yaml(path, &text);
+  return {root, std::move(text)};
+}
+
+/// A case with a sweep, run without --variant: every variant of it.
+int run_every_variant(const RunArgs& args, const dem::app::SweepPlan& plan, const YAML::Node& root) {
+  dem::app::SweepOptions sweep;
+  sweep.case_path = args.case_path;
+  sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
+  sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
+  return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
+}
+
+/// --variant K: the case becomes that variant of its sweep, and its record says which.
+void select_variant(const RunArgs& args, const dem::app::SweepPlan& plan, CaseAsRun& as_run) {
+  if (args.variant >= static_cast<long>(plan.variants.size()))
+    throw dem::CaseError(fmt::format("--variant {}: the case has {} sweep variants", args.variant, plan.variants.size()));
+  as_run.root = dem::app::variant_case(as_run.root, plan, static_cast<size_t>(args.variant));
+  as_run.text = fmt::format("# {} of {}: {}\n", plan.name(args.variant), args.case_path, plan.label(args.variant)) + YAML::Dump(as_run.root) + "\n";
+}
+
+/// The record is the case as run: a duration given on the command line is written into it.
+void write_duration_into_case(const RunArgs& args, CaseAsRun& as_run) {
+  const std::string header = as_run.text.starts_with("# ") && args.variant >= 0 ? as_run.text.substr(0, as_run.text.find('\n') + 1) : "";
+  as_run.root["simulation"]["duration"] = args.duration;
+  as_run.text = header + fmt::format("# {} as run with --duration {:g}\n", args.case_path, args.duration) + YAML::Dump(as_run.root) + "\n";
+}
+
+/// The output folder, claimed before the case is compiled: refused when it holds another run's
+/// results (without --resume or --overwrite) or a file of the run's names that no run wrote, and
+/// locked while this run writes it (output/run_folder.h). What this program writes there after
+/// the run (the case as run, equipment meshes, renders, the report) is guarded as the run's own.
+struct OutputFolder {
+  std::vector<std::string> caller_outputs;  ///< what this program writes there after the run
+  std::shared_ptr<dem::RunFolder> folder;   ///< claimed on rank 0; null on the other ranks
+};
+
+OutputFolder claim_output_folder(const RunArgs& args, const dem::CaseSpec& spec) {
+  OutputFolder claimed;
+  claimed.caller_outputs = {"case.yaml",           "meshes/*.stl",       "renders/frame_*.png",
+                            "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
+                            "report/*.csv",        "report/*.png",       "report/plots/*.png",
+                            "report/plots/*.gp",   "report/plots/*.tsv"};
   if (dem::app::mpi::world().rank == 0) {
     std::vector<std::string> names = dem::run_output_names();
-    names.insert(names.end(), caller_outputs.begin(), caller_outputs.end());
+    names.insert(names.end(), claimed.caller_outputs.begin(), claimed.caller_outputs.end());
     const dem::FolderUse use = args.resume ? dem::FolderUse::resume : args.overwrite ? dem::FolderUse::overwrite : dem::FolderUse::fresh;
-    folder = std::make_shared<dem::RunFolder>(!args.out.empty() ? args.out : spec.output.directory, use, names, std::cout);
+    claimed.folder = std::make_shared<dem::RunFolder>(!args.out.empty() ? args.out : spec.output.directory, use, names, std::cout);
   }
-  const dem::Model model = compile_case(spec);
-  const int threads = args.threads > 0 ? args.threads : model.threads;
-  if (threads > 0) omp_set_num_threads(threads);
-  dem::State state = dem::initial_state(model);
-  dem::Workspace work;
-  // Under mpirun the case is split into a grid of boxes, one per rank (app/mpi/mpi_domain.h); rank 0 writes.
+  return claimed;
+}
+
+/// Under mpirun the case is split into a grid of boxes, one per rank (app/mpi/mpi_domain.h); rank 0 writes.
+struct RankSplit {
+  std::unique_ptr<dem::Domain> domain;  ///< null: not split (no MPI, or a case that cannot be split)
+  bool waits = false;                   ///< a rank other than 0 while the case runs on rank 0 alone
+};
+
+RankSplit split_over_ranks(const RunArgs& args, const dem::Model& model, const dem::State& state, int threads) {
   const dem::app::mpi::World& world = dem::app::mpi::world();
   std::string domain_note;
   std::array<int, 3> grid{0, 0, 0};
@@ -248,60 +271,111 @@ int run_case(const RunArgs& args) {
       throw dem::CaseError(fmt::format("--rank-grid '{}': expected three box counts as NXxNYxNZ, for example 2x2x1", args.rank_grid));
   }
   const dem::app::mpi::Balance balance = args.balance == "time" ? dem::app::mpi::Balance::time : dem::app::mpi::Balance::work;
-  const std::unique_ptr<dem::Domain> domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid, true, balance) : nullptr;
-  if (world.active() && !domain && grid[0] > 0 && world.size > 1) throw dem::CaseError(fmt::format("--rank-grid {}: {}", args.rank_grid, domain_note));
-  if (world.active() && !domain) {  // cannot be split: rank 0 runs it alone, the others wait
-    if (world.rank != 0) return 0;
+  RankSplit split;
+  split.domain = world.active() ? dem::app::mpi::make_domain(model, state, &domain_note, grid, true, balance) : nullptr;
+  if (world.active() && !split.domain && grid[0] > 0 && world.size > 1) throw dem::CaseError(fmt::format("--rank-grid {}: {}", args.rank_grid, domain_note));
+  if (world.active() && !split.domain) {  // cannot be split: rank 0 runs it alone, the others wait
+    if (world.rank != 0) {
+      split.waits = true;
+      return split;
+    }
     std::cout << fmt::format("note: {} MPI ranks, but this case runs on rank 0 alone: {}\n", world.size, domain_note);
   }
-  if (domain && threads <= 0) omp_set_num_threads(dem::app::mpi::cores_per_rank());  // the ranks share the machine's cores
-  if (domain && world.rank == 0)
+  if (split.domain && threads <= 0) omp_set_num_threads(dem::app::mpi::cores_per_rank());  // the ranks share the machine's cores
+  if (split.domain && world.rank == 0)
     std::cout << fmt::format("domain decomposition: {}, {} OpenMP threads per rank\n", domain_note, omp_get_max_threads());
-  std::ostringstream quiet;  // the other ranks' log
-  std::ostream& log = world.rank == 0 ? std::cout : quiet;
+  return split;
+}
+
+/// What the engine is told: the command line's overrides, the claimed folder, the ranks' split.
+dem::RunOptions run_options(const RunArgs& args, dem::Domain* domain, const OutputFolder& output) {
   dem::RunOptions options;
-  options.domain = domain.get();
+  options.domain = domain;
   options.duration = args.duration;
   options.max_steps = args.max_steps;
   options.output_directory = args.out;
   options.progress = !args.quiet;
   options.resume = args.resume;
   options.overwrite = args.overwrite;
-  options.caller_outputs = caller_outputs;
-  options.folder = folder;
+  options.caller_outputs = output.caller_outputs;
+  options.folder = output.folder;
   options.command_line = args.command_line;
   // A split run's ranks write each frame together, with no gather (parallel HDF5).
   if (domain) options.share_frame = dem::app::mpi::collective_frames();
   // Images of the flow: every render_every-th frame, and always the last (run.h).
-  options.on_frame = [&](const dem::Model& m, const dem::State& s, const dem::Workspace&, const std::string& out, bool last) {
+  options.on_frame = [](const dem::Model& m, const dem::State& s, const dem::Workspace&, const std::string& out, bool last) {
     const std::string path = fmt::format("{}/renders/frame_{:06d}.png", out, s.step);
     std::filesystem::create_directories(out + "/renders");
     dem::app::render_state(m, s, image_options(m), path);
     if (last) std::cout << fmt::format("  rendered {}\n", path);
   };
+  return options;
+}
+
+/// What the run and the files written beside its results share.
+struct CaseRun {
+  const RunArgs& args;
+  const dem::CaseSpec& spec;
+  const std::string& case_text;  ///< the record of the case as run (OUT/case.yaml)
+  const dem::Model& model;
+  dem::State& state;
+};
+
+/// Runs the case; a run that numerical trouble stops still gets its report.
+dem::RunSummary run_reporting_a_stop(const CaseRun& case_run, dem::Workspace& work, const dem::RunOptions& options, std::ostream& log) {
   dem::RunSummary summary;
   try {
-    summary = dem::run(model, state, work, options, log);
+    summary = dem::run(case_run.model, case_run.state, work, options, log);
   } catch (const dem::RunStopped& stopped) {
     // Numerical trouble stopped the run: its report shows what it computed up to then, under a
     // banner that says why (a split run's state is not gathered then: no report).
-    if (world.rank == 0 && args.report && !domain && !stopped.summary.scalars.empty()) {
+    if (dem::app::mpi::world().rank == 0 && case_run.args.report && !options.domain && !stopped.summary.scalars.empty()) {
       try {
-        write_run_report(model, state, spec, stopped.summary, args.case_path, case_text);
+        write_run_report(case_run.model, case_run.state, case_run.spec, stopped.summary, case_run.args.case_path, case_run.case_text);
       } catch (const std::exception& e) {
         std::cout << fmt::format("  no report of the stopped run: {}\n", e.what());
       }
     }
     throw;
   }
-  if (world.rank != 0 || summary.already_complete) return 0;
+  return summary;
+}
+
+/// Beside the run's results (rank 0): the case as run, the equipment meshes, the report.
+void write_beside_results(const CaseRun& case_run, const dem::RunSummary& summary) {
   const std::string out = summary.output_directory;
-  dem::write_file_atomically(out + "/case.yaml", case_text);
-  if (spec.equipment) {
-    const auto files = dem::equipment::write_equipment_meshes(spec, out + "/meshes");
+  dem::write_file_atomically(out + "/case.yaml", case_run.case_text);
+  if (case_run.spec.equipment) {
+    const auto files = dem::equipment::write_equipment_meshes(case_run.spec, out + "/meshes");
     std::cout << fmt::format("  wrote {} equipment meshes (STL) to {}/meshes\n", files.size(), out);
   }
-  if (args.report) write_run_report(model, state, spec, summary, args.case_path, case_text);
+  if (case_run.args.report) write_run_report(case_run.model, case_run.state, case_run.spec, summary, case_run.args.case_path, case_run.case_text);
+}
+
+int run_case(const RunArgs& args) {
+  CaseAsRun as_run = read_case_as_written(args.case_path);
+  const dem::app::SweepPlan plan = dem::app::read_sweep(as_run.root, args.case_path);
+  if (!plan.variants.empty() && args.variant < 0) return run_every_variant(args, plan, as_run.root);
+  if (args.variant >= 0) select_variant(args, plan, as_run);
+  if (args.duration > 0) write_duration_into_case(args, as_run);
+  dem::CaseSpec spec = dem::parse_case_node(as_run.root, args.case_path);
+  dem::equipment::expand_equipment(spec);
+  const OutputFolder output = claim_output_folder(args, spec);
+  const dem::Model model = compile_case(spec);
+  const int threads = args.threads > 0 ? args.threads : model.threads;
+  if (threads > 0) omp_set_num_threads(threads);
+  dem::State state = dem::initial_state(model);
+  dem::Workspace work;
+  const RankSplit split = split_over_ranks(args, model, state, threads);
+  if (split.waits) return 0;
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  std::ostringstream quiet;  // the other ranks' log
+  std::ostream& log = world.rank == 0 ? std::cout : quiet;
+  const dem::RunOptions options = run_options(args, split.domain.get(), output);
+  const CaseRun case_run{args, spec, as_run.text, model, state};
+  const dem::RunSummary summary = run_reporting_a_stop(case_run, work, options, log);
+  if (world.rank != 0 || summary.already_complete) return 0;
+  write_beside_results(case_run, summary);
   return 0;
 }
 
@@ -372,54 +446,68 @@ std::string rank_prefix() {
   return world.active() ? fmt::format("rank {}: ", world.rank) : "";
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  dem::tune_allocator();
-  dem::materials::use_material_library();  // cases find `library:` materials outside their own folders
-  // MPI only when mpirun (or another MPI launcher) started this process; see app/campaign/mpi_campaign.h.
-  dem::app::mpi::Session mpi_session(&argc, &argv);
-  const dem::app::mpi::World& world = dem::app::mpi::world();
-  CLI::App app{"demdesign: DEM simulation for the design of bulk-materials-handling equipment"};
-  app.require_subcommand(0, 1);
-  RunArgs args;
-  auto add_run_options = [&](CLI::App* cmd) {
-    cmd->add_option("--duration", args.duration, "simulated time [s], overrides the case")->check(dem::app::number_in(0, 1e6, "s", true));
-    cmd->add_option("--max-steps", args.max_steps, "stop after this many steps (shortened run)")->check(dem::app::whole_in(1, 1e15));
-    cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)")->check(dem::app::whole_in(1, 1024));
-    cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
-    cmd->add_flag("--quiet", args.quiet, "no progress lines");
-    cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
-    cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
-    cmd->add_option("--rank-grid", args.rank_grid, "under mpirun: the grid of boxes, NXxNYxNZ (default: chosen from the domain's shape)");
-    cmd->add_option("--balance", args.balance,
-                    "under mpirun: what the cuts balance: work (particles and contacts, reproducible) or time (each rank's measured computing time)")
-        ->check(CLI::IsMember({"work", "time"}));
-    CLI::Option* resume = cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
-    cmd->add_flag("--overwrite", args.overwrite,
-                  "replace the results of an earlier run in OUT: removes the files runs wrote there (run_files.txt), nothing else")
-        ->excludes(resume);
-  };
-  app.add_option("case", args.case_path, "case file (YAML) to run");
-  add_run_options(&app);
-  CLI::App* run_cmd = app.add_subcommand("run", "run a case");
-  run_cmd->add_option("case", args.case_path, "case file (YAML)")->required();
-  add_run_options(run_cmd);
+/// What the command line fills, command by command: CLI11 writes into it while parsing, so it
+/// stays where it is until the command has run.
+struct CommandLine {
+  RunArgs run;  ///< demdesign CASE, demdesign run CASE
   std::string check_path;
-  CLI::App* check_cmd = app.add_subcommand("check", "read and compile a case and print its set-up");
-  check_cmd->add_option("case", check_path, "case file (YAML)")->required();
+  CLI::App* check_cmd = nullptr;
   std::vector<std::string> mesh_files;
   dem::geometry::ImportOptions mesh_options;
   double mesh_particle_diameter = 0;
-  CLI::App* mesh_cmd = app.add_subcommand("check-mesh", "import meshes (STL, OBJ, PLY, glTF, 3MF, ...), check and repair them");
-  mesh_cmd->add_option("files", mesh_files, "mesh files")->required();
-  mesh_cmd->add_option("--unit-scale", mesh_options.unit_scale, "file units to metres (0.001 for millimetres)");
-  mesh_cmd->add_option("--particle-diameter", mesh_particle_diameter, "[m] enables the triangle size checks");
+  CLI::App* mesh_cmd = nullptr;
   std::string render_out, render_frame = "last";
   dem::app::ImageOptions render_options;
-  CLI::App* render_cmd = app.add_subcommand("render", "render saved frames of a run to PNG (headless)");
-  render_cmd->add_option("results", render_out, "output folder of a run")->required();
-  render_cmd->add_option("--frame", render_frame, "frame index, last or all")
+  bool render_video = false;
+  CLI::App* render_cmd = nullptr;
+  CLI::App* effects_cmd = nullptr;
+  CLI::App* materials_cmd = nullptr;
+  bool keys_markdown = false;
+  std::string keys_source;
+  CLI::App* keys_cmd = nullptr;
+  std::string validate_out = "out/validation", validate_source;
+  CLI::App* validate_cmd = nullptr;
+};
+
+/// The options of a run, on `demdesign CASE` and on `demdesign run CASE`.
+void add_run_options(CLI::App* cmd, RunArgs& args) {
+  cmd->add_option("--duration", args.duration, "simulated time [s], overrides the case")->check(dem::app::number_in(0, 1e6, "s", true));
+  cmd->add_option("--max-steps", args.max_steps, "stop after this many steps (shortened run)")->check(dem::app::whole_in(1, 1e15));
+  cmd->add_option("--threads", args.threads, "OpenMP threads (default: all cores)")->check(dem::app::whole_in(1, 1024));
+  cmd->add_option("--out", args.out, "output folder (default: the case's output.directory)");
+  cmd->add_flag("--quiet", args.quiet, "no progress lines");
+  cmd->add_flag("!--no-report", args.report, "skip the report (renders, plots, report.html)");
+  cmd->add_option("--variant", args.variant, "run only this variant (0-based) of the case's sweep")->group("");
+  cmd->add_option("--rank-grid", args.rank_grid, "under mpirun: the grid of boxes, NXxNYxNZ (default: chosen from the domain's shape)");
+  cmd->add_option("--balance", args.balance,
+                  "under mpirun: what the cuts balance: work (particles and contacts, reproducible) or time (each rank's measured computing time)")
+      ->check(CLI::IsMember({"work", "time"}));
+  CLI::Option* resume = cmd->add_flag("--resume", args.resume, "continue from OUT's checkpoint (written every output.checkpoint_every, and on SIGINT/SIGTERM; a run split over ranks resumes on any rank count)");
+  cmd->add_flag("--overwrite", args.overwrite,
+                "replace the results of an earlier run in OUT: removes the files runs wrote there (run_files.txt), nothing else")
+      ->excludes(resume);
+}
+
+/// Running a case: `demdesign CASE` and `demdesign run CASE`.
+void add_run_commands(CLI::App& app, RunArgs& args) {
+  app.add_option("case", args.case_path, "case file (YAML) to run");
+  add_run_options(&app, args);
+  CLI::App* run_cmd = app.add_subcommand("run", "run a case");
+  run_cmd->add_option("case", args.case_path, "case file (YAML)")->required();
+  add_run_options(run_cmd, args);
+}
+
+/// The commands on a case, its meshes and its results: check, check-mesh, render.
+void add_case_tools(CLI::App& app, CommandLine& line) {
+  line.check_cmd = app.add_subcommand("check", "read and compile a case and print its set-up");
+  line.check_cmd->add_option("case", line.check_path, "case file (YAML)")->required();
+  line.mesh_cmd = app.add_subcommand("check-mesh", "import meshes (STL, OBJ, PLY, glTF, 3MF, ...), check and repair them");
+  line.mesh_cmd->add_option("files", line.mesh_files, "mesh files")->required();
+  line.mesh_cmd->add_option("--unit-scale", line.mesh_options.unit_scale, "file units to metres (0.001 for millimetres)");
+  line.mesh_cmd->add_option("--particle-diameter", line.mesh_particle_diameter, "[m] enables the triangle size checks");
+  line.render_cmd = app.add_subcommand("render", "render saved frames of a run to PNG (headless)");
+  line.render_cmd->add_option("results", line.render_out, "output folder of a run")->required();
+  line.render_cmd->add_option("--frame", line.render_frame, "frame index, last or all")
       ->check(CLI::Validator(
           [](std::string& text) {
             return text == "last" || text == "all" || dem::app::whole_in(0, 1e9)(text).empty()
@@ -427,36 +515,36 @@ int main(int argc, char** argv) {
                        : fmt::format("'{}' is not a frame; valid: a frame index (0, 1, ...), last or all", text);
           },
           "INDEX|last|all"));
-  render_cmd->add_option("--color-by", render_options.colour, "speed, radius or material")
+  line.render_cmd->add_option("--color-by", line.render_options.colour, "speed, radius or material")
       ->check(CLI::IsMember({"speed", "radius", "material"}));
-  render_cmd->add_option("--camera", render_options.camera, "side, front, top or iso")
+  line.render_cmd->add_option("--camera", line.render_options.camera, "side, front, top or iso")
       ->check(CLI::IsMember({"side", "front", "top", "iso"}));
-  bool render_video = false;
-  render_cmd->add_flag("--video", render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
-  render_cmd->add_option("--width", render_options.width, "[px]")->check(dem::app::whole_in(16, 8192));
-  render_cmd->add_option("--height", render_options.height, "[px]")->check(dem::app::whole_in(16, 8192));
-  CLI::App* effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
-  CLI::App* materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
-  bool keys_markdown = false;
-  std::string keys_source = dem::app::default_source_dir();
-  CLI::App* keys_cmd = app.add_subcommand("keys", "every key of case, material and measurement files, read from the "
-                                                  "readers themselves (docs/case-keys.md is its --markdown output)");
-  keys_cmd->add_flag("--markdown", keys_markdown, "Markdown tables, as in docs/case-keys.md");
-  keys_cmd->add_option("--source", keys_source, "source tree whose shipped files are read (default: the one built from)");
+  line.render_cmd->add_flag("--video", line.render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
+  line.render_cmd->add_option("--width", line.render_options.width, "[px]")->check(dem::app::whole_in(16, 8192));
+  line.render_cmd->add_option("--height", line.render_options.height, "[px]")->check(dem::app::whole_in(16, 8192));
+}
 
-  std::string validate_out = "out/validation", validate_source = dem::app::default_source_dir();
-  CLI::App* validate_cmd = app.add_subcommand("validate", "run the published benchmarks (Chung & Ooi 2011 tests 1-8) and write a "
-                                                          "validation page with tables and plots");
-  validate_cmd->add_option("--out", validate_out, "output folder (validation.html, validation.md, validation.csv, plots/)");
-  validate_cmd->add_option("--source", validate_source, "source tree whose cases/ are run (default: the one built from)");
+/// The reference commands: effects, materials, keys, validate.
+void add_reference_commands(CLI::App& app, CommandLine& line) {
+  line.effects_cmd = app.add_subcommand("effects", "list the contact effects and their parameters");
+  line.materials_cmd = app.add_subcommand("materials", "list the material library (materials/*.yaml)");
+  line.keys_source = dem::app::default_source_dir();
+  line.keys_cmd = app.add_subcommand("keys", "every key of case, material and measurement files, read from the "
+                                             "readers themselves (docs/case-keys.md is its --markdown output)");
+  line.keys_cmd->add_flag("--markdown", line.keys_markdown, "Markdown tables, as in docs/case-keys.md");
+  line.keys_cmd->add_option("--source", line.keys_source, "source tree whose shipped files are read (default: the one built from)");
 
-  // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
-  dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
-    dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
-  });
+  line.validate_source = dem::app::default_source_dir();
+  line.validate_cmd = app.add_subcommand("validate", "run the published benchmarks (Chung & Ooi 2011 tests 1-8) and write a "
+                                                     "validation page with tables and plots");
+  line.validate_cmd->add_option("--out", line.validate_out, "output folder (validation.html, validation.md, validation.csv, plots/)");
+  line.validate_cmd->add_option("--source", line.validate_source, "source tree whose cases/ are run (default: the one built from)");
+}
 
-  // A first word that is neither an option, a command nor a file is most likely a misspelt
-  // command (CLI11 would take it for the case file and then complain about the next word).
+/// A first word that is neither an option, a command nor a file is most likely a misspelt
+/// command (CLI11 would take it for the case file and then complain about the next word): says
+/// so, with the nearest command, and returns true.
+bool reject_misspelt_command(CLI::App& app, int argc, char** argv) {
   if (argc > 1 && argv[1][0] != '-' && !std::filesystem::exists(argv[1])) {
     std::vector<std::string> commands;
     for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) commands.push_back(sub->get_name());
@@ -464,44 +552,73 @@ int main(int argc, char** argv) {
       const std::string hint = dem::nearest_word(argv[1], commands);
       std::cerr << fmt::format("error: '{}' is neither a command{} nor a case file; commands: {} (or give a case file to run)\n", argv[1],
                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), fmt::join(commands, ", "));
-      return 2;
+      return true;
     }
   }
+  return false;
+}
+
+/// Runs the parsed command; returns the exit status.
+int run_command(CLI::App& app, const CommandLine& line, dem::app::CalibrationCommands& calibration) {
+  const dem::app::mpi::World& world = dem::app::mpi::world();
+  if (calibration.parsed()) return calibration.run();  // compare, calibrate, diagnose: every rank; test: rank 0
+  // Commands that are not campaigns run on rank 0; a case decides in run_case (a sweep uses every rank).
+  if (world.active() && world.rank != 0 && line.run.case_path.empty()) return 0;
+  if (line.effects_cmd->parsed()) {
+    std::cout << dem::describe_effects();
+    return 0;
+  }
+  if (line.materials_cmd->parsed()) {
+    std::cout << fmt::format("material library: {}\n", dem::materials::library_folder());
+    for (const auto& m : dem::materials::list_library())
+      std::cout << fmt::format("  {:<20} {}\n", m.name, m.description);
+    std::cout << "use in a case: materials: {NAME: {library: FILE_STEM}}\n";
+    return 0;
+  }
+  if (line.keys_cmd->parsed()) {
+    std::cout << dem::app::case_key_reference(line.keys_source, line.keys_markdown);
+    return 0;
+  }
+  if (line.validate_cmd->parsed()) return dem::app::validate_command(line.validate_source, line.validate_out, std::cout);
+  if (line.check_cmd->parsed()) return check_case(line.check_path);
+  if (line.mesh_cmd->parsed()) return dem::geometry::check_mesh_command(line.mesh_files, line.mesh_options, line.mesh_particle_diameter, std::cout);
+  if (line.render_cmd->parsed()) return render_results(line.render_out, line.render_frame, line.render_options, line.render_video);
+  if (line.run.case_path.empty()) {
+    std::cout << app.help();
+    return 2;
+  }
+  return run_case(line.run);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  dem::tune_allocator();
+  dem::materials::use_material_library();  // cases find `library:` materials outside their own folders
+  // MPI only when mpirun (or another MPI launcher) started this process; see app/campaign/mpi_campaign.h.
+  dem::app::mpi::Session mpi_session(&argc, &argv);
+  CLI::App app{"demdesign: DEM simulation for the design of bulk-materials-handling equipment"};
+  app.require_subcommand(0, 1);
+  CommandLine line;
+  add_run_commands(app, line.run);
+  add_case_tools(app, line);
+  add_reference_commands(app, line);
+
+  // Calibration: test, compare, calibrate, diagnose (materials/ simulates, app/ reports and renders).
+  dem::app::CalibrationCommands calibration(app, [](const dem::Model& m, const dem::State& s, const std::string& png) {
+    dem::app::render_state(m, s, {"", "speed", 1280, 720}, png);
+  });
+
+  if (reject_misspelt_command(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version end with 0; a bad command line with 2, as every other bad input.
     return app.exit(e) == 0 ? 0 : 2;
   }
-  for (int k = 0; k < argc; ++k) args.command_line += (k ? " " : "") + std::string(argv[k]);
+  for (int k = 0; k < argc; ++k) line.run.command_line += (k ? " " : "") + std::string(argv[k]);
   try {
-    if (calibration.parsed()) return calibration.run();  // compare, calibrate, diagnose: every rank; test: rank 0
-    // Commands that are not campaigns run on rank 0; a case decides in run_case (a sweep uses every rank).
-    if (world.active() && world.rank != 0 && args.case_path.empty()) return 0;
-    if (effects_cmd->parsed()) {
-      std::cout << dem::describe_effects();
-      return 0;
-    }
-    if (materials_cmd->parsed()) {
-      std::cout << fmt::format("material library: {}\n", dem::materials::library_folder());
-      for (const auto& m : dem::materials::list_library())
-        std::cout << fmt::format("  {:<20} {}\n", m.name, m.description);
-      std::cout << "use in a case: materials: {NAME: {library: FILE_STEM}}\n";
-      return 0;
-    }
-    if (keys_cmd->parsed()) {
-      std::cout << dem::app::case_key_reference(keys_source, keys_markdown);
-      return 0;
-    }
-    if (validate_cmd->parsed()) return dem::app::validate_command(validate_source, validate_out, std::cout);
-    if (check_cmd->parsed()) return check_case(check_path);
-    if (mesh_cmd->parsed()) return dem::geometry::check_mesh_command(mesh_files, mesh_options, mesh_particle_diameter, std::cout);
-    if (render_cmd->parsed()) return render_results(render_out, render_frame, render_options, render_video);
-    if (args.case_path.empty()) {
-      std::cout << app.help();
-      return 2;
-    }
-    return run_case(args);
+    return run_command(app, line, calibration);
   } catch (const dem::CaseError& e) {
     std::cerr << rank_prefix() << "error: " << e.what() << "\n";
     return stop_with(2);
