@@ -7,7 +7,7 @@ simulations at a time, one core each. Printed per test and observable: the mean 
 between packings (the replica noise) at each step, and the shift of the mean from the smallest
 step, in units of the noise, with its standard error (four packings a step resolve a shift of
 about 0.7 of the noise, eight about 0.5: the printed error says how far the data can tell). The
-lab tests' rule (materials/virtual_tests.h, kLabRayleighFraction) is the largest step whose
+lab tests' rule (materials/lab/virtual_tests.h, kLabRayleighFraction) is the largest step whose
 shift stays under a quarter of the noise for every observable, as far as the packings resolve
 it. Rows are appended to bench/results/lab_time_step.csv.
 
