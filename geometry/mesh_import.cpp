@@ -390,17 +390,8 @@ void check_off_file(const std::string& path) {
   }
 }
 
-}  // namespace
-
-bool has_importable_extension(const std::string& path) {
-  // One importer for all queries: constructing one instantiates every format reader.
-  static const Assimp::Importer importer;
-  const std::string extension = lower_extension(path);
-  return !extension.empty() && !is_brep_cad(path) && importer.IsExtensionSupported(extension);
-}
-
-TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) {
-  // Options first: a zero or non-finite scale would collapse or poison every vertex.
+/// The options are checked first: a zero or non-finite scale would collapse or poison every vertex.
+void refuse_invalid_options(const std::string& path, const ImportOptions& options) {
   bool options_valid = std::isfinite(options.unit_scale) && options.unit_scale > 0;
   for (int axis = 0; axis < 3; ++axis)
     options_valid = options_valid && std::isfinite(options.scale[axis]) && options.scale[axis] != 0 &&
@@ -408,7 +399,10 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   if (!options_valid)
     throw MeshError(MeshError::Kind::invalid_options,
                     path + ": invalid import options: unit_scale must be > 0, scale non-zero, and all values finite");
+}
 
+/// Files refused before assimp opens them: B-rep CAD, a missing file, and damaged OFF, PLY and STL files.
+void refuse_unreadable_file(const std::string& path) {
   // B-rep CAD is refused by extension, before assimp guesses at it (its STEP reader is for IFC only).
   if (is_brep_cad(path))
     throw MeshError(MeshError::Kind::cad_format,
@@ -422,9 +416,10 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   refuse_impossible_counts(path);
   if (lower_extension(path) == ".off") check_off_file(path);
   if (lower_extension(path) == ".stl") check_stl_file(path);
+}
 
-  // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
-  Assimp::Importer importer;
+/// The file as assimp reads it with no post-processing; the scene belongs to `importer`.
+const aiScene* read_scene(Assimp::Importer& importer, const std::string& path) {
   // Everything but positions and faces is dropped, so JoinIdenticalVertices joins by position only.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS |
@@ -447,47 +442,59 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
     throw MeshError(MeshError::Kind::unreadable, path + ": assimp could not read it (" + reason + "); " +
                                                      "export STL, OBJ, PLY, 3MF or glTF (assimp reads: " + known + ")");
   }
+  return scene;
+}
 
-  // Surfaces present at all? (assimp's scene preprocessor fills mPrimitiveTypes.)
-  bool has_surface = false;
-  for (unsigned int m = 0; m < scene->mNumMeshes; ++m)
-    has_surface = has_surface || (scene->mMeshes[m] && (scene->mMeshes[m]->mPrimitiveTypes &
-                                                        (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)));
-  const std::string no_triangles =
-      path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " + kExportAdvice;
-  if (!has_surface) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
+/// Surfaces present at all? (assimp's scene preprocessor fills mPrimitiveTypes.)
+bool has_surfaces(const aiScene& scene) {
+  bool found = false;
+  for (unsigned int m = 0; m < scene.mNumMeshes; ++m)
+    found = found || (scene.mMeshes[m] && (scene.mMeshes[m]->mPrimitiveTypes &
+                                           (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)));
+  return found;
+}
 
-  // Non-finite coordinates, before post-processing hides them (joining identical vertices merges
-  // a NaN vertex into another, and the repair then drops the "degenerate" triangle silently).
-  {
-    NonFinite bad;
-    std::size_t face_index = 0;
-    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) {
-      const aiMesh* mesh = scene->mMeshes[m];
-      if (!mesh || !mesh->mVertices) continue;
-      for (unsigned int f = 0; f < mesh->mNumFaces; ++f, ++face_index) {
-        const aiFace& face = mesh->mFaces[f];
-        bool finite = true;
-        for (unsigned int c = 0; c < face.mNumIndices && face.mIndices; ++c) {
-          if (face.mIndices[c] >= mesh->mNumVertices) continue;  // ValidateDataStructure refuses it below
-          const aiVector3D& v = mesh->mVertices[face.mIndices[c]];
-          finite = finite && std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-        }
-        if (finite) continue;
-        if (bad.examples.size() < 10) bad.examples.push_back(face_index);
-        ++bad.count;
+/// "7, 12, 40": the examples of `bad`, for an error message.
+std::string example_list(const NonFinite& bad) {
+  std::string which;
+  for (std::size_t t : bad.examples) which += (which.empty() ? "" : ", ") + std::to_string(t);
+  return which;
+}
+
+/// Non-finite coordinates, before post-processing hides them (joining identical vertices merges
+/// a NaN vertex into another, and the repair then drops the "degenerate" triangle silently).
+void refuse_non_finite_faces(const aiScene& scene, const std::string& path) {
+  NonFinite bad;
+  std::size_t face_index = 0;
+  for (unsigned int m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (!mesh || !mesh->mVertices) continue;
+    for (unsigned int f = 0; f < mesh->mNumFaces; ++f, ++face_index) {
+      const aiFace& face = mesh->mFaces[f];
+      bool finite = true;
+      for (unsigned int c = 0; c < face.mNumIndices && face.mIndices; ++c) {
+        if (face.mIndices[c] >= mesh->mNumVertices) continue;  // ValidateDataStructure refuses it below
+        const aiVector3D& v = mesh->mVertices[face.mIndices[c]];
+        finite = finite && std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
       }
-    }
-    if (bad.count > 0) {
-      std::string which;
-      for (std::size_t t : bad.examples) which += (which.empty() ? "" : ", ") + std::to_string(t);
-      throw MeshError(MeshError::Kind::unreadable,
-                      path + ": " + std::to_string(bad.count) + " faces have a corner with non-finite coordinates (NaN or "
-                          "infinity), e.g. triangles " + which + " (0-based, in file order); the file is damaged: re-export it");
+      if (finite) continue;
+      if (bad.examples.size() < 10) bad.examples.push_back(face_index);
+      ++bad.count;
     }
   }
+  if (bad.count > 0) {
+    const std::string which = example_list(bad);
+    throw MeshError(MeshError::Kind::unreadable,
+                    path + ": " + std::to_string(bad.count) + " faces have a corner with non-finite coordinates (NaN or "
+                        "infinity), e.g. triangles " + which + " (0-based, in file order); the file is damaged: re-export it");
+  }
+}
 
-  // Validate first (so broken files are refused, not crashed on), then triangulate and join.
+/// Validate first (so broken files are refused, not crashed on), then triangulate and join; the
+/// scene belongs to `importer`.
+const aiScene* validate_and_join(Assimp::Importer& importer, const std::string& path) {
+  const aiScene* scene = nullptr;
+  std::string reason;
   try {
     scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
                                          aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
@@ -499,7 +506,12 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   if (!scene)
     throw MeshError(MeshError::Kind::unreadable,
                     path + ": the file is damaged (" + reason + "); re-export it as STL, OBJ, PLY, 3MF or glTF");
+  return scene;
+}
 
+/// The scene's triangles in metres, placed by the user's options; corners with non-finite
+/// coordinates are refused.
+TriangleMesh place_triangles(const aiScene& scene, const std::string& path, const ImportOptions& options) {
   // Walk the node hierarchy, placing each referenced mesh by its node's global transform.
   TriangleMesh out;
   out.source = path;
@@ -508,27 +520,51 @@ TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) 
   const Affine placement = from_options(options);
   std::size_t points_and_lines = 0;
   std::vector<std::pair<const aiNode*, Affine>> stack;
-  if (scene->mRootNode) stack.emplace_back(scene->mRootNode, placement);
+  if (scene.mRootNode) stack.emplace_back(scene.mRootNode, placement);
   while (!stack.empty()) {
     const auto [node, parent] = stack.back();
     stack.pop_back();
     const Affine global = compose(parent, from_assimp(node->mTransformation));
     for (unsigned int k = 0; k < node->mNumMeshes; ++k)
-      if (node->mMeshes[k] < scene->mNumMeshes)
-        points_and_lines += append_mesh(*scene->mMeshes[node->mMeshes[k]], global, welder, out, bad);
+      if (node->mMeshes[k] < scene.mNumMeshes)
+        points_and_lines += append_mesh(*scene.mMeshes[node->mMeshes[k]], global, welder, out, bad);
     for (unsigned int child = 0; child < node->mNumChildren; ++child)
       if (node->mChildren[child]) stack.emplace_back(node->mChildren[child], global);
   }
   // A scene whose nodes reference no mesh at all: take the meshes as they are.
   if (out.triangles.empty() && points_and_lines == 0)
-    for (unsigned int m = 0; m < scene->mNumMeshes; ++m) append_mesh(*scene->mMeshes[m], placement, welder, out, bad);
+    for (unsigned int m = 0; m < scene.mNumMeshes; ++m) append_mesh(*scene.mMeshes[m], placement, welder, out, bad);
   if (bad.count > 0) {
-    std::string which;
-    for (std::size_t t : bad.examples) which += (which.empty() ? "" : ", ") + std::to_string(t);
+    const std::string which = example_list(bad);
     throw MeshError(MeshError::Kind::unreadable,
                     path + ": " + std::to_string(bad.count) + " triangle corners have non-finite coordinates (NaN or infinity), "
                         "e.g. in triangles " + which + " (0-based, in file order); the file is damaged: re-export it");
   }
+  return out;
+}
+
+}  // namespace
+
+bool has_importable_extension(const std::string& path) {
+  // One importer for all queries: constructing one instantiates every format reader.
+  static const Assimp::Importer importer;
+  const std::string extension = lower_extension(path);
+  return !extension.empty() && !is_brep_cad(path) && importer.IsExtensionSupported(extension);
+}
+
+TriangleMesh import_mesh(const std::string& path, const ImportOptions& options) {
+  refuse_invalid_options(path, options);
+  refuse_unreadable_file(path);
+  // Read with no post-processing first, so a file without surfaces is told apart from a broken one.
+  Assimp::Importer importer;
+  const aiScene* scene = read_scene(importer, path);
+  const bool surfaces = has_surfaces(*scene);
+  const std::string no_triangles =
+      path + ": holds no triangles (only points, lines or no geometry); a wall needs a surface: " + kExportAdvice;
+  if (!surfaces) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
+  refuse_non_finite_faces(*scene, path);
+  scene = validate_and_join(importer, path);
+  TriangleMesh out = place_triangles(*scene, path, options);
   if (out.triangles.empty()) throw MeshError(MeshError::Kind::no_triangles, no_triangles);
   if (out.vertices.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
     throw MeshError(MeshError::Kind::unreadable, path + ": more than 2^31 vertices; decimate the mesh before import");

@@ -69,9 +69,8 @@ MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const st
   return m;
 }
 
-Experiment read_experiment(const YAML::Node& node, const std::string& file, size_t index, const std::vector<MaterialSpec>& walls) {
-  MapReader map(node, file, fmt::format("experiments[{}]", index));
-  Experiment e;
+/// The experiment's id and test, also given to its set-up; returns the test, one of test_names().
+std::string read_id_and_test(MapReader& map, Experiment& e) {
   e.location = map.location();
   e.id = map.required_string("id", "a name for the experiment, unique in the file");
   const std::vector<std::string> tests = test_names();
@@ -81,94 +80,134 @@ Experiment read_experiment(const YAML::Node& node, const std::string& file, size
   e.setup.test = test;
   e.setup.id = e.id;
   e.setup.location = e.location;
-  // Set-up: numbers and words; which keys a test needs is checked by the test itself
-  // (check_experiments, before anything is simulated).
-  const YAML::Node setup = map.node("setup");
-  if (!setup) map.fail("setup", fmt::format("missing: the set-up of the {} test, {{key: value, ...}}", test));
-  MapReader s(setup, file, map.key_path("setup"));
-  s.keys_are_names("SETUP_KEY");
-  for (const std::string& key : s.keys()) {
-    const YAML::Node v = s.node(key);
-    if (!v.IsScalar()) s.fail(key, "must be a number (SI units) or a word (a wall material, `periodic`, ...)");
-    double number = 0;
-    if (YAML::convert<double>::decode(v, number)) {
-      if (!std::isfinite(number)) s.fail(key, "must be a finite number");
-      e.setup.numbers[key] = number;
-    } else {
-      e.setup.words[key] = v.Scalar();
+  return test;
+}
+
+/// What the phases of read_experiment share, once its test is known: its map (experiments[INDEX]),
+/// its file, its test and the experiment as read so far.
+struct ExperimentReader {
+  MapReader& map;
+  const std::string& file;
+  const std::string& test;
+  Experiment& e;
+
+  /// Set-up: numbers and words; which keys a test needs is checked by the test itself
+  /// (check_experiments, before anything is simulated).
+  void read_setup(const std::vector<MaterialSpec>& walls) {
+    const YAML::Node setup = map.node("setup");
+    if (!setup) map.fail("setup", fmt::format("missing: the set-up of the {} test, {{key: value, ...}}", test));
+    MapReader s(setup, file, map.key_path("setup"));
+    s.keys_are_names("SETUP_KEY");
+    for (const std::string& key : s.keys()) {
+      const YAML::Node v = s.node(key);
+      if (!v.IsScalar()) s.fail(key, "must be a number (SI units) or a word (a wall material, `periodic`, ...)");
+      double number = 0;
+      if (YAML::convert<double>::decode(v, number)) {
+        if (!std::isfinite(number)) s.fail(key, "must be a finite number");
+        e.setup.numbers[key] = number;
+      } else {
+        e.setup.words[key] = v.Scalar();
+      }
+    }
+    // Words that name wall materials must be ones the file declares.
+    std::vector<std::string> wall_names;
+    for (const auto& w : walls) wall_names.push_back(w.name);
+    for (const char* key : {"base", "wall", "plate"}) {
+      const auto it = e.setup.words.find(key);
+      if (it == e.setup.words.end() || wall_names.empty()) continue;
+      if (std::find(wall_names.begin(), wall_names.end(), it->second) == wall_names.end())
+        s.fail(key, fmt::format("'{}' is not a wall material of this file{}; valid: {} (declared under `walls:`)", it->second,
+                                did_you_mean(it->second, wall_names), join(wall_names)));
+    }
+    s.finish();
+  }
+
+  /// Observations: each {value, sigma > 0}, of an observable this test has.
+  void read_observed(const std::vector<std::string>& observables) {
+    if (const YAML::Node observed = map.node("observed")) {
+      MapReader o(observed, file, map.key_path("observed"));
+      o.keys_are_names("OBSERVABLE");
+      for (const std::string& key : o.keys()) {
+        if (key == "outcome")
+          o.fail(key, outcome_names(test).empty()
+                          ? fmt::format("{} has no outcomes; its observables: {}", test, join(observables))
+                          : fmt::format("an outcome is not an observation: write `outcome: {}` beside `observed:` (at the experiment's level, "
+                                        "as `id` and `setup`), not under it; outcomes of {}: {}",
+                                        outcome_names(test).front(), test, join(outcome_names(test))));
+        if (std::find(observables.begin(), observables.end(), key) == observables.end())
+          o.fail(key, fmt::format("'{}' is not an observable of {}{}; valid: {}", key, test, did_you_mean(key, observables), join(observables)));
+        MapReader v(o.node(key), file, o.key_path(key));
+        Observation obs;
+        obs.location = v.location();
+        obs.value = v.required_number("value", -1e12, 1e12);
+        if (!v.has("sigma")) v.fail("sigma", "missing: the one-standard-deviation repeatability of the value, > 0");
+        obs.sigma = v.required_number("sigma", 0, 1e12);
+        if (!(obs.sigma > 0)) v.fail("sigma", fmt::format("is {:g}; valid: > 0 (one standard deviation of the measurement)", obs.sigma));
+        v.finish();
+        e.observed[key] = obs;
+      }
+      o.finish();
     }
   }
-  // Words that name wall materials must be ones the file declares.
-  std::vector<std::string> wall_names;
-  for (const auto& w : walls) wall_names.push_back(w.name);
-  for (const char* key : {"base", "wall", "plate"}) {
-    const auto it = e.setup.words.find(key);
-    if (it == e.setup.words.end() || wall_names.empty()) continue;
-    if (std::find(wall_names.begin(), wall_names.end(), it->second) == wall_names.end())
-      s.fail(key, fmt::format("'{}' is not a wall material of this file{}; valid: {} (declared under `walls:`)", it->second,
-                              did_you_mean(it->second, wall_names), join(wall_names)));
+
+  /// `outcome`, when given; returns whether it is `none`, which says that a value which looks like
+  /// an outcome (take_outcomes_written_as_numbers) is meant as a number.
+  bool read_outcome() {
+    bool as_number = false;
+    if (map.has("outcome")) {
+      std::vector<std::string> outcomes = outcome_names(test);
+      if (outcomes.empty()) map.fail("outcome", fmt::format("{} has no outcomes; remove the key", test));
+      outcomes.push_back("none");
+      e.outcome = map.string("outcome", "", outcomes);
+      as_number = e.outcome == "none";
+      if (as_number) e.outcome.clear();
+    }
+    return as_number;
   }
-  s.finish();
-  // Observations: each {value, sigma > 0}, of an observable this test has.
+
+  /// An outcome written as a number, as a lab writes it: no heap as an angle of 0, an arch as no
+  /// flow, a bed that slides without an avalanche as a drum angle of 0. It is compared as the
+  /// outcome it means, with a warning, unless the file says `outcome: none` (`as_number`).
+  void take_outcomes_written_as_numbers(bool as_number) {
+    for (auto it = e.observed.begin(); it != e.observed.end() && e.outcome.empty() && !as_number;) {
+      const auto& [key, obs] = *it;
+      const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
+      const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
+      const bool no_avalanche = test == "rotating_drum" && key == "dynamic_angle_deg" && std::abs(obs.value) < 1.0;
+      if (!(no_heap || no_flow || no_avalanche)) {
+        ++it;
+        continue;
+      }
+      e.outcome = no_heap ? "no_heap" : no_flow ? "blocked" : "slipping";
+      e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; compared as `outcome: {}`, not as a number with sigma {:g}. "
+                                       "Write `outcome: {}` beside `observed:` (at the experiment's level) and leave out the value to say "
+                                       "so, or `outcome: none` to compare the number",
+                                       obs.location.str(), key, obs.value,
+                                       no_heap ? "no heap formed" : no_flow ? "the orifice arched" : "the bed slid without avalanching",
+                                       e.outcome, obs.sigma, e.outcome));
+      it = e.observed.erase(it);
+    }
+  }
+
+  /// An experiment observes a value or an outcome.
+  void refuse_nothing_observed(const std::vector<std::string>& observables) const {
+    if (e.observed.empty() && e.outcome.empty())
+      map.fail("observed", fmt::format("missing: what was observed, e.g. {{{}: {{value: V, sigma: S}}}}{}", observables.front(),
+                                       outcome_names(test).empty() ? "" : fmt::format(", or outcome: {}", join(outcome_names(test)))));
+  }
+};
+
+Experiment read_experiment(const YAML::Node& node, const std::string& file, size_t index, const std::vector<MaterialSpec>& walls) {
+  MapReader map(node, file, fmt::format("experiments[{}]", index));
+  Experiment e;
+  const std::string test = read_id_and_test(map, e);
+  ExperimentReader reader{map, file, test, e};
+  reader.read_setup(walls);
   const std::vector<std::string> observables = observable_names(test);
-  if (const YAML::Node observed = map.node("observed")) {
-    MapReader o(observed, file, map.key_path("observed"));
-    o.keys_are_names("OBSERVABLE");
-    for (const std::string& key : o.keys()) {
-      if (key == "outcome")
-        o.fail(key, outcome_names(test).empty()
-                        ? fmt::format("{} has no outcomes; its observables: {}", test, join(observables))
-                        : fmt::format("an outcome is not an observation: write `outcome: {}` beside `observed:` (at the experiment's level, "
-                                      "as `id` and `setup`), not under it; outcomes of {}: {}",
-                                      outcome_names(test).front(), test, join(outcome_names(test))));
-      if (std::find(observables.begin(), observables.end(), key) == observables.end())
-        o.fail(key, fmt::format("'{}' is not an observable of {}{}; valid: {}", key, test, did_you_mean(key, observables), join(observables)));
-      MapReader v(o.node(key), file, o.key_path(key));
-      Observation obs;
-      obs.location = v.location();
-      obs.value = v.required_number("value", -1e12, 1e12);
-      if (!v.has("sigma")) v.fail("sigma", "missing: the one-standard-deviation repeatability of the value, > 0");
-      obs.sigma = v.required_number("sigma", 0, 1e12);
-      if (!(obs.sigma > 0)) v.fail("sigma", fmt::format("is {:g}; valid: > 0 (one standard deviation of the measurement)", obs.sigma));
-      v.finish();
-      e.observed[key] = obs;
-    }
-    o.finish();
-  }
-  // `outcome: none` says that a value which looks like an outcome (below) is meant as a number.
-  bool as_number = false;
-  if (map.has("outcome")) {
-    std::vector<std::string> outcomes = outcome_names(test);
-    if (outcomes.empty()) map.fail("outcome", fmt::format("{} has no outcomes; remove the key", test));
-    outcomes.push_back("none");
-    e.outcome = map.string("outcome", "", outcomes);
-    as_number = e.outcome == "none";
-    if (as_number) e.outcome.clear();
-  }
-  // An outcome written as a number, as a lab writes it: no heap as an angle of 0, an arch as no
-  // flow, a bed that slides without an avalanche as a drum angle of 0. It is compared as the
-  // outcome it means, with a warning, unless the file says `outcome: none`.
-  for (auto it = e.observed.begin(); it != e.observed.end() && e.outcome.empty() && !as_number;) {
-    const auto& [key, obs] = *it;
-    const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
-    const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
-    const bool no_avalanche = test == "rotating_drum" && key == "dynamic_angle_deg" && std::abs(obs.value) < 1.0;
-    if (!(no_heap || no_flow || no_avalanche)) {
-      ++it;
-      continue;
-    }
-    e.outcome = no_heap ? "no_heap" : no_flow ? "blocked" : "slipping";
-    e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; compared as `outcome: {}`, not as a number with sigma {:g}. "
-                                     "Write `outcome: {}` beside `observed:` (at the experiment's level) and leave out the value to say "
-                                     "so, or `outcome: none` to compare the number",
-                                     obs.location.str(), key, obs.value,
-                                     no_heap ? "no heap formed" : no_flow ? "the orifice arched" : "the bed slid without avalanching",
-                                     e.outcome, obs.sigma, e.outcome));
-    it = e.observed.erase(it);
-  }
-  if (e.observed.empty() && e.outcome.empty())
-    map.fail("observed", fmt::format("missing: what was observed, e.g. {{{}: {{value: V, sigma: S}}}}{}", observables.front(),
-                                     outcome_names(test).empty() ? "" : fmt::format(", or outcome: {}", join(outcome_names(test)))));
+  reader.read_observed(observables);
+  const bool as_number = reader.read_outcome();
+  reader.take_outcomes_written_as_numbers(as_number);
+  reader.refuse_nothing_observed(observables);
   map.finish();
   return e;
 }

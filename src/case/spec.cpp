@@ -133,33 +133,35 @@ void add_names(std::vector<std::pair<std::string, SourceLocation>>& named, const
   for (const auto& item : items) named.emplace_back(item.name, item.location);
 }
 
-CaseSpec read_case(const YAML::Node& root, const std::string& file) {
-  MapReader top(root, file, "");
-  CaseSpec spec;
-  spec.path = file;
-  spec.title = top.string("title", "");
-  spec.simulation = read_simulation(top.node("simulation"), file);
-  if (!top.has("simulation")) top.fail("simulation", "missing: give at least {duration: SECONDS}");
+/// What library materials bring beyond their own entries: the contact model the first of them was
+/// calibrated with, and their pair parameters against wall materials.
+struct LibraryContacts {
+  YAML::Node contact;  // valid only when file is set
+  std::string file;
+  std::vector<std::pair<std::string, std::pair<std::string, YAML::Node>>> walls;  // material, (wall, params)
+};
 
+/// `materials`: each entry read in place or from the material library.
+void read_materials(MapReader& top, const std::string& file, CaseSpec& spec, LibraryContacts& library) {
   const YAML::Node materials = top.node("materials");
   if (!materials || !materials.IsMap() || materials.size() == 0)
     top.fail("materials", "missing: a map of material names to {density, youngs_modulus, ...}");
-  YAML::Node library_contact;  // valid only when library_contact_file is set
-  std::string library_contact_file;
-  std::vector<std::pair<std::string, std::pair<std::string, YAML::Node>>> library_walls;  // material, (wall, params)
   for (const auto& kv : materials) {
     const std::string name = kv.first.as<std::string>();
     if (kv.second.IsMap() && kv.second["library"]) {
       MapReader entry(kv.second, file, "materials." + name);
       LibraryMaterial lib = read_library_material(name, entry, file);
-      if (lib.contact && library_contact_file.empty()) library_contact = lib.contact, library_contact_file = lib.file;
-      for (auto& wall : lib.walls) library_walls.push_back({name, {wall.first, wall.second}});
+      if (lib.contact && library.file.empty()) library.contact = lib.contact, library.file = lib.file;
+      for (auto& wall : lib.walls) library.walls.push_back({name, {wall.first, wall.second}});
       spec.materials.push_back(std::move(lib.material));
     } else {
       spec.materials.push_back(read_material(name, kv.second, file, "materials." + name));
     }
   }
+}
 
+/// `interactions`: the pair parameters the case gives.
+void read_interactions(MapReader& top, const std::string& file, CaseSpec& spec) {
   if (const YAML::Node list = top.node("interactions")) {
     if (!list.IsSequence()) top.fail("interactions", "must be a list of {materials: [A, B], KEY: VALUE}");
     for (size_t k = 0; k < list.size(); ++k) {
@@ -174,12 +176,12 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
       spec.interactions.push_back(std::move(in));
     }
   }
-  // The contact model: the case's, else the one the first library material was calibrated with.
-  if (top.has("contact") || library_contact_file.empty()) spec.contact = read_contact(top.node("contact"), file);
-  else spec.contact = read_contact(library_contact, library_contact_file);
-  // Pair parameters a library material gives against wall materials the case has, unless the
-  // case gives that pair itself.
-  for (const auto& material_wall : library_walls) {
+}
+
+/// Pair parameters a library material gives against wall materials the case has, unless the
+/// case gives that pair itself.
+void add_library_wall_pairs(const LibraryContacts& library, CaseSpec& spec) {
+  for (const auto& material_wall : library.walls) {
     // Named references, not structured bindings: clang 14 (the fuzz build) cannot capture those.
     const std::string& material = material_wall.first;
     const auto& wall = material_wall.second;
@@ -197,6 +199,11 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     read_effect_params(map, {}, in.params, in.where);
     spec.interactions.push_back(std::move(in));
   }
+}
+
+/// The parts of the scene, in this order: plane walls, mesh walls, clump templates, inlets,
+/// outlets, particle sets and sensors.
+void read_parts(MapReader& top, const std::string& file, CaseSpec& spec) {
   if (const YAML::Node walls = top.node("walls")) {
     if (!walls.IsSequence()) top.fail("walls", "must be a list of walls");
     for (size_t k = 0; k < walls.size(); ++k) spec.planes.push_back(read_wall(walls[k], file, k));
@@ -227,21 +234,46 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
     if (!sensors.IsSequence()) top.fail("sensors", "must be a list of sensors ({name, plane: {...}, region} or {name, box: {...}})");
     for (size_t k = 0; k < sensors.size(); ++k) spec.sensors.push_back(read_sensor(sensors[k], file, k));
   }
-  {
-    std::vector<std::pair<std::string, SourceLocation>> walls, inlets, outlets, sensors;
-    add_names(walls, spec.planes), add_names(walls, spec.meshes), add_names(inlets, spec.inlets), add_names(outlets, spec.outlets),
-        add_names(sensors, spec.sensors);
-    refuse_duplicate_names(walls, "wall");
-    refuse_duplicate_names(inlets, "inlet");
-    refuse_duplicate_names(outlets, "outlet");
-    refuse_duplicate_names(sensors, "sensor");
-  }
-  if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
+}
+
+/// Walls (planes and meshes), inlets, outlets and sensors each need names of their own.
+void refuse_duplicate_part_names(const CaseSpec& spec) {
+  std::vector<std::pair<std::string, SourceLocation>> walls, inlets, outlets, sensors;
+  add_names(walls, spec.planes), add_names(walls, spec.meshes), add_names(inlets, spec.inlets), add_names(outlets, spec.outlets),
+      add_names(sensors, spec.sensors);
+  refuse_duplicate_names(walls, "wall");
+  refuse_duplicate_names(inlets, "inlet");
+  refuse_duplicate_names(outlets, "outlet");
+  refuse_duplicate_names(sensors, "sensor");
+}
+
+/// `wear_coefficients`: per mesh name, or `default`.
+void read_wear_coefficients(MapReader& top, const std::string& file, CaseSpec& spec) {
   if (const YAML::Node wear = top.node("wear_coefficients")) {
     MapReader w(wear, file, "wear_coefficients");
     w.keys_are_names("MESH");  // a mesh name, or `default`
     for (const std::string& key : w.keys()) spec.wear_coefficients[key] = w.number(key, 0.0, 0.0, 1e-6, "m^3/J");
   }
+}
+
+CaseSpec read_case(const YAML::Node& root, const std::string& file) {
+  MapReader top(root, file, "");
+  CaseSpec spec;
+  spec.path = file;
+  spec.title = top.string("title", "");
+  spec.simulation = read_simulation(top.node("simulation"), file);
+  if (!top.has("simulation")) top.fail("simulation", "missing: give at least {duration: SECONDS}");
+  LibraryContacts library;
+  read_materials(top, file, spec, library);
+  read_interactions(top, file, spec);
+  // The contact model: the case's, else the one the first library material was calibrated with.
+  if (top.has("contact") || library.file.empty()) spec.contact = read_contact(top.node("contact"), file);
+  else spec.contact = read_contact(library.contact, library.file);
+  add_library_wall_pairs(library, spec);
+  read_parts(top, file, spec);
+  refuse_duplicate_part_names(spec);
+  if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
+  read_wear_coefficients(top, file, spec);
   top.node("sweep");  // read by the sweep runner (app/campaign/sweep.cpp) before the variants are parsed
   top.node("uncertainty");  // likewise (app/campaign/uncertainty.h)
   top.node("bias_check");   // likewise (app/campaign/bias_check.h)
