@@ -6,6 +6,9 @@
 #include <cmath>
 #include <numbers>
 #include <limits>
+#include <span>
+#include <utility>
+#include <vector>
 
 #include "render/render.h"
 
@@ -28,18 +31,19 @@ render::Camera camera_for(const Model& model, const ImageOptions& options, const
   return render::fit_camera(lo, hi, options.camera.empty() ? default_camera(model) : options.camera, aspect);
 }
 
-}  // namespace
-
-void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
-  render::Frame frame;
-  frame.width = options.width, frame.height = options.height;
-  // Particles and the field they are coloured by.
+/// The field the particles are coloured by: diameter [mm], material id or speed [m/s].
+std::vector<float> particle_values(const State& s, const ImageOptions& options) {
   std::vector<float> value(s.size());
   for (size_t p = 0; p < s.size(); ++p) {
     if (options.colour == "radius") value[p] = static_cast<float>(2000.0 * s.radius[p]);
     else if (options.colour == "material") value[p] = static_cast<float>(s.material[p]);
     else value[p] = static_cast<float>(std::sqrt(s.vx[p] * s.vx[p] + s.vy[p] * s.vy[p] + s.vz[p] * s.vz[p]));
   }
+  return value;
+}
+
+/// Particles and the field they are coloured by (`value`, which the layer borrows).
+void add_particles(const State& s, const std::vector<float>& value, const ImageOptions& options, render::Frame& frame) {
   render::ParticleLayer particles;
   particles.x = s.x, particles.y = s.y, particles.z = s.z, particles.radius = s.radius, particles.value = value;
   frame.particles.push_back(particles);
@@ -47,15 +51,22 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
   colours.label = options.colour == "radius" ? "diameter [mm]" : options.colour == "material" ? "material" : "speed [m/s]";
   if (options.colour == "speed") colours.min = 0.0;
   frame.particle_colours = colours;
+}
 
-  // Bounding box of what matters: particles and meshes.
+/// Bounding box [m] of what is drawn, which frames the camera and sizes the walls.
+struct Box {
+  Eigen::Vector3d lo, hi;
+};
+
+/// Bounding box of what matters: particles and meshes, the meshes placed at their pose now
+/// into `placed` (one vertex list per mesh); a 10 cm box at the origin when there is nothing.
+Box bounding_box(const Model& model, const State& s, std::vector<std::vector<std::array<double, 3>>>& placed) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (size_t p = 0; p < s.size(); ++p) {
     const Eigen::Vector3d c(s.x[p], s.y[p], s.z[p]);
     lo = lo.cwiseMin(c - Eigen::Vector3d::Constant(s.radius[p])), hi = hi.cwiseMax(c + Eigen::Vector3d::Constant(s.radius[p]));
   }
   // Meshes at their pose now.
-  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     const Pose pose = model.meshes[m].motion.pose(s.time);
     for (const auto& v : model.meshes[m].surface->vertices) {
@@ -65,6 +76,11 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
     }
   }
   if (!std::isfinite(lo.x())) lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Constant(0.1);
+  return {lo, hi};
+}
+
+/// The meshes (`placed`, which the layers borrow) as translucent, cut-away layers.
+void add_meshes(const Model& model, const std::vector<std::vector<std::array<double, 3>>>& placed, render::Frame& frame) {
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     render::MeshLayer layer;
     layer.vertices = placed[m];
@@ -73,68 +89,118 @@ void render_state(const Model& model, const State& s, const ImageOptions& option
     layer.opacity = 0.45f;
     frame.meshes.push_back(layer);
   }
+}
+
+/// Exact walls as triangles, which the frame's layers borrow.
+struct WallShapes {
   // Planes as squares around the particles' extent (an infinite plane cannot be drawn).
   std::vector<std::vector<std::array<double, 3>>> plane_vertices;
   std::vector<std::array<std::int32_t, 3>> quad = {{0, 1, 2}, {0, 2, 3}};
   // Round walls as triangles: the rings of vertices and the triangles between them.
   std::vector<std::vector<std::array<double, 3>>> round_vertices;
   std::vector<std::array<std::int32_t, 3>> round_triangles;
-  const Eigen::Vector3d centre = 0.5 * (lo + hi);
-  const double half = 0.6 * (hi - lo).maxCoeff() + 1e-3;
+};
+
+/// Steps around a round wall (two vertices each, one per end of the ring).
+constexpr int steps_around = 96;
+
+/// A round wall's ring of vertices, two per step around (the ring's two ends), at `at` now.
+std::vector<std::array<double, 3>> round_wall_ring(const PlaneWall& wall, const Eigen::Vector3d& n, const Eigen::Vector3d& at,
+                                                   const Box& box) {
+  // A cylinder over the particles' extent along its axis (an infinite one cannot be drawn);
+  // a tube over its length; a disc as its ring.
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  double from = 0, to = wall.length;
+  if (wall.shape == PlaneWall::Shape::cylinder) {
+    const double a0 = (box.lo - at).dot(n), a1 = (box.hi - at).dot(n);
+    from = std::min(a0, a1) - 0.1 * wall.radius, to = std::max(a0, a1) + 0.1 * wall.radius;
+  }
+  std::vector<std::array<double, 3>> ring;
+  for (int k = 0; k < steps_around; ++k) {
+    const double angle = 2 * std::numbers::pi * k / steps_around;
+    const Eigen::Vector3d radial = std::cos(angle) * u + std::sin(angle) * v;
+    const bool disc = wall.shape == PlaneWall::Shape::disc;
+    for (int end = 0; end < 2; ++end) {
+      const Eigen::Vector3d c = disc ? Eigen::Vector3d(at + (end ? wall.radius : wall.hole) * radial)
+                                     : Eigen::Vector3d(at + (end ? to : from) * n + wall.radius * radial);
+      ring.push_back({c.x(), c.y(), c.z()});
+    }
+  }
+  return ring;
+}
+
+/// The triangles between the two ends of a ring (the same for every round wall).
+void add_ring_triangles(std::vector<std::array<std::int32_t, 3>>& round_triangles) {
+  for (std::int32_t k = 0; k < steps_around; ++k) {
+    const std::int32_t a = 2 * k, b = 2 * ((k + 1) % steps_around);
+    round_triangles.push_back({a, b, a + 1}), round_triangles.push_back({b, b + 1, a + 1});
+  }
+}
+
+/// A plane as a square of half side `half` around the foot of `centre` on it.
+std::vector<std::array<double, 3>> plane_square(const Eigen::Vector3d& n, const Eigen::Vector3d& at, const Eigen::Vector3d& centre,
+                                                double half) {
+  const Eigen::Vector3d foot = centre - (centre - at).dot(n) * n;
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  std::vector<std::array<double, 3>> corners;
+  for (auto [a, b] : {std::pair{-1, -1}, std::pair{1, -1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+    const Eigen::Vector3d c = foot + half * (a * u + b * v);
+    corners.push_back({c.x(), c.y(), c.z()});
+  }
+  return corners;
+}
+
+/// The exact walls at their place now: round walls as rings, planes as squares sized by `box`.
+WallShapes wall_shapes(const Model& model, const State& s, const Box& box) {
+  WallShapes shapes;
+  const Eigen::Vector3d centre = 0.5 * (box.lo + box.hi);
+  const double half = 0.6 * (box.hi - box.lo).maxCoeff() + 1e-3;
   for (size_t w = 0; w < model.planes.size(); ++w) {
     const PlaneWall& wall = model.planes[w];
     const Eigen::Vector3d n(wall.normal[0], wall.normal[1], wall.normal[2]);
     const Eigen::Vector3d at(s.walls.px[w], s.walls.py[w], s.walls.pz[w]);
     if (wall.shape != PlaneWall::Shape::plane) {
-      // A cylinder over the particles' extent along its axis (an infinite one cannot be drawn);
-      // a tube over its length; a disc as its ring.
-      const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
-      const int around = 96;
-      double from = 0, to = wall.length;
-      if (wall.shape == PlaneWall::Shape::cylinder) {
-        const double a0 = (lo - at).dot(n), a1 = (hi - at).dot(n);
-        from = std::min(a0, a1) - 0.1 * wall.radius, to = std::max(a0, a1) + 0.1 * wall.radius;
-      }
-      std::vector<std::array<double, 3>> ring;
-      for (int k = 0; k < around; ++k) {
-        const double angle = 2 * std::numbers::pi * k / around;
-        const Eigen::Vector3d radial = std::cos(angle) * u + std::sin(angle) * v;
-        const bool disc = wall.shape == PlaneWall::Shape::disc;
-        for (int end = 0; end < 2; ++end) {
-          const Eigen::Vector3d c = disc ? Eigen::Vector3d(at + (end ? wall.radius : wall.hole) * radial)
-                                         : Eigen::Vector3d(at + (end ? to : from) * n + wall.radius * radial);
-          ring.push_back({c.x(), c.y(), c.z()});
-        }
-      }
-      if (round_triangles.empty())
-        for (std::int32_t k = 0; k < around; ++k) {
-          const std::int32_t a = 2 * k, b = 2 * ((k + 1) % around);
-          round_triangles.push_back({a, b, a + 1}), round_triangles.push_back({b, b + 1, a + 1});
-        }
-      round_vertices.push_back(std::move(ring));
+      std::vector<std::array<double, 3>> ring = round_wall_ring(wall, n, at, box);
+      if (shapes.round_triangles.empty()) add_ring_triangles(shapes.round_triangles);
+      shapes.round_vertices.push_back(std::move(ring));
       continue;
     }
-    const Eigen::Vector3d foot = centre - (centre - at).dot(n) * n;
-    const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
-    std::vector<std::array<double, 3>> corners;
-    for (auto [a, b] : {std::pair{-1, -1}, std::pair{1, -1}, std::pair{1, 1}, std::pair{-1, 1}}) {
-      const Eigen::Vector3d c = foot + half * (a * u + b * v);
-      corners.push_back({c.x(), c.y(), c.z()});
-    }
-    plane_vertices.push_back(corners);
+    shapes.plane_vertices.push_back(plane_square(n, at, centre, half));
   }
-  // Exact walls drawn as translucent, cut-away layers.
-  const auto add_wall = [&](const auto& vertices, const auto& triangles) {
-    render::MeshLayer layer;
-    layer.vertices = vertices;
-    layer.triangles = triangles;
-    layer.cutaway = true;
-    layer.opacity = 0.35f;
-    frame.meshes.push_back(std::move(layer));
-  };
-  for (const auto& ring : round_vertices) add_wall(ring, round_triangles);
-  for (const auto& corners : plane_vertices) add_wall(corners, quad);
-  frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
+  return shapes;
+}
+
+/// One wall as a translucent, cut-away layer that borrows `vertices` and `triangles`.
+void add_wall(std::span<const std::array<double, 3>> vertices, std::span<const std::array<std::int32_t, 3>> triangles,
+              render::Frame& frame) {
+  render::MeshLayer layer;
+  layer.vertices = vertices;
+  layer.triangles = triangles;
+  layer.cutaway = true;
+  layer.opacity = 0.35f;
+  frame.meshes.push_back(std::move(layer));
+}
+
+/// Exact walls drawn as translucent, cut-away layers (borrowing `walls`): round ones, then planes.
+void add_walls(const WallShapes& walls, render::Frame& frame) {
+  for (const auto& ring : walls.round_vertices) add_wall(ring, walls.round_triangles, frame);
+  for (const auto& corners : walls.plane_vertices) add_wall(corners, walls.quad, frame);
+}
+
+}  // namespace
+
+void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  // The frame's layers borrow `value`, `placed` and `walls`: they live until the image is written.
+  const std::vector<float> value = particle_values(s, options);
+  add_particles(s, value, options, frame);
+  std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
+  const Box box = bounding_box(model, s, placed);
+  add_meshes(model, placed, frame);
+  const WallShapes walls = wall_shapes(model, s, box);
+  add_walls(walls, frame);
+  frame.camera = camera_for(model, options, box.lo, box.hi, double(frame.width) / frame.height);
   frame.caption = fmt::format("{}   t = {:.3f} s   {} particles", model.title.empty() ? model.source : model.title, s.time, s.size());
   render::render_png(frame, path);
 }
