@@ -178,10 +178,6 @@ class DiagnosisRun {
     d_.words.push_back(std::move(words));
     if (options_.progress) options_.progress("diagnose: " + d_.words.back());
   }
-  template <class SignatureOf, class OwnChi2>
-  std::string weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
-                              const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor, detail::Progress& progress,
-                              double& measured_chi2, double& cost);
   void fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of);
   void confirm(CandidateResult& cr, const CalibrationOptions& options);
   void separate(const CandidateResult& best, const CandidateResult& rival);
@@ -407,46 +403,6 @@ void DiagnosisRun::replan_for_the_screen() {
 
 // ---- the screen ----------------------------------------------------------------------------
 
-/// An unstable candidate whose two strengths both overshoot (its own runs explain less than the
-/// linear share says a fraction `multiple` of its start would) is simulated once more, at that
-/// fraction: the likelihood of the data at a strength the data may hold, not only at two that are
-/// too strong. Returns the words for its rank (" and at STRENGTH"), or "" when nothing was run.
-/// Rejected: the two strengths alone, with which rolling resistance explained 0 % of
-/// lab_rolling.yaml's misfit on a fit pinned at friction 0.9 (its start step was about twice what
-/// the data hold), and the linear share (a threshold makes it meaningless).
-template <class SignatureOf, class OwnChi2>
-std::string DiagnosisRun::weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
-                                          const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor,
-                                          detail::Progress& progress, double& measured_chi2, double& cost) {
-  if (c.parameters.size() != 1 || !(multiple > 0.05 && multiple < 0.9) || measured_chi2 <= rr * (1 - linear)) return "";
-  const auto& [key, range] = *c.parameters.begin();
-  if (!c.start.count(key)) return "";
-  const double from = c.unchanged.count(key) ? c.unchanged.at(key) : range.first;
-  const double value = from + multiple * (c.start.at(key) - from);
-  MaterialModel with = d_.base.fitted;
-  c.add(with);
-  for (const auto& [k, v] : c.start) set_parameter(with, k, v);
-  set_parameter(with, key, value);
-  std::vector<ExperimentRun> runs;
-  try {
-    if (options_.walls_first) {
-      std::vector<FitParameter> all_fitted = parameters_;
-      all_fitted.push_back({key, range.first, range.second});
-      CalibrationOptions quiet = options_;
-      quiet.progress = nullptr;
-      with = detail::fit_walls_first(with, measured_, all_fitted, quiet).model;
-    }
-    for (const Experiment& e : measured_.experiments) progress.plan(e, replicas);
-    if (command_.outermost()) count_.plan_more(experiments_ * replicas);
-    runs = detail::simulate_experiments(with, measured_.experiments, options_, replicas, &progress, fmt::format("{} at {:.3g} ", c.name, value));
-  } catch (const CaseError&) {
-    return "";
-  }
-  for (const ExperimentRun& run : runs) cost += run.wall_seconds;
-  measured_chi2 = std::min(measured_chi2, own_chi2(signature_of(compare_runs(measured_, runs, options_, floor))));
-  return fmt::format(" (at its start, the stronger step and {:.3g}, where the linear screen points)", value);
-}
-
 /// Each candidate's signature at two strengths: its start values with replicas (the base
 /// comparison's first packings: common random numbers; this run is also the "before" of its
 /// confirmation), and a step twice as far with one packing. A signature is the change of every
@@ -510,47 +466,6 @@ void DiagnosisRun::screen_signatures() {
     options_.progress("diagnose: the calibrated residual lies along what the fitted parameters do (a bound or the surrogate held them): "
                       "signatures are screened whole");
   const auto orthogonal = [&](const Eigen::VectorXd& s) { return removable ? Eigen::VectorXd(s - A * fitted_directions.solve(s)) : s; };
-  // A fit held at a bound can still move inward: the least chi^2 of v + A d with the fitted
-  // parameters d kept inside their ranges (an active set over the few of them: each free, at its
-  // lower or at its upper edge), in A's units of half a range. Rejected: no recalibration at all,
-  // with which an effect added at its start values to a fit pinned at the top of its friction
-  // overshoots every heap and drum and explains nothing (lab_rolling.yaml's rolling resistance at
-  // friction 0.9, 0 % where its linear share was 54 %).
-  const auto recalibrated = [&](const Eigen::VectorXd& v) {
-    const Eigen::Index p = A.cols();
-    std::vector<std::pair<double, double>> room(static_cast<size_t>(p));
-    for (Eigen::Index j = 0; j < p; ++j) {
-      const FitParameter& f = parameters_[static_cast<size_t>(j)];
-      const double half = 0.5 * (f.max - f.min), x = d_.base.value[static_cast<size_t>(j)];
-      room[static_cast<size_t>(j)] = half > 0 ? std::make_pair((f.min - x) / half, (f.max - x) / half) : std::make_pair(0.0, 0.0);
-    }
-    double best = v.squaredNorm();
-    int combinations = 1;
-    for (Eigen::Index j = 0; j < p; ++j) combinations *= 3;
-    for (int code = 0; code < combinations; ++code) {
-      Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
-      std::vector<Eigen::Index> free;
-      for (Eigen::Index j = 0, c = code; j < p; ++j, c /= 3) {
-        const auto& [low, high] = room[static_cast<size_t>(j)];
-        if (c % 3 == 0) free.push_back(j);
-        else d[j] = c % 3 == 1 ? low : high;
-      }
-      if (!free.empty()) {
-        Eigen::MatrixXd M(A.rows(), static_cast<Eigen::Index>(free.size()));
-        for (size_t k = 0; k < free.size(); ++k) M.col(static_cast<Eigen::Index>(k)) = A.col(free[k]);
-        const Eigen::VectorXd step = M.completeOrthogonalDecomposition().solve(-(v + A * d));
-        bool inside = true;
-        for (size_t k = 0; k < free.size(); ++k) {
-          const auto& [low, high] = room[static_cast<size_t>(free[k])];
-          inside = inside && step[static_cast<Eigen::Index>(k)] >= low - 1e-12 && step[static_cast<Eigen::Index>(k)] <= high + 1e-12;
-          d[free[k]] = step[static_cast<Eigen::Index>(k)];
-        }
-        if (!inside) continue;
-      }
-      best = std::min(best, (v + A * d).squaredNorm());
-    }
-    return best;
-  };
   // Multiple of the added strength that best cancels r (0 when the step does not reduce it).
   const auto cancelling = [&](const Eigen::VectorXd& s_perp, const Eigen::VectorXd& s) {
     const double ss = s_perp.squaredNorm();
@@ -601,7 +516,7 @@ void DiagnosisRun::screen_signatures() {
     };
     // The chi^2 of a candidate's own runs after the linear recalibration of the fitted parameters.
     const auto own_chi2 = [&](const Eigen::VectorXd& s) {
-      return removable ? rr - std::max(0.0, reachable - orthogonal(r + s).squaredNorm()) : recalibrated(r + s);
+      return rr - std::max(0.0, reachable - orthogonal(r + s).squaredNorm());
     };
     Eigen::VectorXd at_start;
     for (int strength = 0; strength < 2; ++strength) {
@@ -629,15 +544,13 @@ void DiagnosisRun::screen_signatures() {
     cr.agreement = signature && norms > 0 ? perp[0].dot(perp[1]) / norms : 1.0;
     cr.stable = cr.agreement >= 0.5 && flips.empty();
     const double linear = std::max(cr.explained_start, cr.explained_stronger);
-    const std::string weaker = cr.stable ? std::string() : weaker_strength(c, cancelling(perp[0], at_start), linear, rr, signature_of, own_chi2, replicas,
-                                                                          floor, progress, measured_chi2, cr.cost);
     cr.screen_chi2 = cr.stable ? rr * (1 - linear) : measured_chi2;
     cr.explained = rr > 0 ? std::max(0.0, 1 - cr.screen_chi2 / rr) : 0.0;
     cr.expected_gain = rr - cr.screen_chi2 - static_cast<double>(cr.adds.size()) * ln_n;
     cr.ranked_why = cr.stable ? fmt::format("ranked by its linear share, {:.0f} % (its strengths agree, {:.2f})", 100 * linear, cr.agreement)
-                              : fmt::format("ranked by its own runs' chi^2 after a linear recalibration{}, {:.1f} of {:.1f} ({}; its linear share "
+                              : fmt::format("ranked by its own runs' chi^2 after a linear recalibration, {:.1f} of {:.1f} ({}; its linear share "
                                             "would say {:.0f} %)",
-                                            weaker, cr.screen_chi2, rr,
+                                            cr.screen_chi2, rr,
                                             flips.empty() ? fmt::format("its strengths disagree, agreement {:.2f}", cr.agreement)
                                                           : fmt::format("an outcome flips: {}", join(flips, ", ")),
                                             100 * linear);
@@ -861,7 +774,7 @@ void DiagnosisRun::write_verdict() {
     if (p.kind != "fits") misfits.push_back(p.words);
   const std::string gain = fmt::format("chi^2/n falls from {:.2f} to {:.2f} and BIC from {:.1f} to {:.1f} (by {:.1f} > margin {:.0f}", base.chi2_per_n(),
                                        best->fit.after.chi2_per_n(), d_.base_bic, best->bic, best->delta_bic, options_.bic_margin);
-  if (best->kind == "parameter") {
+  if (best->kind == "parameter" && fits) {
     d_.grade = Verdict::parameter, d_.recommended = best->name;
     say(fmt::format("Not missing physics: {} ({}), which the fit left out, explains the misfit ({}). Calibrated with the others it comes to "
                     "{:.3g}, {}). {}; or measure it and state it in the measurement file.",
