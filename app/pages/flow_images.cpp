@@ -58,6 +58,16 @@ struct Box {
   Eigen::Vector3d lo, hi;
 };
 
+/// Mesh m's vertices at its pose at `time`, appended to `placed`, widening the box [lo, hi].
+void place_mesh(const Model& model, size_t m, double time, std::vector<std::array<double, 3>>& placed, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  const Pose pose = model.meshes[m].motion.pose(time);
+  for (const auto& v : model.meshes[m].surface->vertices) {
+    const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+    placed.push_back({w.x(), w.y(), w.z()});
+    lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+  }
+}
+
 /// Bounding box of what matters: particles and meshes, the meshes placed at their pose now
 /// into `placed` (one vertex list per mesh); a 10 cm box at the origin when there is nothing.
 Box bounding_box(const Model& model, const State& s, std::vector<std::vector<std::array<double, 3>>>& placed) {
@@ -67,14 +77,7 @@ Box bounding_box(const Model& model, const State& s, std::vector<std::vector<std
     lo = lo.cwiseMin(c - Eigen::Vector3d::Constant(s.radius[p])), hi = hi.cwiseMax(c + Eigen::Vector3d::Constant(s.radius[p]));
   }
   // Meshes at their pose now.
-  for (size_t m = 0; m < model.meshes.size(); ++m) {
-    const Pose pose = model.meshes[m].motion.pose(s.time);
-    for (const auto& v : model.meshes[m].surface->vertices) {
-      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
-      placed[m].push_back({w.x(), w.y(), w.z()});
-      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
-    }
-  }
+  for (size_t m = 0; m < model.meshes.size(); ++m) place_mesh(model, m, s.time, placed[m], lo, hi);
   if (!std::isfinite(lo.x())) lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Constant(0.1);
   return {lo, hi};
 }
@@ -223,12 +226,7 @@ void render_wall_field(const Model& model, const State& s, const std::vector<std
   std::vector<std::vector<float>> values(model.meshes.size());
   std::vector<double> all;
   for (size_t m = 0; m < model.meshes.size(); ++m) {
-    const Pose pose = model.meshes[m].motion.pose(s.time);
-    for (const auto& v : model.meshes[m].surface->vertices) {
-      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
-      placed[m].push_back({w.x(), w.y(), w.z()});
-      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
-    }
+    place_mesh(model, m, s.time, placed[m], lo, hi);
     for (double v : field[m]) {
       values[m].push_back(static_cast<float>(v));
       if (std::isfinite(v)) all.push_back(v);
