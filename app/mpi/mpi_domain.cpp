@@ -522,6 +522,9 @@ class MpiDomain final : public Domain {
     s.ghosts = 0;
     s.pairs.clear(), s.wall_pairs.clear();
     s.x_built.clear(), s.y_built.clear(), s.z_built.clear();
+    // Each rank integrates the loads of its own particles from here: the next row averages them
+    // over the same time on every rank (MeshLoads::interval).
+    s.mesh_loads.restart_interval();
     // Run totals live on the root alone; the others count from zero and add theirs when gathered.
     if (rank_ != 0) {
       s.lost = 0, s.lost_mass = 0;

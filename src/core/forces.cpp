@@ -560,6 +560,7 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
     if (meshes) sum_records_in_turn(model, s, work, n);
     moved |= thread_moved;
   }
+  if (finish_in_pass && !model.meshes.empty()) s.mesh_loads.integrate(model.dt);  // else mesh_contact_forces does
   work.drifted_ahead = ahead ? (moved | untested(limits)) : -1;
   work.drifts_ahead += ahead;
   work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;

@@ -466,6 +466,7 @@ void mesh_contact_forces(const Model& model, State& state, Workspace& work) {
     for_own_blocks(work, n, [&](long begin, long end) { pass.run(begin, end); });
   }
   sum_mesh_records(model, state, work, 0, n);
+  state.mesh_loads.integrate(model.dt);
 }
 
 }  // namespace dem

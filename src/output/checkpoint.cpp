@@ -17,8 +17,12 @@ namespace dem {
 
 namespace {
 
-/// Version 7: magic, model hash, run id, the State as version 6 (visit).
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '7'};
+/// Version 8: magic, model hash, run id, the State with the mesh loads integrated since the last
+/// row of scalars (MeshLoads::interval; visit).
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '8'};
+/// Version 7 lacks MeshLoads::interval: read as empty, so the first row after resuming averages
+/// the mesh loads from the resume on.
+constexpr char kMagic7[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '7'};
 /// Version 6 has no run id (read as 0).
 constexpr char kMagic6[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
 /// A rank's share: magic, model hash, step, rank, ranks, count, then `count` doubles.
@@ -27,9 +31,9 @@ constexpr char kShareMagic[8] = {'D', 'E', 'M', 'S', 'H', 'A', 'R', '1'};
 /// (verlet.h), so its runs resume.
 constexpr char kMagic5[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
 
-/// Every field of the State, in one order, for both directions (`version` 5 or 6).
+/// Every field of the State, in one order, for both directions (`version` 5 to 8; 7 stores the State as 6).
 template <typename Io, typename S>
-void visit(Io& io, S& s, int version = 6) {
+void visit(Io& io, S& s, int version = 8) {
   io(s.time), io(s.step), io(s.next_id), io(s.lost), io(s.lost_mass);
   for (auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
                   &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
@@ -57,6 +61,7 @@ void visit(Io& io, S& s, int version = 6) {
   for (auto* c : {&s.mesh_loads.fx, &s.mesh_loads.fy, &s.mesh_loads.fz, &s.mesh_loads.tx, &s.mesh_loads.ty, &s.mesh_loads.tz,
                   &s.mesh_loads.power})
     io(*c);
+  if (version >= 8) io(s.mesh_loads.interval), io(s.mesh_loads.interval_time);
 }
 
 struct Writer {
@@ -122,7 +127,8 @@ State load_checkpoint(const std::string& path, const Model& model, std::uint64_t
   Reader reader{in, path, static_cast<std::uint64_t>(std::filesystem::file_size(path))};
   char magic[sizeof kMagic];
   reader.read(magic, sizeof magic);
-  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0     ? 7
+  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0     ? 8
+                      : std::memcmp(magic, kMagic7, sizeof kMagic7) == 0 ? 7
                       : std::memcmp(magic, kMagic6, sizeof kMagic6) == 0 ? 6
                       : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5
                                                                          : 0;
@@ -137,7 +143,7 @@ State load_checkpoint(const std::string& path, const Model& model, std::uint64_t
   if (version >= 7) reader(written_by);
   if (run_id) *run_id = written_by;
   State state;
-  visit(reader, state, std::min(version, 6));
+  visit(reader, state, version);
   return state;
 }
 

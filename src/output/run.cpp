@@ -519,6 +519,7 @@ Scalars measure_row(const RunSetup& s, RowTotals& totals) {
 /// A row of scalars measured and, by the process that writes the results, kept.
 void add_row(const RunSetup& s, RunSummary& summary, RowTotals& totals) {
   Scalars row = measure_row(s, totals);
+  s.state.mesh_loads.restart_interval();
   totals.particles = static_cast<double>(row.particles);
   if (s.writer) summary.scalars.push_back(std::move(row));
 }

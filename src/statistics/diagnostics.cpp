@@ -142,7 +142,7 @@ ScalarParts measure_parts(const Model& model, const State& s, const Workspace& w
   const MeshLoads& loads = s.mesh_loads;
   for (size_t m = 0; m < at.meshes && m < loads.fx.size(); ++m) {
     double* l = sums + at.mesh(m);
-    l[0] = loads.fx[m], l[1] = loads.fy[m], l[2] = loads.fz[m], l[3] = loads.tx[m], l[4] = loads.ty[m], l[5] = loads.tz[m], l[6] = loads.power[m];
+    for (size_t c = 0; c < 7; ++c) l[c] = loads.mean(m, c);  // over the row's interval
   }
   sum_sensors(model, s, sums + at.sensor(0));
   return out;
