@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <mutex>
+#include <numbers>
 #include <random>
 #include <set>
 #include <tuple>
@@ -17,6 +18,7 @@
 #include "calibration/calibration_support.h"
 #include "model/material_model.h"
 #include "lab/measurements.h"
+#include "lab/yield_locus.h"
 
 namespace dem::materials {
 namespace {
@@ -612,6 +614,144 @@ TEST(Calibration, TheDropsSettleTheWallRestitutionFirst) {
   CalibrationOptions beside = analytic_options(sim);
   beside.design_points = 2;
   EXPECT_NO_THROW(calibrate(start, set, {{"friction", 0.1, 0.9}}, beside, nullptr, earlier));
+}
+
+// ---- yield loci ---------------------------------------------------------------------------
+
+/// Points exactly on tau = c + sigma tan(phi) at 5, 10 and 20 kPa, each with standard error `error` [Pa].
+std::vector<LocusPoint> exact_locus(double phi_deg, double cohesion, double error) {
+  std::vector<LocusPoint> points;
+  for (double sigma : {5000.0, 10000.0, 20000.0})
+    points.push_back({sigma, cohesion + sigma * std::tan(phi_deg * std::numbers::pi / 180), error, ""});
+  return points;
+}
+
+TEST(YieldLocus, AnExactLocusGivesItsAngleAndCohesionWithTheClosedFormErrors) {
+  const std::vector<LocusPoint> points = exact_locus(30, 2000, 100);
+  const YieldLocusFit fit = fit_yield_locus(points);
+  ASSERT_TRUE(fit.fitted) << fit.reason;
+  EXPECT_NEAR(fit.friction_angle, 30, 30 * 1e-9);
+  EXPECT_NEAR(fit.cohesion, 2000, 2000 * 1e-9);
+  // Weighted linear regression in closed form: var(slope) = S/D, var(intercept) = Sxx/D,
+  // cov = -Sx/D, D = S Sxx - Sx^2, with S = sum w, Sx = sum w x, Sxx = sum w x^2, w = 1/err^2.
+  double S = 0, Sx = 0, Sxx = 0;
+  for (const LocusPoint& p : points) {
+    const double w = 1 / (p.error * p.error);
+    S += w, Sx += w * p.normal_stress, Sxx += w * p.normal_stress * p.normal_stress;
+  }
+  const double D = S * Sxx - Sx * Sx, tan_phi = std::tan(std::numbers::pi / 6);
+  const double phi_sigma = std::sqrt(S / D) / (1 + tan_phi * tan_phi) * 180 / std::numbers::pi;
+  EXPECT_NEAR(fit.friction_angle_sigma, phi_sigma, phi_sigma * 1e-9);
+  EXPECT_NEAR(fit.cohesion_sigma, std::sqrt(Sxx / D), std::sqrt(Sxx / D) * 1e-9);
+  EXPECT_NEAR(fit.correlation, -Sx / std::sqrt(S * Sxx), 1e-9);
+  EXPECT_EQ(fit.points, 3);
+  EXPECT_EQ(fit.dof, 1);
+  EXPECT_NEAR(fit.chi2_per_dof, 0, 1e-12);
+  EXPECT_FALSE(fit.cohesion_zero);  // 2000 Pa against a standard error of 122 Pa
+}
+
+TEST(YieldLocus, OneNormalStressGivesNoFitAndSaysWhy) {
+  const YieldLocusFit one = fit_yield_locus({{10000, 7000, 100, "a"}, {10000, 7100, 100, "b"}});
+  EXPECT_FALSE(one.fitted);
+  EXPECT_NE(one.reason.find("one normal stress"), std::string::npos) << one.reason;
+  const YieldLocusFit none = fit_yield_locus({});
+  EXPECT_FALSE(none.fitted);
+  EXPECT_FALSE(none.reason.empty());
+  // A point without a standard error cannot be weighted.
+  const YieldLocusFit unweighted = fit_yield_locus({{5000, 4000, 100, ""}, {10000, 7000, 0, "b"}});
+  EXPECT_FALSE(unweighted.fitted);
+  EXPECT_NE(unweighted.reason.find("standard error"), std::string::npos) << unweighted.reason;
+  // Two distinct normal stresses fit, with no degrees of freedom left.
+  const YieldLocusFit two = fit_yield_locus({{5000, 4000, 100, ""}, {10000, 7000, 100, ""}});
+  ASSERT_TRUE(two.fitted) << two.reason;
+  EXPECT_EQ(two.dof, 0);
+  EXPECT_TRUE(std::isnan(two.chi2_per_dof));
+}
+
+TEST(YieldLocus, WordsNameAFlatterOrLowerLocusOrTheNoise) {
+  const auto contains = [](const std::string& text, const std::string& word) { return text.find(word) != std::string::npos; };
+  // 5 deg flatter, far beyond the errors (about 0.4 deg each), the same intercept.
+  const std::string flatter = compare_yield_loci(fit_yield_locus(exact_locus(30, 2000, 100)), fit_yield_locus(exact_locus(25, 2000, 100)));
+  EXPECT_TRUE(contains(flatter, "flatter")) << flatter;
+  EXPECT_TRUE(contains(flatter, "friction")) << flatter;
+  EXPECT_FALSE(contains(flatter, "lower")) << flatter;
+  EXPECT_FALSE(contains(flatter, "within the noise")) << flatter;
+  // The same slope, 3 kPa less intercept (standard errors of c about 0.6 kPa each).
+  const std::string lower = compare_yield_loci(fit_yield_locus(exact_locus(30, 3000, 500)), fit_yield_locus(exact_locus(30, 0, 500)));
+  EXPECT_TRUE(contains(lower, "lower")) << lower;
+  EXPECT_TRUE(contains(lower, "lacks the intercept")) << lower;
+  EXPECT_TRUE(contains(lower, "cohesion")) << lower;
+  EXPECT_FALSE(contains(lower, "flatter")) << lower;
+  EXPECT_FALSE(contains(lower, "steeper")) << lower;
+  // Identical loci.
+  const YieldLocusFit same = fit_yield_locus(exact_locus(30, 2000, 100));
+  const std::string noise = compare_yield_loci(same, same);
+  EXPECT_TRUE(contains(noise, "within the noise")) << noise;
+  // No measured fit: no comparison, and why.
+  const std::string none = compare_yield_loci(fit_yield_locus({}), same);
+  EXPECT_TRUE(contains(none, "No comparison")) << none;
+}
+
+TEST(YieldLocus, AComparisonsShearTermsFormMeasuredAndSimulatedLoci) {
+  // Three direct shear experiments after pre-shear at 20 kPa, and a bulk density that is no locus.
+  MeasurementSet set;
+  Comparison comparison;
+  const double tan30 = std::tan(std::numbers::pi / 6), tan25 = std::tan(25 * std::numbers::pi / 180);
+  for (double sigma : {10000.0, 5000.0, 20000.0}) {
+    Experiment e;
+    e.id = e.setup.id = fmt::format("shear_{:g}", sigma / 1000);
+    e.setup.test = "direct_shear";
+    e.setup.numbers = {{"preshear_stress", 20000}, {"normal_stress", sigma}};
+    Term peak;
+    peak.experiment = e.id, peak.test = "direct_shear", peak.observable = "peak_shear_stress";
+    peak.measured = 2000 + sigma * tan30, peak.sigma_measured = 100;
+    peak.simulated = 500 + sigma * tan25, peak.sigma_simulated = 100;
+    Term steady = peak;
+    steady.observable = "steady_shear_stress";
+    steady.measured = 2000 + 20000 * tan30, steady.simulated = 500 + 20000 * tan25;
+    comparison.terms.push_back(peak);
+    comparison.terms.push_back(steady);
+    e.observed["peak_shear_stress"].value = peak.measured, e.observed["peak_shear_stress"].sigma = 100;
+    e.observed["steady_shear_stress"].value = steady.measured, e.observed["steady_shear_stress"].sigma = 100;
+    set.experiments.push_back(e);
+  }
+  Experiment density;
+  density.id = density.setup.id = "density";
+  density.setup.test = "bulk_density";
+  set.experiments.push_back(density);
+  Term bulk;
+  bulk.experiment = "density", bulk.test = "bulk_density", bulk.observable = "bulk_density";
+  bulk.measured = 1500, bulk.sigma_measured = 20, bulk.simulated = 1480, bulk.sigma_simulated = 10;
+  comparison.terms.push_back(bulk);
+
+  const std::vector<LocusComparison> loci = yield_loci(set, comparison);
+  ASSERT_EQ(loci.size(), 2u);
+  // The peaks: one locus over the normal stresses, in ascending order.
+  const LocusComparison& peak = loci[0];
+  EXPECT_EQ(peak.measured.observable, "peak_shear_stress");
+  EXPECT_DOUBLE_EQ(peak.measured.preshear_stress, 20000);
+  ASSERT_EQ(peak.measured.points.size(), 3u);
+  EXPECT_DOUBLE_EQ(peak.measured.points.front().normal_stress, 5000);
+  EXPECT_EQ(peak.measured.points.front().experiment, "shear_5");
+  ASSERT_TRUE(peak.measured.fit.fitted && peak.simulated.fit.fitted);
+  EXPECT_NEAR(peak.measured.fit.friction_angle, 30, 1e-9);
+  EXPECT_NEAR(peak.measured.fit.cohesion, 2000, 1e-6);
+  EXPECT_NEAR(peak.simulated.fit.friction_angle, 25, 1e-9);
+  EXPECT_NEAR(peak.simulated.fit.cohesion, 500, 1e-6);
+  EXPECT_NE(peak.words.find("flatter"), std::string::npos) << peak.words;
+  // The steady states all lie at the pre-shear stress: one normal stress, no locus.
+  const LocusComparison& steady = loci[1];
+  EXPECT_EQ(steady.measured.observable, "steady_shear_stress");
+  EXPECT_FALSE(steady.measured.fit.fitted);
+  EXPECT_NE(steady.measured.fit.reason.find("one normal stress"), std::string::npos) << steady.measured.fit.reason;
+  EXPECT_NE(steady.words.find("No comparison"), std::string::npos) << steady.words;
+  // The measured set alone gives the same measured loci.
+  const std::vector<YieldLocus> measured = measured_yield_loci(set);
+  ASSERT_EQ(measured.size(), 2u);
+  EXPECT_EQ(measured[0].points.size(), 3u);
+  EXPECT_NEAR(measured[0].fit.friction_angle, peak.measured.fit.friction_angle, 1e-12);
+  EXPECT_NEAR(measured[0].fit.cohesion, peak.measured.fit.cohesion, 1e-9);
+  EXPECT_FALSE(measured[1].fit.fitted);
 }
 
 }  // namespace

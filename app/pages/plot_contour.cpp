@@ -62,6 +62,9 @@ bool draw_errorbar_plot(const ErrorBarPlot& plot, const std::string& png_path, s
         for (size_t k = 0; k < s.x.size(); ++k) out << number(s.x[k]) << '\t' << number(s.y[k]) << '\t' << number(k < s.error.size() ? s.error[k] : 0) << '\n';
         out << "\n\n";
       }
+      // Each straight line as a block of its two end points, after the series' blocks.
+      for (const StraightLine& l : plot.straight_lines)
+        out << "# " << l.label << "\n" << number(l.x0) << '\t' << number(l.y0) << "\t0\n" << number(l.x1) << '\t' << number(l.y1) << "\t0\n\n\n";
     }
     std::string s = fmt::format("# demdesign plot: {}\n", plot.title) + terminal(plot.width, plot.height, fs::path(png_path).filename().string());
     s += fmt::format("set datafile separator tab\nset datafile missing 'NaN'\nset title {}\nset xlabel {}\nset ylabel {}\n", gnuplot_string(plot.title),
@@ -78,6 +81,12 @@ bool draw_errorbar_plot(const ErrorBarPlot& plot, const std::string& png_path, s
       items.push_back(fmt::format("{} index {} using 1:2:3 with yerrorbars pt 7 ps 0.8 lw 1.5 lc {} title {}", gnuplot_string(name), k, k + 1,
                                   gnuplot_string(plot.series[k].label)));
       if (plot.series[k].lines) items.push_back(fmt::format("{} index {} using 1:2 with lines lw 1.2 lc {} notitle", gnuplot_string(name), k, k + 1));
+    }
+    for (size_t k = 0; k < plot.straight_lines.size(); ++k) {
+      const StraightLine& l = plot.straight_lines[k];
+      const std::string colour = l.series >= 0 ? std::to_string(l.series + 1) : "rgb '#888888'";
+      items.push_back(fmt::format("{} index {} using 1:2 with lines lw 1.5 lc {} title {}", gnuplot_string(name), plot.series.size() + k, colour,
+                                  gnuplot_string(l.label)));
     }
     for (double y : plot.zero_band) items.push_back(fmt::format("{} with lines dashtype 2 lc rgb '#888888' notitle", number(y)));
     s += "plot ";

@@ -14,9 +14,17 @@ struct ErrorSeries {
   bool lines = false;               ///< join the points
 };
 
+/// A straight line between two points (a fitted line), drawn solid in the colour of one series.
+struct StraightLine {
+  std::string label;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int series = -1;  ///< index of the series whose colour it takes; -1: grey
+};
+
 struct ErrorBarPlot {
   std::string title, x_label, y_label;
   std::vector<ErrorSeries> series;
+  std::vector<StraightLine> straight_lines;
   std::vector<std::string> x_tics;  ///< when given, x = 0, 1, ... are labelled with these (rotated)
   std::vector<double> zero_band;    ///< horizontal dashed lines (e.g. -2, 0, 2 sigma)
   int width = 960, height = 480;    // [px]

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <set>
 
 #include "pages/html.h"
@@ -161,6 +162,97 @@ std::string calibration_section(const materials::CalibrationResult& r, const std
   return h + comparison_section(r.after, heading + ": at the fit (real simulations)", dir, tag + "_after");
 }
 
+/// One comparison whose simulated yield loci the report shows beside the measured ones.
+struct LociStage {
+  std::string label;  ///< "simulated", "before calibration", ...
+  const Comparison* comparison = nullptr;
+};
+
+/// The locus comparison among `loci` that belongs to the measured locus `m`; nullptr when none.
+const materials::LocusComparison* matching_locus(const std::vector<materials::LocusComparison>& loci, const materials::YieldLocus& m) {
+  for (const materials::LocusComparison& l : loci)
+    if (l.measured.observable == m.observable && l.measured.preshear_stress == m.preshear_stress) return &l;
+  return nullptr;
+}
+
+/// A locus's points in kPa with their one-sigma bars, and its fitted line from sigma = 0 to `x_end` [kPa].
+void add_locus(plot::ErrorBarPlot& p, const materials::YieldLocus& locus, const std::string& label, double x_end) {
+  plot::ErrorSeries s{label, {}, {}, {}, false};
+  for (const materials::LocusPoint& q : locus.points)
+    s.x.push_back(q.normal_stress / 1000), s.y.push_back(q.shear_stress / 1000), s.error.push_back(q.error / 1000);
+  p.series.push_back(s);
+  if (!locus.fit.fitted) return;
+  const double slope = std::tan(locus.fit.friction_angle * std::numbers::pi / 180), intercept = locus.fit.cohesion / 1000;
+  p.straight_lines.push_back({label + ": fitted line", 0, intercept, x_end, intercept + slope * x_end, static_cast<int>(p.series.size()) - 1});
+}
+
+/// One row of the loci table: phi and c with their standard errors, or why there is no fit.
+std::string locus_row(const std::string& label, const materials::YieldLocusFit& f) {
+  if (!f.fitted) return row({esc(label), "no fit: " + esc(f.reason), "", "", "", std::to_string(f.points), ""});
+  return row({esc(label), num(f.friction_angle, 3) + " &plusmn; " + num(f.friction_angle_sigma, 2),
+              num(f.cohesion / 1000, 3) + " &plusmn; " + num(f.cohesion_sigma / 1000, 2), num(f.correlation, 2), num(f.chi2_per_dof, 3),
+              std::to_string(f.points), f.cohesion_zero ? "yes" : "no"});
+}
+
+/// One measured locus with the simulated loci of every stage: plot, table of phi and c, words.
+std::string locus_html(const materials::YieldLocus& m, const std::vector<LociStage>& stages,
+                       const std::vector<std::vector<materials::LocusComparison>>& per_stage, const std::string& png) {
+  double x_end = 0;  // [kPa]
+  for (const materials::LocusPoint& q : m.points) x_end = std::max(x_end, 1.1 * q.normal_stress / 1000);
+  plot::ErrorBarPlot p;
+  p.title = "yield locus: " + m.label();
+  p.x_label = "normal stress [kPa]";
+  p.y_label = "shear stress [kPa]";
+  p.width = 720, p.height = 480;
+  add_locus(p, m, "measured", x_end);
+  std::string table = "<table>" + row({"locus", "&phi; [&deg;]", "c [kPa]", "correlation of &phi; and c", "&chi;&sup2;/dof", "points",
+                                       "c within 2 &sigma; of 0"}, true) + locus_row("measured", m.fit);
+  std::string words;
+  for (size_t k = 0; k < stages.size(); ++k) {
+    const materials::LocusComparison* l = matching_locus(per_stage[k], m);
+    if (!l) continue;
+    add_locus(p, l->simulated, "simulated: " + stages[k].label, x_end);
+    table += locus_row("simulated: " + stages[k].label, l->simulated.fit);
+    words += fmt::format("<li><b>{}</b>: {}</li>", esc(stages[k].label), esc(l->words));
+  }
+  std::string message;
+  std::string h = fmt::format("<h3>{}</h3>\n", esc(m.label()));
+  h += figure_html(plot::draw_errorbar_plot(p, png, &message), png, p.title, message,
+                   "Shear stress against normal stress: points with one-sigma bars, lines the weighted Mohr-Coulomb fits.");
+  return h + table + "</table>\n" + (words.empty() ? "" : "<ul>" + words + "</ul>\n");
+}
+
+/// The yield loci of the direct shear experiments, for every measured locus with two or more
+/// normal stresses; "" when there is none.
+std::string yield_loci_section(const materials::MeasurementSet& measured, const std::vector<LociStage>& stages, const std::string& dir) {
+  std::vector<std::vector<materials::LocusComparison>> per_stage;
+  for (const LociStage& s : stages) per_stage.push_back(materials::yield_loci(measured, *s.comparison));
+  const std::vector<materials::YieldLocus> loci = materials::measured_yield_loci(measured);
+  std::string body;
+  for (size_t k = 0; k < loci.size(); ++k)
+    if (loci[k].fit.fitted)
+      body += locus_html(loci[k], stages, per_stage, (fs::path(dir) / "plots" / fmt::format("yield_locus{}.png", k)).string());
+  if (body.empty()) return "";
+  return "<h2>Yield loci</h2>\n<p>Shear tests at several normal stresses after one pre-shear, as materials are compared by Gr&ouml;ger &amp; "
+         "Katterfeld: the Mohr-Coulomb line &tau; = c + &sigma; tan &phi; fitted by weighted least squares (weights 1/&sigma;&sup2;), the "
+         "angle of internal friction &phi; from the slope and the cohesion c from the intercept, with standard errors from the fit's "
+         "covariance. Peaks are sheared at <code>normal_stress</code> after pre-shear at <code>preshear_stress</code>; steady states "
+         "at <code>preshear_stress</code>. A difference is named when it exceeds 2 &sigma; of both fits combined.</p>\n" + body;
+}
+
+/// The comparisons of a report whose yield loci are shown, labelled.
+std::vector<LociStage> loci_stages(const CalibrationReportInput& in) {
+  if (in.diagnosis) {
+    std::vector<LociStage> stages = {{"starting model", &in.diagnosis->base.before}, {"calibrated as it is", &in.diagnosis->base.after}};
+    for (const materials::CandidateResult& c : in.diagnosis->candidates)
+      if (c.confirmed) stages.push_back({"with " + c.name + ", recalibrated", &c.fit.after});
+    return stages;
+  }
+  if (in.calibration) return {{"before calibration", &in.calibration->before}, {"after calibration", &in.calibration->after}};
+  if (in.comparison) return {{"simulated", in.comparison}};
+  return {};
+}
+
 std::string ledger_section(const std::vector<materials::LedgerEntry>& ledger, const std::string& dir) {
   if (ledger.empty()) return "";
   std::string h = "<h2>Error ledger</h2>\n<p>Every model version of this material (ledger.yaml), its effects and parameters, and its error.</p>\n";
@@ -251,6 +343,7 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
   } else if (in.comparison) {
     h += comparison_section(*in.comparison, "Measured against simulated", dir, "compare");
   }
+  if (in.measured) h += yield_loci_section(*in.measured, loci_stages(in), dir);
   h += ledger_section(in.ledger, dir);
   if (!in.images.empty()) {
     h += "<h2>Final states</h2><div class=\"grid\">";

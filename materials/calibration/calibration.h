@@ -45,6 +45,7 @@
 #include "model/material_model.h"
 #include "lab/measurements.h"
 #include "lab/virtual_tests.h"
+#include "lab/yield_locus.h"
 
 namespace dem::materials {
 
@@ -250,6 +251,11 @@ Comparison compare(const MaterialModel& model, const MeasurementSet& measured, c
 
 /// Residual patterns per (test, observable): regression on the varied set-up quantity.
 std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms);
+
+/// The yield loci of a comparison's direct shear terms (lab/yield_locus.h): per locus the
+/// measured values with sigma_measured and the simulated means with sigma_simulated, on the
+/// normal stresses of the experiments' set-ups in `measured`, each fitted and compared in words.
+std::vector<LocusComparison> yield_loci(const MeasurementSet& measured, const Comparison& comparison);
 
 // ---- calibration --------------------------------------------------------------------------
 

@@ -266,4 +266,21 @@ std::vector<Pattern> analyse_patterns(const std::vector<Term>& terms) {
   return out;
 }
 
+std::vector<LocusComparison> yield_loci(const MeasurementSet& measured, const Comparison& comparison) {
+  std::vector<ShearValue> observed, simulated;
+  for (const Term& t : comparison.terms) {
+    if (t.is_outcome() || t.test != "direct_shear") continue;
+    observed.push_back({t.experiment, t.observable, t.measured, t.sigma_measured});
+    simulated.push_back({t.experiment, t.observable, t.simulated, t.sigma_simulated});
+  }
+  // Both groupings see the same experiments, so their loci pair by observable and pre-shear.
+  const std::vector<YieldLocus> measured_loci = group_yield_loci(measured, observed), simulated_loci = group_yield_loci(measured, simulated);
+  std::vector<LocusComparison> out;
+  for (const YieldLocus& m : measured_loci)
+    for (const YieldLocus& s : simulated_loci)
+      if (s.observable == m.observable && s.preshear_stress == m.preshear_stress)
+        out.push_back({m, s, compare_yield_loci(m.fit, s.fit)});
+  return out;
+}
+
 }  // namespace dem::materials
