@@ -39,6 +39,7 @@
 #include "output/results_hdf5.h"
 #include "output/run.h"
 #include "report/report.h"
+#include "report/report_wear.h"
 #include "statistics/diagnostics.h"
 #include "campaign/sweep.h"
 #include "triangle_mesh.h"
@@ -135,11 +136,10 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
   input.stopped = summary.stopped;
   input.records_from = model.output.records_from;
   input.sensors = model.sensors, input.design = model.design;
-  for (const auto& mesh : spec.meshes) {
-    auto k = spec.wear_coefficients.find(mesh.name);
-    if (k == spec.wear_coefficients.end()) k = spec.wear_coefficients.find("default");
-    if (k != spec.wear_coefficients.end()) input.wear_coefficient[mesh.name] = k->second;
-  }
+  // Liners per mesh (a belt or pulley takes no default) and the hours a year their life is at.
+  input.liners = dem::report::liners_for(spec, model);
+  input.operating_hours_per_year = spec.wear.operating_hours_per_year;
+  input.operating_hours_given = spec.wear.hours_given;
   for (const auto& outlet : spec.outlets)
     if (!outlet.spillage) input.outlet_intended.push_back(outlet.name);
   const std::string flow = fmt::format("{}/renders/frame_{:06d}.png", out, state.step);

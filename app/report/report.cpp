@@ -16,15 +16,18 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
+#include "case/liner_materials.h"
 #include "output/run.h"
 #include "pages/plot.h"
 #include "report/report_analysis.h"
 #include "report/report_internal.h"
+#include "report/report_wear.h"
 #include "statistics/steady_state.h"
 
 namespace dem::report {
@@ -43,6 +46,22 @@ std::string html_head(const std::string& title) { return html::head(title); }
 std::string pm(double mean, double spread, int sig = 4) { return num(mean, sig) + " &plusmn; " + num(spread, 2); }
 
 std::string table_row(std::initializer_list<std::string> cells, bool header = false) { return html::row(cells, header); }
+
+/// Mean and standard error of the mean over the run's interval ("m &plusmn; e"), times `scale`
+/// (1e-3: W to kW, N to kN, N m to kN m).
+std::string pm_se(const IntervalStats& s, double scale) { return pm(scale * s.mean, scale * s.std_error); }
+
+/// A series times `scale`, for a plot in kW or kN m.
+std::vector<double> scaled(std::vector<double> y, double scale) {
+  for (double& v : y) v *= scale;
+  return y;
+}
+
+/// Where a series' own steady part begins, or why it has none.
+std::string own_steady(const Quantity& q) { return q.own.found ? fmt::format("from {} s", num(q.own.t_start, 3)) : esc(q.own.why); }
+
+/// "(x, y, z)" of a point [m] or a unit direction.
+std::string vector_text(const Eigen::Vector3d& v) { return fmt::format("({}, {}, {})", num(v.x(), 4), num(v.y(), 4), num(v.z(), 4)); }
 
 /// Draws a plot into dir/plots and returns the HTML figure (or the reason there is none).
 std::string figure(const plot::Plot& p, const std::string& dir, const std::string& name, const std::string& caption) {
@@ -122,8 +141,9 @@ std::string summary(const Page& page) {
   const Quantity& primary = run.primary;
   const std::vector<Hotspot>& spots = run.spots;
   std::string h = "<h2>Summary</h2>\n";
-  h += fmt::format("<p><b>{}</b>.{} Values are means &plusmn; standard deviation of the signal over the {} interval <b>{}</b>; "
-                   "the standard error of the mean (batch means) is given where it matters.</p>\n<table>\n",
+  h += fmt::format("<p><b>{}</b>.{} Values are means &plusmn; standard deviation of the signal over the {} interval <b>{}</b>, "
+                   "except the drives&#39;, which are &plusmn; the standard error of the mean (batch means), as it is given for the "
+                   "other means where it matters.</p>\n<table>\n",
                    esc(run.metrics.steady_text),
                    model.outlets.empty() ? std::string()
                                          : fmt::format(" Throughput {} t/h.", num(primary.at_run.mean, 4)),
@@ -140,8 +160,10 @@ std::string summary(const Page& page) {
   h += table_row({"spillage", num(run.spillage, 3), "kg", fmt::format("{} % of the inserted {} kg", num(run.spillage_pct, 3), num(run.last.inserted_mass, 4))});
   h += table_row({"hold-up at the end", num(run.holdup.empty() ? 0.0 : run.holdup.back()), "kg", "inserted &minus; removed &minus; lost"});
   h += table_row({"blockage", run.blockage.blocked ? "<b>yes</b>" : "no", "", esc(run.blockage.text)});
-  for (std::size_t m = 0; m < run.power.size(); ++m)
-    h += table_row({"power of " + esc(model.meshes[m].name), pm(run.power[m].at_run.mean, run.power[m].at_run.std_dev), "W", ""});
+  for (const Drive& d : run.drives)
+    h += table_row({"drive power of " + esc(d.name), pm_se(d.power.at_run, 1e-3), "kW",
+                    fmt::format("{} {} {}", d.kind == DriveKind::rotating ? "shaft torque" : "pull",
+                                pm_se(d.effort.at_run, 1e-3), d.kind == DriveKind::rotating ? "kN m about its own axis" : "kN")});
   for (const BoxResult& b : run.boxes)
     h += table_row({"centring offset on " + esc(b.name), pm(b.offset.at_run.mean, b.offset.at_run.std_dev, 3), "mm",
                     b.width > 0 ? fmt::format("{} % of the {} mm box width", num(100 * b.offset.at_run.mean / (1000 * b.width), 3), num(1000 * b.width, 4)) : ""});
@@ -245,60 +267,104 @@ std::string mass_balance(const Page& page) {
   return h;
 }
 
-/// The particles' force and torque on each mesh, by component.
+/// The particles' force on each mesh, by component, in kN.
 std::string mesh_loads(const Page& page) {
   const RunAnalysis& run = page.run;
   const Model& model = page.model;
-  std::string h = fmt::format("<h3>Loads on the meshes</h3>\n<p>The particles&#39; force on each mesh and its torque about the mesh&#39;s motion "
-                              "origin (the world origin for a static mesh), by component, averaged over {} &plusmn; the standard error of the "
-                              "mean (batch means); |F&#772;| is the magnitude of the mean force, which noise does not inflate as it does the mean "
-                              "of the magnitude. Also in mesh_loads.csv.</p>\n<table>\n", run.interval_text);
-  h += table_row({"mesh", "F<sub>x</sub> [N]", "F<sub>y</sub> [N]", "F<sub>z</sub> [N]", "|F&#772;| [N]", "T<sub>x</sub> [N m]",
-                  "T<sub>y</sub> [N m]", "T<sub>z</sub> [N m]"}, true);
+  std::string h = fmt::format("<h3>Loads on the meshes</h3>\n<p>The particles&#39; force on each mesh by component, averaged over {} &plusmn; "
+                              "the standard error of the mean (batch means); |F&#772;| is the magnitude of the mean force, which noise does "
+                              "not inflate as it does the mean of the magnitude. Static parts appear here only: they do no work. "
+                              "mesh_loads.csv has these with the torque about each mesh&#39;s motion origin (the world origin for a mesh "
+                              "that does not move).</p>\n<table>\n", run.interval_text);
+  h += table_row({"mesh", "kind", "F<sub>x</sub> [kN]", "F<sub>y</sub> [kN]", "F<sub>z</sub> [kN]", "|F&#772;| [kN]"}, true);
   for (std::size_t m = 0; m < model.meshes.size() && 6 * m + 5 < run.mesh_load.size(); ++m) {
-    const auto se = [&](int c) { return pm(run.mesh_load[6 * m + c].at_run.mean, run.mesh_load[6 * m + c].at_run.std_error); };
+    const auto se = [&](int c) { return pm_se(run.mesh_load[6 * m + c].at_run, 1e-3); };
     const double fx = run.mesh_load[6 * m].at_run.mean, fy = run.mesh_load[6 * m + 1].at_run.mean, fz = run.mesh_load[6 * m + 2].at_run.mean;
-    h += table_row({esc(model.meshes[m].name), se(0), se(1), se(2), num(std::sqrt(fx * fx + fy * fy + fz * fz), 4), se(3), se(4), se(5)});
+    h += table_row({esc(model.meshes[m].name), drive_kind_name(run.mesh_kind[m]), se(0), se(1), se(2),
+                    num(1e-3 * std::sqrt(fx * fx + fy * fy + fz * fz), 4)});
   }
   h += "</table>\n";
   return h;
 }
 
-/// Power and torque per mesh: the table, the two plots and the loads.
-std::string power_and_torque(const Page& page) {
-  const RunAnalysis& run = page.run;
-  const Model& model = page.model;
-  const std::vector<double>& t = run.t;
-  const std::vector<Quantity>& power = run.power;
-  const std::vector<Quantity>& torque = run.torque;
-  std::string h = "<h2>Power and torque</h2>\n";
-  if (power.empty()) {
-    h += "<p>The case has no mesh walls.</p>\n";
-    return h;
+/// What the drives table states: the window, the error, the sign conventions and the checks.
+std::string drives_intro(const Page& page) {
+  return fmt::format(
+      "<p>What each drive supplies to the material, averaged over {} ({}) &plusmn; the standard error of the mean from "
+      "non-overlapping batch means (10 to 30 batches over the window, so that correlated samples do not make it look smaller "
+      "than it is). <b>Belt pull</b> F<sub>t</sub>: the particles&#39; force on the belt resolved along its direction of "
+      "travel, positive when the material resists the belt (the drive must pull it). <b>Shaft torque</b> T: about the part&#39;s "
+      "own axis (through its axis point, oriented so that the part turns anticlockwise about it), from the recorded force F and "
+      "torque T<sub>o</sub> about the motion origin o: T = &minus;(T<sub>o</sub> &minus; (p &minus; o) &times; F) &middot; "
+      "&acirc;, positive when the material resists the turning. <b>Power</b> P: the rate of work the part does on the material, "
+      "&Sigma; F<sub>i</sub> &middot; v<sub>wall</sub> over its contacts. F<sub>t</sub> v and T &omega; check it: they equal P "
+      "on a belt whose surface contains its direction of travel and on a part turning about a fixed axis. For parts carried on "
+      "a path (buckets), F<sub>t</sub> is the force along the path at the carried frame&#39;s origin, and F<sub>t</sub> v leaves "
+      "out the work of their turning round the pulleys. Only the material&#39;s share: idler, bearing and belt-bending losses "
+      "are not modelled.</p>\n",
+      page.run.interval_text, page.run.steady ? "the steady state" : "the last third of the run: no steady state");
+}
+
+/// The belts and the parts carried on a path: speed, pull, power and the check F_t v ("" without any).
+std::string linear_drives(const Page& page) {
+  std::string rows;
+  for (const Drive& d : page.run.drives) {
+    if (d.kind == DriveKind::rotating) continue;
+    rows += table_row({esc(d.name) + (d.note.empty() ? std::string() : " (" + esc(d.note) + ")"), drive_kind_name(d.kind), num(d.speed, 4),
+                       pm_se(d.effort.at_run, 1e-3), pm_se(d.power.at_run, 1e-3), pm_se(d.check.at_run, 1e-3), own_steady(d.power)});
   }
-  h += "<p>Sign convention: power is the rate of work a mesh does on the material; <b>positive = the mesh drives the material</b> "
-       "(a rotating drum, a belt through its surface velocity), negative = the material does work on the mesh. Torque is about "
-       "the mesh&#39;s rotation axis (its magnitude |T| about the motion origin when the mesh does not rotate). A static mesh "
-       "without surface velocity does no work.</p>\n<table>\n";
-  h += table_row({"mesh", "power [W]", "torque [N m]", "own steady state (power)"}, true);
-  for (std::size_t m = 0; m < power.size(); ++m)
-    h += table_row({esc(model.meshes[m].name), pm(power[m].at_run.mean, power[m].at_run.std_dev), pm(torque[m].at_run.mean, torque[m].at_run.std_dev),
-                    power[m].own.found ? fmt::format("from {} s", num(power[m].own.t_start, 3)) : esc(power[m].own.why)});
-  h += "</table>\n";
+  if (rows.empty()) return "";
+  return "<h3>Belts and parts carried on a path</h3>\n<table>\n" +
+         table_row({"part", "kind", "speed v [m/s]", "pull F<sub>t</sub> [kN]", "power P [kW]", "check F<sub>t</sub> v [kW]",
+                    "own steady state (P)"}, true) +
+         rows + "</table>\n";
+}
+
+/// The rotating parts: axis, speed, shaft torque about the own axis, power and the check T omega
+/// ("" without any).
+std::string rotating_drives(const Page& page) {
+  std::string rows;
+  for (const Drive& d : page.run.drives) {
+    if (d.kind != DriveKind::rotating) continue;
+    rows += table_row({esc(d.name), vector_text(d.at_end.axis_point), vector_text(d.at_end.direction), num(d.speed * 30 / std::numbers::pi, 4),
+                       pm_se(d.effort.at_run, 1e-3), pm_se(d.power.at_run, 1e-3), pm_se(d.check.at_run, 1e-3), own_steady(d.power)});
+  }
+  if (rows.empty()) return "";
+  return "<h3>Rotating parts</h3>\n<table>\n" +
+         table_row({"part", "axis point p [m]", "axis &acirc;", "speed [rpm]", "shaft torque T [kN m]", "power P [kW]",
+                    "check T &omega; [kW]", "own steady state (P)"}, true) +
+         rows + "</table>\n";
+}
+
+/// The drives' power over time, and the rotating parts' shaft torque about their own axes.
+std::string drive_plots(const Page& page) {
+  const RunAnalysis& run = page.run;
   plot::Plot p;
-  p.title = "Power of the meshes on the material";
+  p.title = "Drive power on the material";
   p.x_label = "time [s]";
-  p.y_label = "power [W]";
-  for (std::size_t m = 0; m < power.size(); ++m) p.series.push_back({model.meshes[m].name, t, power[m].y});
+  p.y_label = "power [kW]";
+  for (const Drive& d : run.drives) p.series.push_back({d.name, run.t, scaled(d.power.y, 1e-3)});
   page.set_band(p);
-  h += figure(p, page.dir, "mesh_power", "Power per mesh (positive: the mesh does work on the material).");
-  p.title = "Torque on the meshes";
-  p.y_label = "torque [N m]";
+  std::string h = figure(p, page.dir, "drive_power", "Power per drive (positive: the part does work on the material).");
+  p.title = "Shaft torque about each rotating part's own axis";
+  p.y_label = "torque [kN m]";
   p.series.clear();
-  for (std::size_t m = 0; m < torque.size(); ++m) p.series.push_back({model.meshes[m].name, t, torque[m].y});
-  h += figure(p, page.dir, "mesh_torque", "Torque per mesh about its rotation axis.");
-  h += mesh_loads(page);
+  for (const Drive& d : run.drives)
+    if (d.kind == DriveKind::rotating) p.series.push_back({d.name, run.t, scaled(d.effort.y, 1e-3)});
+  if (!p.series.empty())
+    h += figure(p, page.dir, "drive_torque", "Shaft torque about each rotating part's own axis (positive: the material resists the turning).");
   return h;
+}
+
+/// The drives of the moving parts (tables and plots), then the loads on every mesh.
+std::string drives_and_loads(const Page& page) {
+  std::string h = "<h2>Drives and loads</h2>\n";
+  if (page.model.meshes.empty()) return h + "<p>The case has no mesh walls.</p>\n";
+  if (page.run.drives.empty())
+    h += "<p>No mesh moves or has a moving surface: there is no drive.</p>\n";
+  else
+    h += drives_intro(page) + linear_drives(page) + rotating_drives(page) + drive_plots(page);
+  return h + mesh_loads(page);
 }
 
 /// When material first reached each outlet, sensor or the domain's bounds ("" without events).
@@ -319,23 +385,96 @@ std::string wear_per_mesh(const Page& page) {
   const std::vector<MeshWear>& mesh_wear = page.run.mesh_wear;
   std::string h = fmt::format(
       "<p>From the per-triangle records over the recording interval {} s to {} s ({} s): shear power per area q = friction work / "
-      "(area &times; interval) [W/m&sup2;], the Archard wear input, and impact power per area = sum of &frac12; m* v<sub>n</sub>&sup2; "
-      "at contact starts / (area &times; interval) [W/m&sup2;]. Where a specific wear rate k<sub>A</sub> = k/H [m&sup3;/J] is given "
-      "for a mesh, the wear depth rate is h&#775; = k<sub>A</sub> q [m/s], shown in mm/year (8760 h of operation a year).</p>\n<table>\n",
-      num(page.in.records_from, 3), num(page.state.time, 4), num(page.run.record_time, 3));
+      "(area &times; interval) [W/m&sup2;], the Archard wear input, and impact power per area q<sub>i</sub> = sum of &frac12; m* "
+      "v<sub>n</sub>&sup2; at contact starts / (area &times; interval) [W/m&sup2;]. Where a mesh has a liner, its wear depth rate is "
+      "h&#775; = k<sub>s</sub> q + K<sub>i</sub> q<sub>i</sub> [m/s] (sliding, Archard; impact, Bitter&#39;s deformation wear), "
+      "shown in mm/year at {} h of operation a year.</p>\n<table>\n",
+      num(page.in.records_from, 3), num(page.state.time, 4), num(page.run.record_time, 3), num(page.run.operating_hours, 4));
   h += table_row({"mesh", "area [m&sup2;]", "shear power [W]", "impact power [W]", "max shear power [W/m&sup2;]", "max impact power [W/m&sup2;]",
-                  "k<sub>A</sub> [m&sup3;/J]", "max wear rate [mm/yr]"},
+                  "k<sub>s</sub> [m&sup3;/J]", "max wear rate [mm/yr]"},
                  true);
   for (std::size_t m = 0; m < model.meshes.size(); ++m) {
     const MeshWear& w = mesh_wear[m];
     h += table_row({esc(model.meshes[m].name), num(w.area), num(w.shear_power, 3), num(w.impact_power, 3), num(w.max_shear, 3), num(w.max_impact, 3),
-                    std::isnan(w.k) ? std::string("not given") : num(w.k, 3), std::isnan(w.k) ? std::string("&ndash;") : num(w.max_wear, 3)});
+                    std::isnan(w.k) ? std::string("not given") : num(w.k, 3), w.has_liner ? num(w.max_wear, 3) : std::string("&ndash;")});
   }
   h += "</table>\n";
-  if (std::all_of(mesh_wear.begin(), mesh_wear.end(), [](const MeshWear& w) { return std::isnan(w.k); }))
-    h += "<p class=\"note\">No wear depth: the case gives no specific wear rate. Add <code>wear_coefficients: {default: K}</code> "
-         "(or per mesh name), K = k/H of the liner in m&sup3;/J, for the wear rate in mm/year.</p>\n";
+  if (std::none_of(mesh_wear.begin(), mesh_wear.end(), [](const MeshWear& w) { return w.has_liner; })) {
+    std::string words;
+    for (const std::string& k : liner_material_keys()) words += (words.empty() ? "" : ", ") + k;
+    h += fmt::format("<p class=\"note\">No wear depth: the case gives no liner. Add <code>wear: {{liners: {{default: {{material: ar400, "
+                     "thickness_mm: 20}}}}}}</code> (or per mesh name; materials: {}) for the wear rate in mm/year and the liner life; "
+                     "<code>wear_coefficients: {{default: K}}</code> still gives a sliding rate alone.</p>\n",
+                     words);
+  }
   return h;
+}
+
+/// What the liner life rests on: the operating hours, the laws, the throughput for mm/Mt.
+std::string liner_life_basis(const Page& page) {
+  const RunAnalysis& run = page.run;
+  const std::string hours = run.operating_hours_given
+                                ? fmt::format("{} h of operation a year (<code>wear.operating_hours_per_year</code>)", num(run.operating_hours, 4))
+                                : fmt::format("<b>{} h of operation a year, assumed</b>: the case gives no <code>wear.operating_hours_per_year</code> "
+                                              "(about two shifts a day, 250 days a year)",
+                                              num(run.operating_hours, 4));
+  const std::string tonnes = std::isnan(run.wear_throughput)
+                                 ? std::string("no throughput is known (no outlet, plane sensor, design capacity or inlet rate): no mm/Mt")
+                                 : fmt::format("{} t/h, {}", num(run.wear_throughput, 4), esc(run.wear_throughput_text));
+  return fmt::format(
+      "<p>Months until the liner&#39;s thickness is worn through, at {}: at the mesh&#39;s worst triangle (the highest depth rate) "
+      "and at its mean (its wear volume spread over its area). Wear per million tonnes conveyed, the depth rate over the throughput, "
+      "does not depend on the hours: {}. Belts and pulleys (meshes with a surface velocity) take no <code>default</code> liner, only "
+      "one given by their name. The coefficients are order-of-magnitude values from the sources below, for rock on the liner; "
+      "wear measured on the plant&#39;s own liners supersedes them (<code>sliding_coefficient</code>, "
+      "<code>impact_coefficient</code> of a liner).</p>\n",
+      hours, tonnes);
+}
+
+/// The liner life table: per mesh with a liner, its worst triangle and its mean.
+std::string liner_life_table(const Page& page) {
+  const RunAnalysis& run = page.run;
+  const double hours = run.operating_hours;
+  std::string h = "<table>\n" + table_row({"mesh", "liner material", "thickness [mm]", "k<sub>s</sub>, K<sub>i</sub> [m&sup3;/J]",
+                                          "sliding [mm/yr]", "impact [mm/yr]", "worst-spot life [months]", "mean life [months]",
+                                          "wear [mm/Mt]", "worst triangle (centroid [m])"},
+                                         true);
+  for (std::size_t m = 0; m < page.model.meshes.size(); ++m) {
+    const MeshWear& w = run.mesh_wear[m];
+    if (!w.has_liner) continue;
+    const LinerMaterial* material = find_liner_material(w.liner.material);
+    const std::string what = material ? esc(material->name) : "coefficient only (" + esc(w.liner.origin) + ")";
+    h += table_row({esc(page.model.meshes[m].name), what, w.liner.thickness > 0 ? num(1e3 * w.liner.thickness, 3) : std::string("not given"),
+                    num(w.liner.sliding_coefficient, 2) + ", " + num(w.liner.impact_coefficient, 2), num(mm_per_year(w.worst.sliding, hours), 3),
+                    num(mm_per_year(w.worst.impact, hours), 3), num(w.worst.life_months, 3), num(w.mean.life_months, 3),
+                    num(w.worst.mm_per_megatonne, 3), fmt::format("{} {}", w.worst.triangle, vector_text(w.worst.centroid))});
+  }
+  return h + "</table>\n<p class=\"note\">Sliding and impact at the worst triangle; wear per Mt at the worst triangle. Also in "
+             "wear_life.csv (each mesh&#39;s worst triangle and mean).</p>\n";
+}
+
+/// The rows of the liner-material table the liners use, with their sources.
+std::string liner_sources(const Page& page) {
+  std::set<std::string> used;
+  for (const MeshWear& w : page.run.mesh_wear)
+    if (w.has_liner && !w.liner.material.empty()) used.insert(w.liner.material);
+  if (used.empty()) return "";
+  std::string h = "<table>\n" + table_row({"liner material", "k<sub>s</sub> [m&sup3;/J]", "K<sub>i</sub> [m&sup3;/J]", "sliding: source",
+                                          "impact: source", "note"},
+                                         true);
+  for (const LinerMaterial& m : liner_materials())
+    if (used.count(m.key))
+      h += table_row({esc(m.name), num(m.sliding_coefficient, 2), num(m.impact_coefficient, 2), esc(m.sliding_source), esc(m.impact_source),
+                      esc(m.note)});
+  return h + "</table>\n<p class=\"note\">The table&#39;s values; a liner may override them in the case. The laws and the rejected "
+             "alternatives are stated in src/case/liner_materials.cpp.</p>\n";
+}
+
+/// Liner life: its basis, the table per mesh, and the sources of the coefficients ("" without a liner).
+std::string liner_life(const Page& page) {
+  const std::vector<MeshWear>& mesh_wear = page.run.mesh_wear;
+  if (std::none_of(mesh_wear.begin(), mesh_wear.end(), [](const MeshWear& w) { return w.has_liner; })) return "";
+  return "<h3>Liner life</h3>\n" + liner_life_basis(page) + liner_life_table(page) + liner_sources(page);
 }
 
 /// The triangles with the highest shear power per area.
@@ -364,6 +503,7 @@ std::string wear(const Page& page) {
     h += fmt::format("<p>No wall records: recording starts at {} s, the run ended at {} s.</p>\n", num(page.in.records_from, 3), num(page.state.time, 4));
   } else {
     h += wear_per_mesh(page);
+    h += liner_life(page);
     h += wear_hotspots(page);
   }
   return h;
@@ -524,7 +664,8 @@ std::string reproducibility(const Page& page) {
 
 /// The list of the files beside the report, and the end of the page.
 std::string page_foot() {
-  return "<p class=\"note\">Files beside this report: metrics.csv, steady_state.csv, wear_hotspots.csv, plots/*.png with their data "
+  return "<p class=\"note\">Files beside this report: metrics.csv, steady_state.csv, drives.csv (with moving parts), "
+         "mesh_loads.csv (with meshes), wear_hotspots.csv, wear_life.csv (with meshes), plots/*.png with their data "
          "(*.tsv) and gnuplot scripts (*.gp).</p>\n</body></html>\n";
 }
 
@@ -541,7 +682,7 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
   h += summary(page);
   h += throughput(page);
   h += mass_balance(page);
-  h += power_and_torque(page);
+  h += drives_and_loads(page);
   h += first_arrivals(page);
   h += wear(page);
   h += belt_loading(page);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -25,6 +26,16 @@ struct ImageRef {
   std::string title, path, caption;
 };
 
+/// The liner of a mesh as the wear analysis reads it: what it is, how thick, and the volume it
+/// loses per joule by sliding and by impact (case/liner_materials.cpp has the laws and sources).
+struct Liner {
+  std::string material;  ///< key of the liner-material table; "" when only a coefficient is given
+  std::string origin;    ///< the case key it came from: "wear.liners.spoon", "wear_coefficients.default"
+  double thickness = 0;  ///< [m] wearable thickness; 0 when not given (no life)
+  double sliding_coefficient = std::numeric_limits<double>::quiet_NaN();  ///< [m^3/J] per friction work; NaN: none
+  double impact_coefficient = std::numeric_limits<double>::quiet_NaN();   ///< [m^3/J] per normal impact energy; NaN: none
+};
+
 struct RunReportInput {
   const Model* model = nullptr;
   const State* state = nullptr;  ///< final state; state->records give the wear inputs
@@ -32,8 +43,13 @@ struct RunReportInput {
   std::string case_path, case_text, version;
   double wall_seconds = 0;  // [s] run wall time
   std::vector<ImageRef> images;
-  /// Per mesh name: Archard specific wear rate k/H [m^3/J] (= wear volume per friction work).
+  /// Per mesh name: its liner (report/report_wear.h, liners_for, resolves them from a case).
+  std::map<std::string, Liner> liners;
+  /// Per mesh name not in `liners`: a sliding wear coefficient [m^3/J] (wear volume per friction
+  /// work) alone, as a liner with no material, thickness or impact wear.
   std::map<std::string, double> wear_coefficient;
+  double operating_hours_per_year = kDefaultOperatingHoursPerYear;  ///< [h] the wear rates and lives are at
+  bool operating_hours_given = false;  ///< false: the default, stated in the report as an assumption
   double records_from = 0;  // [s] when the wall records started accumulating
   /// Names of the outlets material is meant to leave by; empty: all outlets. Mass into any other
   /// outlet counts as spillage.

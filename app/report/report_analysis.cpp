@@ -1,7 +1,8 @@
 // The numbers of the run report: each series with its steady state and its average over the
-// run's interval, the mass balance, spillage and blockage, power and torque, wear per triangle,
-// belt loading and the metrics; and the report's tables (steady_state.csv, wear_hotspots.csv,
-// metrics.csv). report.cpp draws the plots and writes report.html.
+// run's interval, the mass balance, spillage and blockage, the drives and the loads, wear per triangle,
+// belt loading and the metrics; and the report's tables (steady_state.csv, mesh_loads.csv,
+// drives.csv, wear_hotspots.csv, wear_life.csv, metrics.csv). report.cpp draws the plots and
+// writes report.html. The liner life (depth rates, months, mm/Mt) is report_wear.cpp's.
 #include "report/report_analysis.h"
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include "pages/html.h"
@@ -21,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using html::num;
-constexpr double kSecondsPerYear = 8760.0 * 3600.0;  // 8760 h
 constexpr double kTonnesPerHourPerKgPerSecond = 3.6;
 
 /// Design value whose name contains all of `parts`; NaN when none.
@@ -299,26 +300,106 @@ void design_capacity(const AnalysisInput& input, RunAnalysis& run) {
   }
 }
 
-// ---- power and torque per mesh --------------------------------------------------------
+// ---- loads per mesh and the drives of the moving parts ---------------------------------
 
-/// Per mesh: its power, torque and the six components of its load, each a finished series.
-void power_and_torque(const AnalysisInput& input, RunAnalysis& run) {
+/// Per mesh: its power, its drive kind and the six components of its load, each a finished series.
+void mesh_loads_and_power(const AnalysisInput& input, RunAnalysis& run) {
   const Model& model = input.model;
   const std::vector<Scalars>& rows = input.rows;
-  std::vector<Quantity>& power = run.power;
-  std::vector<Quantity>& torque = run.torque;
   for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-    power.push_back({"power " + model.meshes[m].name, "W", column(rows, [m](const Scalars& r) { return at(r.mesh_power, m); }), {}, {}});
-    torque.push_back({"torque " + model.meshes[m].name, "N m", column(rows, [m](const Scalars& r) { return at(r.mesh_torque, m); }), {}, {}});
-    finish_series(run, power.back());
-    finish_series(run, torque.back());
+    run.mesh_kind.push_back(drive_kind(model.meshes[m]));
+    run.power.push_back({"power " + model.meshes[m].name, "W", column(rows, [m](const Scalars& r) { return at(r.mesh_power, m); }), {}, {}});
+    finish_series(run, run.power.back());
     static constexpr const char* kComponents[6] = {"force x", "force y", "force z", "torque x", "torque y", "torque z"};
     for (int c = 0; c < 6; ++c) {
-      run.mesh_load.push_back({fmt::format("{} {}", kComponents[c], model.meshes[m].name), c < 3 ? "N" : "N m",
+      const std::string name = fmt::format("{} on {}{}", kComponents[c], model.meshes[m].name, c < 3 ? "" : " about its motion origin");
+      run.mesh_load.push_back({name, c < 3 ? "N" : "N m",
                                column(rows, [m, c](const Scalars& r) { return m < r.mesh_load.size() ? r.mesh_load[m][c] : 0.0; }), {}, {}});
       finish_series(run, run.mesh_load.back());
     }
   }
+}
+
+/// The belt_loop part that carries `mesh` round its path, or nullptr.
+const MotionPart* belt_loop_of(const MeshWall& mesh) {
+  for (const MotionPart& part : mesh.motion.parts)
+    if (part.kind == MotionPart::Kind::belt_loop) return &part;
+  return nullptr;
+}
+
+/// Whether two belt_loop parts run on one loop (the same pulleys, radius and speed).
+bool same_loop(const MotionPart* a, const MotionPart* b) {
+  return a && b && a->lower == b->lower && a->upper == b->upper && a->axis == b->axis && a->radius == b->radius && a->speed == b->speed;
+}
+
+/// The moving meshes grouped by drive: each on its own, except the meshes carried round one belt
+/// loop (the buckets of an elevator), which one chain drives.
+std::vector<std::vector<std::size_t>> drive_groups(const Model& model) {
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+    if (drive_kind(model.meshes[m]) == DriveKind::fixed) continue;
+    const MotionPart* loop = belt_loop_of(model.meshes[m]);
+    const auto joined = std::find_if(groups.begin(), groups.end(), [&](const std::vector<std::size_t>& g) {
+      return same_loop(loop, belt_loop_of(model.meshes[g.front()]));
+    });
+    if (joined != groups.end())
+      joined->push_back(m);
+    else
+      groups.push_back({m});
+  }
+  return groups;
+}
+
+/// The drive of the meshes `group`: its name, and per row its effort (pull or shaft torque), its
+/// power and its check power, each summed over the group and finished as a series.
+Drive drive_series(const AnalysisInput& input, const RunAnalysis& run, const std::vector<std::size_t>& group) {
+  const Model& model = input.model;
+  const std::vector<Scalars>& rows = input.rows;
+  Drive d;
+  d.meshes = group;
+  const MeshWall& first = model.meshes[group.front()];
+  d.kind = drive_kind(first);
+  d.name = group.size() == 1 ? first.name : fmt::format("{} to {}", first.name, model.meshes[group.back()].name);
+  if (group.size() > 1) d.note = fmt::format("{} meshes carried round one belt loop", group.size());
+  d.at_end = drive_geometry(first, run.t_end);
+  std::vector<double> effort(rows.size(), 0.0), power(rows.size(), 0.0), check(rows.size(), 0.0), speed(rows.size(), 0.0);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    speed[i] = std::abs(drive_geometry(first, rows[i].time).speed);
+    for (std::size_t m : group) {
+      const std::array<double, 6> load = m < rows[i].mesh_load.size() ? rows[i].mesh_load[m] : std::array<double, 6>{};
+      const DriveReading r = drive_reading(drive_geometry(model.meshes[m], rows[i].time), load);
+      effort[i] += r.effort, check[i] += r.check_power, power[i] += at(rows[i].mesh_power, m);
+    }
+  }
+  const bool rotating = d.kind == DriveKind::rotating;
+  d.effort = {fmt::format("drive {} {}", rotating ? "torque" : "pull", d.name), rotating ? "N m" : "N", std::move(effort), {}, {}};
+  d.power = {"drive power " + d.name, "W", std::move(power), {}, {}};
+  d.check = {fmt::format("drive {} {}", rotating ? "T omega" : "F v", d.name), "W", std::move(check), {}, {}};
+  for (Quantity* q : {&d.effort, &d.power, &d.check}) finish_series(run, *q);
+  d.speed = average_over(run.t, speed, run.run_t0, run.run_t1).mean;
+  return d;
+}
+
+/// The drives of the moving parts (a static mesh has none: it appears in the loads only).
+void find_drives(const AnalysisInput& input, RunAnalysis& run) {
+  for (const std::vector<std::size_t>& group : drive_groups(input.model)) run.drives.push_back(drive_series(input, run, group));
+}
+
+/// drives.csv: per drive its pull or shaft torque, power and check power over the run's interval,
+/// with the standard error of each mean (batch means); nothing without a drive.
+void write_drives_csv(const RunAnalysis& run, const std::string& report_dir) {
+  if (run.drives.empty()) return;
+  std::string csv = "drive,kind,quantity,unit,mean,std_error,std_dev,samples,t_start_s,t_end_s\n";
+  for (const Drive& d : run.drives) {
+    const std::pair<const char*, const Quantity*> rows[3] = {
+        {d.kind == DriveKind::rotating ? "shaft_torque" : "pull", &d.effort}, {"power", &d.power}, {"check_power", &d.check}};
+    for (const auto& [quantity, q] : rows) {
+      const IntervalStats& s = q->at_run;
+      csv += fmt::format("\"{}\",{},{},{},{:.6g},{:.6g},{:.6g},{},{:.6g},{:.6g}\n", d.name, key(drive_kind_name(d.kind)), quantity, q->unit,
+                         s.mean, s.std_error, s.std_dev, s.samples, run.run_t0, run.run_t1);
+    }
+  }
+  write_file_atomically((fs::path(report_dir) / "drives.csv").string(), csv);
 }
 
 /// The run's first arrivals, in the order they happened.
@@ -327,53 +408,94 @@ void events_in_order(const AnalysisInput& input, RunAnalysis& run) {
   std::stable_sort(run.events.begin(), run.events.end(), [](const RunEvent& a, const RunEvent& b) { return a.step < b.step; });
 }
 
-// ---- wear per triangle ----------------------------------------------------------------
+// ---- wear per triangle and liner life -----------------------------------------------------
 
-/// Per mesh its wear totals, and the 10 triangles with the highest shear power per area.
+/// The throughput [t/h] the wear per million tonnes is taken against: the primary flow (the
+/// intended outlets, else the plane sensors) over the run's interval, else the design capacity
+/// or the inlets' feed rate; NaN without any.
+void find_wear_throughput(RunAnalysis& run) {
+  const Quantity& primary = run.primary;
+  if (primary.unit == "t/h" && primary.at_run.mean > 0) {
+    run.wear_throughput = primary.at_run.mean;
+    run.wear_throughput_text = fmt::format("{}, mean over {}{}", primary.name, run.interval_text, run.steady ? "" : " (not steady)");
+  } else if (!std::isnan(run.capacity) && run.capacity > 0) {
+    run.wear_throughput = run.capacity;
+    run.wear_throughput_text = fmt::format("{} ({})", run.capacity_label, run.capacity_source);
+  }
+}
+
+/// Triangle `tri` of mesh m: its centroid (at the mesh's pose at t = 0), its wear inputs per
+/// area over the recording interval [s] and, with a liner, its depth rate by sliding and impact
+/// together, also in mm/year at `hours` [h] a year.
+Hotspot triangle_wear(const MeshWall& mesh, const Pose& pose, const TriangleRecords& rec, std::size_t m, std::size_t tri,
+                      double record_time, const std::optional<Liner>& liner, double hours) {
+  const TriangleSurface& surface = *mesh.surface;
+  Hotspot h;
+  h.mesh = m, h.triangle = tri, h.area = surface.areas[tri];
+  Eigen::Vector3d c(0, 0, 0);
+  for (int v = 0; v < 3; ++v) {
+    const auto& p = surface.vertices[surface.triangles[tri][v]];
+    c += Eigen::Vector3d(p[0], p[1], p[2]) / 3.0;
+  }
+  h.centroid = pose.rotation * c + pose.translation;
+  h.shear_rate = rec.shear_work[tri] / (h.area * record_time);
+  h.impact_rate = at(rec.impact_energy, tri) / (h.area * record_time);
+  h.impacts_rate = at(rec.impacts, tri) / (h.area * record_time);
+  if (liner) {
+    // Depth rate [m/s] = k_s q_shear + K_i q_impact, coefficients [m^3/J] times powers per area [W/m^2].
+    h.wear_rate = total_rate(depth_rate(liner->sliding_coefficient, rec.shear_work[tri], h.area, record_time),
+                             depth_rate(liner->impact_coefficient, at(rec.impact_energy, tri), h.area, record_time));
+    h.wear_mm_per_year = mm_per_year(h.wear_rate, hours);
+  }
+  return h;
+}
+
+/// Mesh m: its wear totals, its triangles as candidate hot spots, and its liner's worst
+/// triangle (the highest depth rate) and mean (its wear spread over its area).
+void mesh_wear_and_life(const AnalysisInput& input, RunAnalysis& run, std::size_t m) {
+  const MeshWall& mesh = input.model.meshes[m];
+  const TriangleRecords& rec = input.state.records[m];
+  const double record_time = run.record_time, hours = run.operating_hours;  // [s], [h]
+  const std::optional<Liner> liner = liner_of(input.in, mesh.name);
+  const Pose pose = mesh.motion.pose(0.0);
+  MeshWear& w = run.mesh_wear[m];
+  if (liner) w.has_liner = true, w.liner = *liner, w.k = liner->sliding_coefficient;
+  std::optional<Hotspot> worst;
+  for (std::size_t tri = 0; tri < mesh.surface->size() && tri < rec.shear_work.size(); ++tri) {
+    if (mesh.surface->areas[tri] <= 0) continue;
+    const Hotspot h = triangle_wear(mesh, pose, rec, m, tri, record_time, liner, hours);
+    w.shear_power += rec.shear_work[tri] / record_time;
+    w.impact_power += at(rec.impact_energy, tri) / record_time;
+    w.area += h.area;
+    w.max_shear = std::max(w.max_shear, h.shear_rate);
+    w.max_impact = std::max(w.max_impact, h.impact_rate);
+    if (!std::isnan(h.wear_rate) && (!worst || h.wear_rate > worst->wear_rate)) worst = h;
+    run.spots.push_back(h);
+  }
+  if (!liner) return;
+  const double throughput = run.wear_throughput;  // [t/h]
+  if (worst) {
+    w.worst = wear_zone(*liner, rec.shear_work[worst->triangle], at(rec.impact_energy, worst->triangle), worst->area, record_time,
+                        hours, throughput);
+    w.worst.triangle = worst->triangle, w.worst.centroid = worst->centroid;
+    w.max_wear = worst->wear_mm_per_year;
+  }
+  w.mean = wear_zone(*liner, w.shear_power * record_time, w.impact_power * record_time, w.area, record_time, hours, throughput);
+}
+
+/// Per mesh its wear totals and its liner's life, and the 10 triangles with the highest shear
+/// power per area.
 void wear_per_triangle(const AnalysisInput& input, RunAnalysis& run) {
   const RunReportInput& in = input.in;
   const Model& model = input.model;
   const State& state = input.state;
-  const double record_time = run.record_time = state.time - in.records_from;  // [s]
+  run.record_time = state.time - in.records_from;  // [s]
+  run.operating_hours = in.operating_hours_per_year, run.operating_hours_given = in.operating_hours_given;
+  find_wear_throughput(run);
+  run.mesh_wear.resize(model.meshes.size());
+  if (run.record_time > 0)
+    for (std::size_t m = 0; m < model.meshes.size() && m < state.records.size(); ++m) mesh_wear_and_life(input, run, m);
   std::vector<Hotspot>& spots = run.spots;
-
-  std::vector<MeshWear>& mesh_wear = run.mesh_wear;
-  mesh_wear.resize(model.meshes.size());
-  if (record_time > 0) {
-    for (std::size_t m = 0; m < model.meshes.size() && m < state.records.size(); ++m) {
-      const MeshWall& mesh = model.meshes[m];
-      const TriangleSurface& surface = *mesh.surface;
-      const TriangleRecords& rec = state.records[m];
-      const Pose pose = mesh.motion.pose(0.0);
-      const auto k_it = in.wear_coefficient.find(mesh.name);
-      MeshWear& w = mesh_wear[m];
-      if (k_it != in.wear_coefficient.end()) w.k = k_it->second;
-      for (std::size_t tri = 0; tri < surface.size() && tri < rec.shear_work.size(); ++tri) {
-        const double area = surface.areas[tri];
-        if (area <= 0) continue;
-        Hotspot h;
-        h.mesh = m, h.triangle = tri, h.area = area;
-        Eigen::Vector3d c(0, 0, 0);
-        for (int v = 0; v < 3; ++v) {
-          const auto& p = surface.vertices[surface.triangles[tri][v]];
-          c += Eigen::Vector3d(p[0], p[1], p[2]) / 3.0;
-        }
-        h.centroid = pose.rotation * c + pose.translation;
-        h.shear_rate = rec.shear_work[tri] / (area * record_time);
-        h.impact_rate = at(rec.impact_energy, tri) / (area * record_time);
-        h.impacts_rate = at(rec.impacts, tri) / (area * record_time);
-        // Archard: wear depth rate = k_A q, k_A [m^3/J] = [m/Pa m], q [W/m^2] -> [m/s].
-        if (!std::isnan(w.k)) h.wear_mm_per_year = w.k * h.shear_rate * 1000.0 * kSecondsPerYear;
-        w.shear_power += rec.shear_work[tri] / record_time;
-        w.impact_power += at(rec.impact_energy, tri) / record_time;
-        w.area += area;
-        w.max_shear = std::max(w.max_shear, h.shear_rate);
-        w.max_impact = std::max(w.max_impact, h.impact_rate);
-        if (!std::isnan(h.wear_mm_per_year)) w.max_wear = std::isnan(w.max_wear) ? h.wear_mm_per_year : std::max(w.max_wear, h.wear_mm_per_year);
-        spots.push_back(h);
-      }
-    }
-  }
   std::sort(spots.begin(), spots.end(), [](const Hotspot& a, const Hotspot& b) { return a.shear_rate > b.shear_rate; });
   if (spots.size() > 10) spots.resize(10);
 }
@@ -445,7 +567,6 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   const Quantity& primary = run.primary;
   const std::vector<Quantity>& plane_sensors = run.plane_sensors;
   const std::vector<Quantity>& power = run.power;
-  const std::vector<Quantity>& torque = run.torque;
   const double capacity = run.capacity;
   const double record_time = run.record_time;
 
@@ -468,13 +589,16 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   double total_power = 0;
   for (std::size_t m = 0; m < power.size(); ++m) {
     metric("power_" + model.meshes[m].name + "_W", power[m].at_run.mean);
-    metric("torque_" + model.meshes[m].name + "_N_m", torque[m].at_run.mean);
     total_power += power[m].at_run.mean;
     // The magnitude of the mean force, not the mean of the magnitude (which noise inflates).
     const double fx = run.mesh_load[6 * m].at_run.mean, fy = run.mesh_load[6 * m + 1].at_run.mean, fz = run.mesh_load[6 * m + 2].at_run.mean;
     metric("force_" + model.meshes[m].name + "_N", std::sqrt(fx * fx + fy * fy + fz * fz));
   }
   if (!power.empty()) metric("power_total_W", total_power);
+  for (const Drive& d : run.drives) {
+    metric("drive_" + d.name + "_power_W", d.power.at_run.mean);
+    metric("drive_" + d.name + (d.kind == DriveKind::rotating ? "_torque_N_m" : "_pull_N"), d.effort.at_run.mean);
+  }
   if (!model.meshes.empty() && record_time > 0) {
     double max_shear = 0, max_impact = 0, max_wear = kNaN;
     for (const MeshWear& w : run.mesh_wear) {
@@ -484,6 +608,7 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
     metric("shear_power_max_W_m2", max_shear);
     metric("impact_power_max_W_m2", max_impact);
     if (!std::isnan(max_wear)) metric("wear_rate_max_mm_yr", max_wear);
+    add_liner_metrics(run, model);
   }
   for (const BoxResult& b : run.boxes) {
     metric("centring_offset_" + b.name + "_pct", b.width > 0 ? 100 * b.offset.at_run.mean / (1000 * b.width) : kNaN);
@@ -500,10 +625,91 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
 
 }  // namespace
 
+const char* drive_kind_name(DriveKind kind) {
+  switch (kind) {
+    case DriveKind::belt: return "belt";
+    case DriveKind::rotating: return "rotating part";
+    case DriveKind::path: return "carried on a path";
+    case DriveKind::fixed: break;
+  }
+  return "static";
+}
+
+DriveKind drive_kind(const MeshWall& mesh) {
+  if (!mesh.motion.is_static()) {
+    for (const MotionPart& part : mesh.motion.parts)
+      if (part.kind == MotionPart::Kind::rotation && part.angular_speed != 0) return DriveKind::rotating;
+    return DriveKind::path;
+  }
+  const SurfaceVelocitySpec& surface = mesh.surface_velocity;
+  if (surface.kind == SurfaceVelocitySpec::Kind::linear && surface.velocity.norm() > 0) return DriveKind::belt;
+  if (surface.kind == SurfaceVelocitySpec::Kind::rotation && surface.angular_speed != 0) return DriveKind::rotating;
+  return DriveKind::fixed;
+}
+
+DriveGeometry drive_geometry(const MeshWall& mesh, double time) {
+  DriveGeometry g;
+  g.kind = drive_kind(mesh);
+  const RigidVelocity motion = mesh.motion.velocity(time);
+  g.origin = motion.origin;
+  const SurfaceVelocitySpec& surface = mesh.surface_velocity;
+  if (g.kind == DriveKind::belt) {
+    g.speed = surface.velocity.norm();
+    g.direction = surface.velocity / g.speed;
+  } else if (g.kind == DriveKind::rotating && mesh.motion.is_static()) {
+    // A turning surface on a mesh at rest (a pulley): its own axis, not the motion origin.
+    g.direction = (surface.angular_speed < 0 ? -1.0 : 1.0) * surface.axis.normalized();
+    g.axis_point = surface.point;
+    g.speed = std::abs(surface.angular_speed);
+  } else if (g.kind == DriveKind::rotating) {
+    // A turning mesh (a screw, a drum): the first rotation part's axis, through its `point`,
+    // which is the motion origin (Motion::velocity).
+    for (const MotionPart& part : mesh.motion.parts)
+      if (part.kind == MotionPart::Kind::rotation) {
+        g.direction = (part.angular_speed < 0 ? -1.0 : 1.0) * part.axis.normalized();
+        break;
+      }
+    g.axis_point = motion.origin;
+    g.speed = motion.angular.dot(g.direction);
+  } else if (g.kind == DriveKind::path) {
+    // Along the path: the velocity of the carried frame's origin (a bucket's attachment).
+    g.speed = motion.linear.norm();
+    if (g.speed > 0) g.direction = motion.linear / g.speed;
+  }
+  return g;
+}
+
+double belt_pull(const Eigen::Vector3d& force_on_belt, const Eigen::Vector3d& direction) { return -force_on_belt.dot(direction); }
+
+double torque_about_axis(const Eigen::Vector3d& torque_about_origin, const Eigen::Vector3d& force, const Eigen::Vector3d& origin,
+                         const Eigen::Vector3d& axis_point, const Eigen::Vector3d& axis) {
+  // Moving the reference point from o to p: T_p = sum (x - p) x F_i = T_o - (p - o) x F.
+  return (torque_about_origin - (axis_point - origin).cross(force)).dot(axis);
+}
+
+DriveReading drive_reading(const DriveGeometry& drive, const std::array<double, 6>& load) {
+  const Eigen::Vector3d force(load[0], load[1], load[2]), torque(load[3], load[4], load[5]);
+  DriveReading r;
+  if (drive.kind == DriveKind::belt || drive.kind == DriveKind::path) {
+    r.effort = belt_pull(force, drive.direction);
+  } else if (drive.kind == DriveKind::rotating) {
+    // The material's torque on the part about its axis opposes the turning when it resists:
+    // the shaft must supply its negative.
+    r.effort = -torque_about_axis(torque, force, drive.origin, drive.axis_point, drive.direction);
+  }
+  // Rate of work on the material: sum F_i . v_wall = F_t v for a belt whose surfaces contain its
+  // direction of travel, and -omega . T_axis = T omega for a part turning about a fixed axis.
+  r.check_power = r.effort * drive.speed;
+  return r;
+}
+
 std::vector<const Quantity*> RunAnalysis::all() const {
   std::vector<const Quantity*> out{&primary};
-  for (const auto* group : {&outlets, &plane_sensors, &power, &torque, &mesh_load})
+  for (const auto* group : {&outlets, &plane_sensors})
     for (const Quantity& q : *group) out.push_back(&q);
+  // The drives' series; the meshes' own power is left out (a static mesh does no work).
+  for (const Drive& d : drives) out.push_back(&d.effort), out.push_back(&d.power);
+  for (const Quantity& q : mesh_load) out.push_back(&q);
   // A plane's particle flux; not its velocities, whose mean is weighted by the mass flow (the page).
   for (std::size_t k = 0; k < plane_detail.size(); k += 4) out.push_back(&plane_detail[k]);
   for (const BoxResult& b : boxes) out.push_back(&b.offset), out.push_back(&b.mass);
@@ -526,7 +732,8 @@ RunAnalysis analyse_run(const RunReportInput& in) {
   plane_sensor_detail(input, run);
   spillage_and_blockage(input, run);
   design_capacity(input, run);
-  power_and_torque(input, run);
+  mesh_loads_and_power(input, run);
+  find_drives(input, run);
   events_in_order(input, run);
   wear_per_triangle(input, run);
   belt_loading(input, run);
@@ -568,6 +775,8 @@ void write_run_tables(const RunAnalysis& run, const Model& model, const std::str
     write_file_atomically((fs::path(report_dir) / "wear_hotspots.csv").string(), hot);
     write_metrics(metrics, (fs::path(report_dir) / "metrics.csv").string());
   }
+  write_drives_csv(run, report_dir);
+  write_wear_life_csv(run, model, report_dir);
 
 }
 

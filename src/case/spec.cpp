@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 
+#include "case/liner_materials.h"
 #include "case/spec_reading.h"
 #include "case/yaml_check.h"
 
@@ -256,6 +257,52 @@ void read_wear_coefficients(MapReader& top, const std::string& file, CaseSpec& s
   }
 }
 
+/// One entry of `wear.liners`: its material from the liner-material table, its thickness, and
+/// the material's coefficients unless the entry gives its own.
+LinerSpec read_liner(MapReader& liners, const std::string& name, const std::string& file) {
+  const std::vector<std::string> materials = liner_material_keys();
+  std::string words;
+  for (const std::string& m : materials) words += (words.empty() ? "" : ", ") + m;
+  const YAML::Node node = liners.node(name);
+  if (!node.IsMap()) liners.fail(name, "must be a map, e.g. {material: ar400, thickness_mm: 20}");
+  MapReader entry(node, file, liners.key_path(name));
+  LinerSpec liner;
+  liner.location = entry.location();
+  liner.material = entry.required_string("material", "give the liner's material, one of: " + words, materials);
+  const LinerMaterial& material = *find_liner_material(liner.material);
+  liner.thickness = 1e-3 * entry.required_number("thickness_mm", 0.1, 1000.0, "mm");
+  liner.sliding_coefficient = entry.number("sliding_coefficient", material.sliding_coefficient, 0.0, 1e-6, "m^3/J");
+  liner.impact_coefficient = entry.number("impact_coefficient", material.impact_coefficient, 0.0, 1e-6, "m^3/J");
+  entry.finish();
+  return liner;
+}
+
+/// `wear`: the hours of operation a year and the liner of each mesh (or `default`).
+void read_wear(MapReader& top, const std::string& file, CaseSpec& spec) {
+  const YAML::Node node = top.node("wear");
+  if (!node) return;
+  MapReader wear(node, file, "wear");
+  spec.wear.hours_given = wear.has("operating_hours_per_year");
+  spec.wear.operating_hours_per_year =
+      wear.number("operating_hours_per_year", kDefaultOperatingHoursPerYear, 1.0, kHoursInALeapYear, "h");
+  if (const YAML::Node liners = wear.node("liners")) {
+    MapReader map(liners, file, "wear.liners");
+    map.keys_are_names("MESH");  // a mesh name, or `default`
+    for (const std::string& name : map.keys()) spec.wear.liners[name] = read_liner(map, name, file);
+  }
+  wear.finish();
+}
+
+/// A mesh's sliding coefficient is given once: in `wear_coefficients` (the older form) or with
+/// its liner in `wear.liners`.
+void refuse_two_wear_rates(const MapReader& top, const CaseSpec& spec) {
+  for (const auto& [name, liner] : spec.wear.liners)
+    if (spec.wear_coefficients.count(name))
+      throw CaseError(fmt::format("{}: wear_coefficients.{}: '{}' also has a liner in wear.liners (line {}); give one of them: "
+                                  "the liner's own `sliding_coefficient` replaces this value",
+                                  top.where("wear_coefficients").str(), name, name, liner.location.line));
+}
+
 CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   MapReader top(root, file, "");
   CaseSpec spec;
@@ -274,6 +321,8 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   refuse_duplicate_part_names(spec);
   if (const YAML::Node equipment = top.node("equipment")) spec.equipment = read_equipment(equipment, file);
   read_wear_coefficients(top, file, spec);
+  read_wear(top, file, spec);
+  refuse_two_wear_rates(top, spec);
   top.node("sweep");  // read by the sweep runner (app/campaign/sweep.cpp) before the variants are parsed
   top.node("uncertainty");  // likewise (app/campaign/uncertainty.h)
   top.node("bias_check");   // likewise (app/campaign/bias_check.h)

@@ -295,6 +295,29 @@ struct OutputSpec {
   int render_width = 1280, render_height = 720;  // [px]
 };
 
+/// [h] Hours of operation a year when a case gives none (`wear.operating_hours_per_year`): about
+/// two shifts a day, 250 days a year; the report states it as an assumption.
+constexpr double kDefaultOperatingHoursPerYear = 6000.0;
+/// [h] The most hours a year has (a leap year, 366 x 24).
+constexpr double kHoursInALeapYear = 8784.0;
+
+/// The liner of one mesh, or of every mesh without its own (`wear.liners.default`).
+struct LinerSpec {
+  std::string material;             ///< a key of the liner-material table (case/liner_materials.h)
+  double thickness = 0;             ///< [m] wearable thickness (`thickness_mm` / 1000)
+  double sliding_coefficient = 0;   ///< [m^3/J] volume per friction work: the material's unless given
+  double impact_coefficient = 0;    ///< [m^3/J] volume per normal impact energy: the material's unless given
+  SourceLocation location;          ///< of the entry
+};
+
+/// `wear`: how long the plant runs a year and what lines each mesh, for the liner life.
+struct WearSpec {
+  double operating_hours_per_year = kDefaultOperatingHoursPerYear;  ///< [h]
+  bool hours_given = false;  ///< false: the default, which the report states as an assumption
+  /// Per mesh name, or "default" for every mesh without its own that has no surface velocity.
+  std::map<std::string, LinerSpec> liners;
+};
+
 struct CaseSpec {
   std::string path;  ///< the file it was read from ("<inline>" for text)
   std::string title;
@@ -315,9 +338,12 @@ struct CaseSpec {
   std::vector<std::pair<std::string, double>> design;
   /// Render camera preset suggested by the equipment ("" when none).
   std::string equipment_camera;
-  /// Archard specific wear rate k/H [m^3/J] of the liner of each named mesh (`wear_coefficients:
-  /// {hood: 2.0e-13, default: 1.0e-13}`; "default" applies to meshes not named).
+  /// Sliding wear coefficient [m^3/J] (volume per friction work) of each named mesh
+  /// (`wear_coefficients: {hood: 2.0e-13, default: 1.0e-13}`; "default" applies to meshes not
+  /// named that have no surface velocity). The older form of a liner with no material, no
+  /// thickness and no impact wear; a name is in this map or in wear.liners, not both.
   std::map<std::string, double> wear_coefficients;
+  WearSpec wear;  ///< operating hours and liners (`wear:`)
   OutputSpec output;
 };
 

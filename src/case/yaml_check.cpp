@@ -256,9 +256,9 @@ std::string MapReader::read_string(const std::string& key, const std::string& fa
   return value;
 }
 
-std::string MapReader::required_string(const std::string& key, const std::string& what) {
-  record(key, "text", true, "");
-  const std::string value = read_string(key, "", {});
+std::string MapReader::required_string(const std::string& key, const std::string& what, const std::vector<std::string>& allowed) {
+  record(key, allowed.empty() ? "text" : "word", true, "", {}, {}, "", allowed);
+  const std::string value = read_string(key, "", allowed);
   if (value.empty()) fail(key, "missing: " + what);
   return value;
 }

@@ -71,8 +71,9 @@ class MapReader {
   double required_number(const std::string& key, double min, double max, std::string_view unit = "");
   int64_t integer(const std::string& key, int64_t fallback, int64_t min, int64_t max);
   bool boolean(const std::string& key, bool fallback);
-  /// A string that must be given; `what` says what it should name.
-  std::string required_string(const std::string& key, const std::string& what);
+  /// A string that must be given; `what` says what it should name. When `allowed` is not empty
+  /// it must be one of them.
+  std::string required_string(const std::string& key, const std::string& what, const std::vector<std::string>& allowed = {});
   /// A string; when `allowed` is not empty it must be one of them.
   std::string string(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed = {});
   Vec3 vec3(const std::string& key, const Vec3& fallback);

@@ -320,6 +320,24 @@ void add_mesh_walls(const CaseSpec& spec, const MeshLoader& loader, Model& model
   }
 }
 
+/// Every entry of `wear.liners` but `default` names a mesh: a misspelt name would leave its mesh
+/// on the default liner without a word, and the run's report comes only after the run.
+void check_liner_names(const CaseSpec& spec, const Model& model) {
+  for (const auto& entry : spec.wear.liners) {
+    // Named references, not structured bindings: clang 14 (the fuzz build) cannot capture those.
+    const std::string& name = entry.first;
+    const LinerSpec& liner = entry.second;
+    const auto named = [&name](const MeshWall& m) { return m.name == name; };
+    if (name == "default" || std::any_of(model.meshes.begin(), model.meshes.end(), named)) continue;
+    std::vector<std::string> names;
+    std::string list;
+    for (const MeshWall& m : model.meshes) names.push_back(m.name), list += (list.empty() ? "" : ", ") + m.name;
+    const std::string hint = nearest_word(name, names);
+    throw CaseError(fmt::format("{}: wear.liners.{}: no mesh is named '{}'{}; meshes of this case: {}, or `default`", liner.location.str(),
+                                name, name, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list.empty() ? "none" : list));
+  }
+}
+
 /// Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
 void add_clump_templates(const CaseSpec& spec, Model& model) {
   for (const ClumpTemplateSpec& clump : spec.clumps) {
@@ -605,6 +623,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   // Walls, clump templates, particles and what enters, leaves and measures them.
   add_plane_walls(spec, model);
   add_mesh_walls(spec, loader, model);
+  check_liner_names(spec, model);
   add_clump_templates(spec, model);
   add_particle_sources(spec, model);
   check_particle_counts(spec);
