@@ -93,4 +93,26 @@ TEST(CommandLineFuzz, RandomArgumentVectorsGetAnAnswerNeverACrash) {
   fs::remove_all(cwd);
 }
 
+// compare-runs through the real binary: two report folders of the smallest kind give 0 and the
+// page; a folder no run wrote gives 2 and writes nothing (tests/test_compare_runs.cpp has the numbers).
+TEST(CompareRunsCommand, ComparesTwoRunFoldersAndRefusesAMissingOne) {
+  const fs::path dir = fs::temp_directory_path() / ("demdesign_cli_compare_runs_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  for (const char* run : {"a", "b"}) {
+    fs::create_directories(dir / run / "report");
+    std::FILE* steady = std::fopen((dir / run / "report" / "steady_state.csv").c_str(), "w");
+    std::fputs("series,unit,found,t_start_s,t_end_s,mean,std_dev,std_error,trend_per_s,why\n\"outlet bin\",t/h,1,1,4,100,9,3,0,\"\"\n", steady);
+    std::fclose(steady);
+    std::FILE* metrics = std::fopen((dir / run / "report" / "metrics.csv").c_str(), "w");
+    std::fputs("name,value\nsteady,1\nthroughput_t_h,100\n", metrics);
+    std::fclose(metrics);
+  }
+  EXPECT_EQ(run_for({"compare-runs", (dir / "a").string(), (dir / "b").string()}, dir, 30.0), 0);
+  EXPECT_TRUE(fs::exists(dir / "compare_a_b" / "compare.html")) << "the default folder lies beside A";
+  EXPECT_TRUE(fs::exists(dir / "compare_a_b" / "compare.csv"));
+  EXPECT_EQ(run_for({"compare-runs", (dir / "never_run").string(), (dir / "b").string(), "--out", (dir / "refused").string()}, dir, 30.0), 2);
+  EXPECT_FALSE(fs::exists(dir / "refused"));
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -4,6 +4,7 @@
 //   demdesign check CASE.yaml      read and compile a case, print its set-up, run nothing
 //   demdesign check-mesh FILE...   import, check and repair meshes, print their health reports
 //   demdesign render OUT           images of a run's saved frames
+//   demdesign compare-runs A B     two finished runs side by side, figure by figure
 //   demdesign effects              the table of contact effects and their parameters
 //   demdesign materials            the material library
 //   demdesign keys [--markdown]    every key of case, material and measurement files (docs/case-keys.md)
@@ -38,6 +39,7 @@
 #include "mpi/mpi_frames.h"
 #include "output/results_hdf5.h"
 #include "output/run.h"
+#include "report/compare_runs.h"
 #include "report/report.h"
 #include "report/report_wear.h"
 #include "statistics/diagnostics.h"
@@ -460,6 +462,8 @@ struct CommandLine {
   dem::app::ImageOptions render_options;
   bool render_video = false;
   CLI::App* render_cmd = nullptr;
+  std::string compare_a, compare_b, compare_out;  ///< compare-runs A B --out DIR
+  CLI::App* compare_runs_cmd = nullptr;
   CLI::App* effects_cmd = nullptr;
   CLI::App* materials_cmd = nullptr;
   bool keys_markdown = false;
@@ -522,6 +526,12 @@ void add_case_tools(CLI::App& app, CommandLine& line) {
   line.render_cmd->add_flag("--video", line.render_video, "also encode the rendered frames as renders/flow.mp4 (needs ffmpeg)");
   line.render_cmd->add_option("--width", line.render_options.width, "[px]")->check(dem::app::whole_in(16, 8192));
   line.render_cmd->add_option("--height", line.render_options.height, "[px]")->check(dem::app::whole_in(16, 8192));
+  line.compare_runs_cmd = app.add_subcommand("compare-runs", "compare two finished runs (design variants, or one design before and "
+                                                              "after a change) figure by figure: A and B with their standard errors, "
+                                                              "B - A and the difference in standard errors (compare.html, compare.csv)");
+  line.compare_runs_cmd->add_option("A", line.compare_a, "output folder of the first run (the reference)")->required();
+  line.compare_runs_cmd->add_option("B", line.compare_b, "output folder of the second run")->required();
+  line.compare_runs_cmd->add_option("--out", line.compare_out, "output folder (default: beside A, compare_A_B)");
 }
 
 /// The reference commands: effects, materials, keys, validate.
@@ -583,6 +593,7 @@ int run_command(CLI::App& app, const CommandLine& line, dem::app::CalibrationCom
   if (line.check_cmd->parsed()) return check_case(line.check_path);
   if (line.mesh_cmd->parsed()) return dem::geometry::check_mesh_command(line.mesh_files, line.mesh_options, line.mesh_particle_diameter, std::cout);
   if (line.render_cmd->parsed()) return render_results(line.render_out, line.render_frame, line.render_options, line.render_video);
+  if (line.compare_runs_cmd->parsed()) return dem::report::compare_runs_command(line.compare_a, line.compare_b, line.compare_out, std::cout);
   if (line.run.case_path.empty()) {
     std::cout << app.help();
     return 2;

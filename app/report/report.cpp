@@ -509,6 +509,53 @@ std::string wear(const Page& page) {
   return h;
 }
 
+/// What the capacity table states: the CEMA cross-section, the capacity, the throughput and the verdicts.
+std::string belt_capacity_intro(const Page& page) {
+  return fmt::format(
+      "<p>The belt&#39;s capacity from the CEMA load cross-section of a belt on three equal-length troughing rolls (CEMA, <i>Belt "
+      "Conveyors for Bulk Materials</i>, 7th ed., ch. 4): the standard edge distance c = 0.055 b + 0.9 in (0.0229 m) is left clear "
+      "on each side, the belt on the centre roll is l = 0.371 b + 0.25 in, the load fills the trapezoid on the rolls troughed at "
+      "&beta; up to its edges and above them a circular-arc segment meeting the edges at the surcharge angle &theta; (a flat belt: "
+      "the segment alone). Capacity = A v &rho; &times; 3.6 (A v &rho; in kg/s; 1 kg/s = 3.6 t/h) at the belt speed v and the bulk "
+      "density &rho;. Throughput: the run&#39;s flow onto the belt over {} ({}) &plusmn; the standard error of the mean, in tonnes "
+      "of the real material (divided by the mass scaling). Loading = throughput / capacity: &le; 80 % fine (CEMA&#39;s usual "
+      "design factor, room for surges and mistracking), 80&ndash;100 % near full, above 100 % overloaded: the load overtops the "
+      "surcharge profile and spillage is expected. Values marked <i>assumed</i> are defaults the case does not state. Also in "
+      "belt_capacity.csv.</p>\n",
+      page.run.interval_text, page.run.steady ? "the steady state" : "the last third of the run: no steady state");
+}
+
+/// The receiving belts against their CEMA capacity: one row per belt, then where each input came
+/// from ("" without a belt speed at any load box).
+std::string belt_capacity_table(const Page& page) {
+  const std::vector<BeltCapacity>& belts = page.run.belts;
+  if (belts.empty()) return "";
+  const auto assumed = [](const std::string& value, bool is_assumed) { return is_assumed ? value + " <i>(assumed)</i>" : value; };
+  std::string rows, sources;
+  for (const BeltCapacity& b : belts) {
+    if (!b.missing.empty()) {
+      sources += fmt::format("<li><b>{}</b> ({}): no capacity, {}.</li>\n", esc(b.belt), esc(b.sensor), esc(b.missing));
+      continue;
+    }
+    rows += table_row({esc(b.belt) + " (" + esc(b.sensor) + ")", num(b.width, 3), num(b.troughing, 3), assumed(num(b.surcharge, 3), b.surcharge_assumed),
+                       assumed(num(b.bulk_density, 4), b.bulk_density_assumed), num(b.speed, 3), num(b.section.area, 4), num(b.capacity, 4),
+                       std::isnan(b.throughput) ? "&ndash;" : pm(b.throughput, b.throughput_error), std::isnan(b.loading) ? "&ndash;" : pm(b.loading, b.loading_error, 3),
+                       loading_verdict_text(b.verdict)});
+    sources += fmt::format("<li><b>{}</b>: width from the {}; troughing from the {}; surcharge angle {}; bulk density of {} {}; speed from the {}; "
+                           "throughput: {}.</li>\n",
+                           esc(b.belt), esc(b.width_source), esc(b.troughing_source), esc(b.surcharge_source), esc(b.material), esc(b.bulk_density_source),
+                           esc(b.speed_source), esc(b.throughput_source.empty() ? "none (no plane sensor across the belt and no outlet)" : b.throughput_source));
+  }
+  std::string h = "<h3>Belt loading against capacity</h3>\n" + belt_capacity_intro(page);
+  if (!rows.empty())
+    h += "<table>\n" +
+         table_row({"belt (load box)", "width b [m]", "troughing &beta; [&deg;]", "surcharge &theta; [&deg;]", "bulk density &rho; [kg/m&sup3;]",
+                    "belt speed v [m/s]", "CEMA area A [m&sup2;]", "CEMA capacity [t/h]", "throughput [t/h]", "loading [%]", "verdict"},
+                   true) +
+         rows + "</table>\n";
+  return h + "<ul>\n" + sources + "</ul>\n";
+}
+
 /// Belt loading at the box sensors: the table and the plot of the centring offset ("" without box sensors).
 std::string belt_loading(const Page& page) {
   const std::vector<BoxResult>& boxes = page.run.boxes;
@@ -528,6 +575,7 @@ std::string belt_loading(const Page& page) {
                     std::isnan(b.belt_speed) ? "&ndash;" : num(b.belt_speed, 3) + " (" + esc(b.belt_name) + ")",
                     std::isnan(b.belt_speed) || b.belt_speed == 0 ? "&ndash;" : num(b.along / b.belt_speed, 3)});
   h += "</table>\n";
+  h += belt_capacity_table(page);
   plot::Plot p;
   p.title = "Centring offset of the load";
   p.x_label = "time [s]";
@@ -665,7 +713,8 @@ std::string reproducibility(const Page& page) {
 /// The list of the files beside the report, and the end of the page.
 std::string page_foot() {
   return "<p class=\"note\">Files beside this report: metrics.csv, steady_state.csv, drives.csv (with moving parts), "
-         "mesh_loads.csv (with meshes), wear_hotspots.csv, wear_life.csv (with meshes), plots/*.png with their data "
+         "mesh_loads.csv (with meshes), wear_hotspots.csv, wear_life.csv (with meshes), belt_capacity.csv (with a belt&#39;s "
+         "capacity), plots/*.png with their data "
          "(*.tsv) and gnuplot scripts (*.gp).</p>\n</body></html>\n";
 }
 

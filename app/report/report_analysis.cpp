@@ -2,7 +2,8 @@
 // run's interval, the mass balance, spillage and blockage, the drives and the loads, wear per triangle,
 // belt loading and the metrics; and the report's tables (steady_state.csv, mesh_loads.csv,
 // drives.csv, wear_hotspots.csv, wear_life.csv, metrics.csv). report.cpp draws the plots and
-// writes report.html. The liner life (depth rates, months, mm/Mt) is report_wear.cpp's.
+// writes report.html. The liner life (depth rates, months, mm/Mt) is report_wear.cpp's; the
+// receiving belts against their CEMA capacity (belt_capacity.csv) are belt_capacity.cpp's.
 #include "report/report_analysis.h"
 
 #include <fmt/format.h>
@@ -620,6 +621,7 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
       metric("speed_mismatch_" + b.name + "_pct", 100 * std::abs(1 - b.along / b.belt_speed));
     }
   }
+  add_belt_capacity_metrics(run);
   metric("kinetic_energy_J", run.kinetic.at_run.mean);
 }
 
@@ -737,6 +739,7 @@ RunAnalysis analyse_run(const RunReportInput& in) {
   events_in_order(input, run);
   wear_per_triangle(input, run);
   belt_loading(input, run);
+  find_belt_capacities(in, run);
   other_series(input, run);
   add_metrics(input, run);
   return run;
@@ -777,6 +780,7 @@ void write_run_tables(const RunAnalysis& run, const Model& model, const std::str
   }
   write_drives_csv(run, report_dir);
   write_wear_life_csv(run, model, report_dir);
+  write_belt_capacity_csv(run, report_dir);
 
 }
 

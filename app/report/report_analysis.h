@@ -1,9 +1,10 @@
 // The numbers of a run report before they are written (internal to app/): every series of the
 // run with its own steady state and its average over the run's interval, the mass balance,
 // spillage and blockage, the drives of the moving parts and the loads on every mesh, wear per
-// triangle and the liners' life (report_wear.h), belt loading, and the metrics.
-// report_analysis.cpp computes them and writes the report's tables (steady_state.csv,
-// wear_hotspots.csv, wear_life.csv, metrics.csv); report.cpp draws the plots and writes report.html.
+// triangle and the liners' life (report_wear.h), belt loading and the receiving belts against
+// their CEMA capacity (belt_capacity.h), and the metrics. report_analysis.cpp computes them and
+// writes the report's tables (steady_state.csv, wear_hotspots.csv, wear_life.csv,
+// belt_capacity.csv, metrics.csv); report.cpp draws the plots and writes report.html.
 #pragma once
 
 #include <Eigen/Core>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "report/belt_capacity.h"
 #include "report/report.h"
 #include "report/report_internal.h"
 #include "report/report_wear.h"
@@ -165,6 +167,8 @@ struct RunAnalysis {
   double wear_throughput = kNaN;               ///< [t/h] the wear per million tonnes is taken against
   std::string wear_throughput_text;            ///< where that throughput comes from
   std::vector<BoxResult> boxes;
+  /// Per receiving belt with a load box and a speed: its CEMA capacity and the run's loading of it.
+  std::vector<BeltCapacity> belts;
   std::vector<RunEvent> events;                ///< first arrivals, in the order they happened
   Quantity kinetic, particles, holdup_q, contacts;
   RunMetrics metrics;
@@ -175,7 +179,8 @@ struct RunAnalysis {
 /// The numbers of the run report (input.model and input.state are required).
 RunAnalysis analyse_run(const RunReportInput& in);
 /// steady_state.csv, mesh_loads.csv (with meshes), drives.csv (with moving parts),
-/// wear_hotspots.csv, wear_life.csv (with meshes) and metrics.csv into report_dir.
+/// wear_hotspots.csv, wear_life.csv (with meshes), belt_capacity.csv (with a belt's capacity) and
+/// metrics.csv into report_dir.
 void write_run_tables(const RunAnalysis& run, const Model& model, const std::string& report_dir);
 
 }  // namespace dem::report
