@@ -127,6 +127,14 @@ const std::vector<std::pair<std::string, Generator>>& generators() {
   return table;
 }
 
+/// [m] The largest diameter the case's inlets and particle sets draw; 0 when it has none.
+double largest_particle(const CaseSpec& spec) {
+  double largest = 0;
+  for (const InletSpec& inlet : spec.inlets) largest = std::max(largest, inlet.diameter.largest());
+  for (const ParticleSetSpec& set : spec.particles) largest = std::max(largest, set.diameter.largest());
+  return largest;
+}
+
 std::string join(const std::vector<std::string>& words) {
   std::string out;
   for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
@@ -167,6 +175,8 @@ void expand_equipment(CaseSpec& spec) {
       }
     return;
   }
+  // The generators check openings and beds against the largest particle the case feeds.
+  spec.equipment->largest_particle = largest_particle(spec);
   const EquipmentSpec& equipment = *spec.equipment;
   Generated made = generate(equipment);
   const auto clash = [&](const std::string& what, const std::string& name) {

@@ -76,6 +76,13 @@ struct MeshBuilder {
     for (std::int32_t k = 0; k < n; ++k) triangle(c, first + k, first + (k + 1) % n);
   }
 
+  /// Adds the triangles of `other`, its vertices after this builder's (parts built in another frame).
+  void append(const MeshBuilder& other) {
+    const std::int32_t first = static_cast<std::int32_t>(vertices.size());
+    vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
+    for (const auto& t : other.triangles) triangle(first + t[0], first + t[1], first + t[2]);
+  }
+
   /// Moves every vertex: x -> rotation x + shift.
   void transform(const Eigen::Matrix3d& rotation, const Vec3& shift) {
     for (auto& v : vertices) {

@@ -1,8 +1,11 @@
 // Equipment generators without simulation: every generator's defaults make valid meshes; bad
 // parameters name file, line, key path and range; the transfer chute's layout holds over a range
 // of drop heights, hood and spoon radii (the CEMA trajectory meets the hood, the spoon lip lands
-// on the receiving belt); the screw's flight is a helicoid of the given pitch that conveys +x;
-// the bucket elevator's pole distance and discharge type; STL output; expand_equipment.
+// on the receiving belt); plan angle 0 is the inline chute bit for bit, a turned spoon delivers
+// along the receiving belt, centred, and the deck closes an angled chute's two boxes; the rock
+// box's ledge lies under the impact point; the profile spoon's and rock box's checks; the
+// screw's flight is a helicoid of the given pitch that conveys +x; the bucket elevator's pole
+// distance and discharge type; STL output; expand_equipment.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -200,6 +203,303 @@ TEST(TransferChute, LayoutHoldsOverARangeOfDropHeightsAndRadii) {
   // A hood that cannot fit is an error naming the drop height.
   const std::string message = error_of("transfer_chute", "drop_height: 0.4\nhood: {radius: 2}\n");
   EXPECT_NE(message.find("equipment.transfer_chute.drop_height"), std::string::npos) << message;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Angled transfer, rock box, profile spoon
+// ---------------------------------------------------------------------------------------------
+
+/// A transfer chute spec whose case feeds particles up to `largest` [m] across.
+EquipmentSpec chute_with_particles(const std::string& text, double largest) {
+  EquipmentSpec spec = make("transfer_chute", text);
+  spec.largest_particle = largest;
+  return spec;
+}
+
+std::string chute_error(const EquipmentSpec& spec) {
+  try {
+    generate(spec);
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return "";
+}
+
+/// The equipment of cases/angled_transfer.yaml (iron ore, 1,000 t/h, 90 deg, rock box).
+const char* kAngledChute = R"(plan_angle_deg: 90
+drop_height: 3.0
+chute_width: 1.0
+feed_belt: {width: 1.2, speed: 4.0, troughing_angle_deg: 35, length: 4.0, pulley_diameter: 0.8, load_height: 0.15, port_height: 0.35}
+hood: {radius: 1.5}
+rock_box: {height: 0.3, ledge_depth: 0.35}
+spoon: {radius: 1.6, lip_height: 0.25, setback: 0.15, exit_angle_deg: 15}
+receiving_belt: {width: 1.2, speed: 4.5, troughing_angle_deg: 35, length: 4.0, skirt_length: 2.0, skirt_height: 0.4}
+)";
+
+/// A profile spoon (the one of cases/angled_transfer_sweep.yaml) with `shape`.
+std::string profile_spoon(const std::string& shape) {
+  return "spoon: {profile: [[-0.65, 1.35], [-0.62, 1.05], [-0.5, 0.75], [-0.25, 0.48], [0.15, 0.3], [0.6, 0.24]], "
+         "width: 1.0, shape: " + shape + "}\n";
+}
+
+/// The chute of kAngledChute at `angle_deg`, with the arc spoon or a profile spoon of `shape`.
+std::string angled(double angle_deg, const std::string& shape = "") {
+  std::string text = kAngledChute;
+  text.replace(0, text.find('\n'), "plan_angle_deg: " + std::to_string(angle_deg));
+  if (!shape.empty()) text.replace(text.find("spoon: {radius"), text.find("receiving_belt") - text.find("spoon: {radius"), profile_spoon(shape));
+  return text;
+}
+
+/// World point of the receiving frame (x along the receiving belt) turned by the plan angle about
+/// the fall line; written out here, independent of the generator's.
+Vec3 to_world(const TransferChuteLayout& c, const Vec3& local) {
+  const double cos_a = std::cos(c.plan_angle), sin_a = std::sin(c.plan_angle), x = local.x() - c.fall_x;
+  return Vec3(c.fall_x + cos_a * x - sin_a * local.y(), sin_a * x + cos_a * local.y(), local.z());
+}
+Vec3 to_local(const TransferChuteLayout& c, const Vec3& world) {
+  const double cos_a = std::cos(c.plan_angle), sin_a = std::sin(c.plan_angle), x = world.x() - c.fall_x;
+  return Vec3(c.fall_x + cos_a * x + sin_a * world.y(), -sin_a * x + cos_a * world.y(), world.z());
+}
+
+void expect_same_output(const Generated& a, const Generated& b) {
+  ASSERT_EQ(a.meshes.size(), b.meshes.size());
+  for (size_t m = 0; m < a.meshes.size(); ++m) {
+    SCOPED_TRACE(a.meshes[m].name);
+    EXPECT_EQ(a.meshes[m].name, b.meshes[m].name);
+    EXPECT_EQ(a.meshes[m].vertices, b.meshes[m].vertices);  // bit for bit
+    EXPECT_EQ(a.meshes[m].triangles, b.meshes[m].triangles);
+    EXPECT_EQ(a.meshes[m].surface.velocity, b.meshes[m].surface.velocity);
+    EXPECT_EQ(a.meshes[m].material, b.meshes[m].material);
+  }
+  ASSERT_EQ(a.sensors.size(), b.sensors.size());
+  for (size_t k = 0; k < a.sensors.size(); ++k) {
+    EXPECT_EQ(a.sensors[k].point, b.sensors[k].point);
+    EXPECT_EQ(a.sensors[k].normal, b.sensors[k].normal);
+    EXPECT_EQ(a.sensors[k].region_min, b.sensors[k].region_min);
+    EXPECT_EQ(a.sensors[k].region_max, b.sensors[k].region_max);
+  }
+  ASSERT_EQ(a.outlets.size(), b.outlets.size());
+  EXPECT_EQ(a.outlets[0].region_min, b.outlets[0].region_min);
+  EXPECT_EQ(a.outlets[0].region_max, b.outlets[0].region_max);
+  EXPECT_EQ(a.domain_min, b.domain_min);
+  EXPECT_EQ(a.domain_max, b.domain_max);
+  EXPECT_EQ(a.design, b.design);
+  EXPECT_EQ(a.camera, b.camera);
+}
+
+// The inline chute is plan angle 0: the key at 0 changes nothing, bit for bit, and the inline
+// chute keeps its parts and their layout (the code path at 0 is the inline one, untouched).
+TEST(TransferChute, PlanAngleZeroIsTheInlineChute) {
+  const std::string shipped = "drop_height: 1.5\nchute_width: 0.7\nfeed_belt: {width: 0.8, speed: 2.5, troughing_angle_deg: 30, "
+                              "length: 3.0, pulley_diameter: 0.5}\nhood: {radius: 1.0, exit_angle_deg: 5}\nspoon: {radius: 0.8, "
+                              "lip_height: 0.15, setback: 0.25, exit_angle_deg: 15}\nreceiving_belt: {width: 0.8, speed: 3.0, "
+                              "troughing_angle_deg: 30, length: 3.0}\n";
+  const std::string profile = "spoon: {profile: [[-0.2, 0.4], [-0.1, 0.25], [0.3, 0.12]]}\n";
+  for (const std::string& text : {std::string(""), shipped, std::string("rock_box: {}\n"), profile}) {
+    SCOPED_TRACE(text);
+    expect_same_output(generate(make("transfer_chute", text)), generate(make("transfer_chute", text + "plan_angle_deg: 0\n")));
+  }
+  const Generated g = generate(make("transfer_chute", shipped));
+  std::vector<std::string> names;
+  for (const MeshWallSpec& m : g.meshes) names.push_back(m.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"feed_belt", "head_pulley", "hood", "spoon", "side_plates", "receiving_belt", "skirts"}));
+  // The spoon's arc and back plate where the layout puts them, across the chute's width.
+  const TransferChuteLayout c = transfer_chute_layout(make("transfer_chute", shipped));
+  EXPECT_EQ(c.fall_x, c.hood_exit_x);
+  EXPECT_EQ(c.spoon_top_x, c.hood_exit_x - 0.25);
+  for (const auto& v : mesh_named(g, "spoon").vertices) {
+    const bool on_arc = std::abs(std::hypot(v[0] - c.spoon_centre_x, v[2] - c.spoon_centre_z) - c.spoon_radius) < 1e-9;
+    const bool on_back = std::abs(v[0] - c.spoon_top_x) < 1e-12 && v[2] >= c.spoon_top_z - 1e-12 && v[2] <= c.back_plate_top + 1e-12;
+    EXPECT_TRUE(on_arc || on_back) << v[0] << " " << v[2];
+    EXPECT_LE(std::abs(v[1]), 0.35 + 1e-12);
+  }
+  EXPECT_EQ(mesh_named(g, "receiving_belt").surface.velocity, Vec3(3.0, 0, 0));
+  EXPECT_EQ(g.camera, "side");
+  for (const auto& entry : g.design) EXPECT_NE(entry.first, "plan_angle_deg");
+}
+
+/// Mean of the spoon vertices at the lowest and at the next height: the arc's last two rows.
+std::pair<Vec3, Vec3> lip_rows(const MeshWallSpec& spoon) {
+  std::vector<double> heights;
+  for (const auto& v : spoon.vertices) heights.push_back(v[2]);
+  std::sort(heights.begin(), heights.end());
+  const double lowest = heights.front();
+  const double next = *std::find_if(heights.begin(), heights.end(), [&](double z) { return z > lowest + 1e-9; });
+  Vec3 lip = Vec3::Zero(), before = Vec3::Zero();
+  int n_lip = 0, n_before = 0;
+  for (const auto& v : spoon.vertices) {
+    if (std::abs(v[2] - lowest) < 1e-9) lip += Vec3(v[0], v[1], v[2]), ++n_lip;
+    if (std::abs(v[2] - next) < 1e-9) before += Vec3(v[0], v[1], v[2]), ++n_before;
+  }
+  return {lip / n_lip, before / n_before};
+}
+
+/// [deg] Angle between the horizontal parts of two directions.
+double plan_angle_between(const Vec3& a, const Vec3& b) {
+  const Vec3 p(a.x(), a.y(), 0), q(b.x(), b.y(), 0);
+  return std::acos(std::clamp(p.normalized().dot(q.normalized()), -1.0, 1.0)) * 180 / kPi;
+}
+
+// At 90 deg (and at other angles) the spoon turns the stream into the receiving belt's direction
+// of travel: its lip slopes down along the belt within 2 deg, centred on the belt's centre line.
+TEST(TransferChute, AngledSpoonDeliversAlongTheReceivingBelt) {
+  for (const double angle : {90.0, 30.0, 135.0, 180.0}) {
+    SCOPED_TRACE(angle);
+    const EquipmentSpec spec = make("transfer_chute", angled(angle));
+    const Generated g = generate(spec);
+    const TransferChuteLayout c = transfer_chute_layout(spec);
+    const Vec3 belt = mesh_named(g, "receiving_belt").surface.velocity;
+    const Vec3 travel(std::cos(angle * kPi / 180), std::sin(angle * kPi / 180), 0);
+    EXPECT_LT((belt - 4.5 * travel).norm(), 1e-12);
+    const auto [lip, before] = lip_rows(mesh_named(g, "spoon"));
+    const Vec3 exit = lip - before;
+    EXPECT_LT(exit.z(), 0.0) << "the lip slopes down onto the belt";
+    EXPECT_LT(plan_angle_between(exit, belt), 2.0);
+    // Centred: the lip's middle lies on the belt's centre line through the fall line.
+    const Vec3 from_fall = lip - Vec3(c.fall_x, 0, lip.z());
+    EXPECT_LT(std::abs(from_fall.x() * travel.y() - from_fall.y() * travel.x()), 1e-9);
+    EXPECT_NEAR(lip.z(), 0.25, 1e-9);
+    EXPECT_EQ(g.camera, "iso");
+  }
+  // A profile spoon (rectangular: its floor is the polyline) leaves along its last segment, which
+  // the turn lays along the belt.
+  const EquipmentSpec spec = make("transfer_chute", angled(90, "rectangular"));
+  const TransferChuteLayout c = transfer_chute_layout(spec);
+  const Generated g = generate(spec);
+  std::vector<Vec3> floor_lip, floor_before;
+  for (const auto& v : mesh_named(g, "spoon").vertices) {
+    const Vec3 local = to_local(c, Vec3(v[0], v[1], v[2]));
+    if (std::abs(local.y()) > 0.5 - 1e-6) continue;  // the walls and the back plate's edges
+    if (std::abs(local.x() - (c.fall_x + 0.6)) < 1e-9) floor_lip.push_back(Vec3(v[0], v[1], v[2]));
+    if (local.x() < c.fall_x + 0.6 - 1e-9 && local.x() > c.fall_x + 0.6 - 0.15 && std::abs(local.z() - (0.3 - 0.06 * (local.x() - c.fall_x - 0.15) / 0.45)) < 1e-9)
+      floor_before.push_back(Vec3(v[0], v[1], v[2]));
+  }
+  ASSERT_FALSE(floor_lip.empty());
+  ASSERT_FALSE(floor_before.empty());
+  const Vec3 exit = floor_lip.front() - floor_before.front();
+  EXPECT_LT(plan_angle_between(exit, mesh_named(g, "receiving_belt").surface.velocity), 2.0);
+}
+
+// The rock box's ledge lies under the point where the CEMA trajectory meets the hood: the dam's
+// top, the bed's surface there, within 1e-6 m of the impact height; the dam behind the impact
+// point with the trajectory at least 0.05 m above it; the ledge reaching the hood; the spoon under
+// the dam, where the stream now comes down.
+TEST(TransferChute, RockBoxLedgeLiesWhereTheTrajectoryMeetsTheHood) {
+  for (const std::string& text : {std::string("rock_box: {}\n"), std::string(kAngledChute), std::string("rock_box: {ledge_width: 0.5}\n")}) {
+    SCOPED_TRACE(text);
+    const TransferChuteLayout c = transfer_chute_layout(make("transfer_chute", text));
+    const Generated g = generate(make("transfer_chute", text));
+    const double x = trajectory_exit(c);  // this test's own search
+    const double z = c.drop_height - 9.81 * x * x / (2 * c.feed_speed * c.feed_speed);
+    EXPECT_NEAR(c.impact_x, x, 1e-6);
+    EXPECT_NEAR(c.impact_z, z, 1e-6);
+    const MeshWallSpec& box = mesh_named(g, "rock_box");
+    double top = -1e9, bottom = 1e9, back = 1e9, front = -1e9;
+    for (const auto& v : box.vertices)
+      top = std::max(top, v[2]), bottom = std::min(bottom, v[2]), back = std::min(back, v[0]), front = std::max(front, v[0]);
+    EXPECT_NEAR(top, z, 1e-6) << "the dam's top is at the impact height";
+    EXPECT_NEAR(top - bottom, c.rock_box_height, 1e-9);
+    EXPECT_NEAR(back, c.dam_x, 1e-12);
+    EXPECT_LT(back, x) << "the dam stands behind the impact point";
+    EXPECT_GE(c.drop_height - 9.81 * back * back / (2 * c.feed_speed * c.feed_speed), z + 0.05 - 1e-9) << "the stream passes over the dam";
+    EXPECT_NEAR(std::hypot(front - c.hood_centre_x, bottom - c.hood_centre_z), c.hood_radius, 1e-9) << "the ledge reaches the hood";
+    EXPECT_GT(back, c.pulley_radius);
+    EXPECT_EQ(c.fall_x, std::min(c.hood_exit_x, c.dam_x));
+    EXPECT_GT(design(g, "rock_box_volume_m3"), 0.0);
+  }
+}
+
+TEST(TransferChute, AngledRockBoxAndProfileParametersAreChecked) {
+  const auto expect = [](const std::string& message, std::initializer_list<const char*> parts) {
+    for (const char* part : parts) EXPECT_NE(message.find(part), std::string::npos) << part << " in: " << message;
+  };
+  expect(error_of("transfer_chute", "plan_angle_deg: 200\n"), {"equipment.transfer_chute.plan_angle_deg", "valid: [0, 180] deg"});
+  // A profile with a rising segment, naming the point and what is valid.
+  expect(error_of("transfer_chute", "spoon:\n  profile: [[-0.2, 1.0], [0.1, 0.6], [0.4, 0.7]]\n"),
+         {"<inline>:2:", "equipment.transfer_chute.spoon.profile[2]", "descend monotonically", "valid: z < 0.6 m"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.0]]}\n"), {"equipment.transfer_chute.spoon.profile", "2 to 100 points"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.0], [-0.3, 0.5]]}\n"), {"spoon.profile[1]", "runs back"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[0.2, 1.0], [0.5, 0.5]]}\n"), {"spoon.profile[0]", "valid: x <= 0"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.0], [0.5, 0.5]], radius: 1}\n"), {"equipment.transfer_chute.spoon.radius", "not both"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.0], [0.5, 0.5]], shape: V}\n"), {"spoon.shape", "valid: U, rectangular"});
+  // Sizes against the case's largest particle: the trough wider than 3, the bed 2 top sizes deep.
+  expect(chute_error(chute_with_particles("spoon: {profile: [[-0.2, 1.0], [0.5, 0.5]], width: 0.25}\n", 0.1)),
+         {"equipment.transfer_chute.spoon.width", "3 times the largest particle", "valid: more than 0.3 m"});
+  EXPECT_NO_THROW(generate(chute_with_particles("spoon: {profile: [[-0.2, 1.0], [0.5, 0.5]], width: 0.35}\n", 0.1)));
+  expect(chute_error(chute_with_particles("rock_box: {height: 0.15}\n", 0.1)),
+         {"equipment.transfer_chute.rock_box.height", "2 top sizes", "valid: at least 0.2 m"});
+  expect(error_of("transfer_chute", "rock_box: {ledge_depth: 0.6}\n"), {"equipment.transfer_chute.rock_box.ledge_depth", "in front of the head pulley", "valid: ["});
+  expect(error_of("transfer_chute", "rock_box: {ledge_depth: 0.1}\n"), {"equipment.transfer_chute.rock_box.ledge_depth", "behind the impact point"});
+  expect(error_of("transfer_chute", "rock_box: {ledge_width: 0.9}\n"), {"equipment.transfer_chute.rock_box.ledge_width", "valid: [0.1, 0.7] m"});
+  // A U trough needs walls as high as its half circle; walls that fold over on a sharp bend are refused.
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.0], [0.5, 0.5]], width: 0.6, depth: 0.2}\n"), {"spoon.depth", "half the width"});
+  expect(error_of("transfer_chute", "spoon: {profile: [[-0.2, 1.2], [-0.2, 0.6], [0.4, 0.55]], shape: rectangular, depth: 0.7}\n"),
+         {"spoon.depth", "fold over"});
+}
+
+/// Whether the triangle (a, b, c) holds the plan point (x, y) (edges included).
+bool holds_in_plan(const Vec3& a, const Vec3& b, const Vec3& c, double x, double y) {
+  const auto side = [&](const Vec3& p, const Vec3& q) { return (q.x() - p.x()) * (y - p.y()) - (q.y() - p.y()) * (x - p.x()); };
+  const double s1 = side(a, b), s2 = side(b, c), s3 = side(c, a);
+  const double tolerance = 1e-12;
+  return (s1 >= -tolerance && s2 >= -tolerance && s3 >= -tolerance) || (s1 <= tolerance && s2 <= tolerance && s3 <= tolerance);
+}
+
+/// Whether a triangle of `mesh` lying at height z covers the plan point p.
+bool deck_covers(const MeshWallSpec& mesh, double z, const Vec3& p) {
+  for (const auto& t : mesh.triangles) {
+    const Vec3 a = vertex(mesh, t[0]), b = vertex(mesh, t[1]), c = vertex(mesh, t[2]);
+    if (std::abs(a.z() - z) > 1e-9 || std::abs(b.z() - z) > 1e-9 || std::abs(c.z() - z) > 1e-9) continue;
+    if (holds_in_plan(a, b, c, p.x(), p.y())) return true;
+  }
+  return false;
+}
+
+// Mesh health of angled chutes (with a rock box, with a profile spoon): every triangle sound and
+// short, every mesh wound one way (no edge run twice in the same direction), the plant inside the
+// domain; the two boxes closed at the deck everywhere but the opening the stream falls through.
+TEST(TransferChute, AngledChuteMeshesAreSoundAndClosedAtTheDeck) {
+  for (const double angle : {30.0, 90.0, 135.0, 180.0})
+    for (const std::string& shape : {std::string(""), std::string("U"), std::string("rectangular")}) {
+      const std::string text = angled(angle, shape);
+      SCOPED_TRACE(text);
+      const Generated g = generate(make("transfer_chute", text));
+      const TransferChuteLayout c = transfer_chute_layout(make("transfer_chute", text));
+      for (const MeshWallSpec& m : g.meshes) {
+        SCOPED_TRACE(m.name);
+        std::map<std::pair<std::int32_t, std::int32_t>, int> edges;
+        for (const auto& t : m.triangles) {
+          for (const std::int32_t i : t) ASSERT_TRUE(i >= 0 && size_t(i) < m.vertices.size());
+          const Vec3 a = vertex(m, t[0]), b = vertex(m, t[1]), d = vertex(m, t[2]);
+          const double longest = std::max({(b - a).norm(), (d - b).norm(), (a - d).norm()});
+          EXPECT_GT((b - a).cross(d - a).norm(), 1e-6 * longest * longest) << "degenerate triangle";
+          if (m.name != "head_pulley") EXPECT_LT(longest, 0.3);  // the pulley's end caps are fans to its axis
+          for (const Vec3& p : {a, b, d}) EXPECT_TRUE((p.array() >= g.domain_min.array()).all() && (p.array() <= g.domain_max.array()).all());
+          for (int k = 0; k < 3; ++k) {
+            const int runs = ++edges[std::make_pair(t[k], t[(k + 1) % 3])];
+            EXPECT_EQ(runs, 1) << "an edge run twice the same way: normals flip";
+          }
+        }
+      }
+      // The deck: every plan point of one box outside the other is covered at join_z; the fall
+      // line, where the stream comes down, is open.
+      const MeshWallSpec& walls = mesh_named(g, "side_plates");
+      const double half = 0.5 * c.chute_width;
+      for (double x = c.side_x_min; x <= c.hood_box_x_max + 1e-9; x += 0.05)
+        for (double y = -half; y <= half + 1e-9; y += 0.05) {
+          const Vec3 local = to_local(c, Vec3(x, y, c.join_z));
+          const bool in_spoon_box = local.x() > c.spoon_top_x - 1e-6 && local.x() < c.spoon_box_x_max + 1e-6 && std::abs(local.y()) < half + 1e-6;
+          if (!in_spoon_box) EXPECT_TRUE(deck_covers(walls, c.join_z, Vec3(x, y, c.join_z))) << "hood box open at " << x << " " << y;
+        }
+      for (double x = c.spoon_top_x; x <= c.spoon_box_x_max + 1e-9; x += 0.05)
+        for (double y = -half; y <= half + 1e-9; y += 0.05) {
+          const Vec3 world = to_world(c, Vec3(x, y, c.join_z));
+          const bool in_hood_box = world.x() > c.side_x_min - 1e-6 && world.x() < c.hood_box_x_max + 1e-6 && std::abs(world.y()) < half + 1e-6;
+          if (!in_hood_box) EXPECT_TRUE(deck_covers(walls, c.join_z, world)) << "spoon box open at " << world.x() << " " << world.y();
+        }
+      EXPECT_FALSE(deck_covers(walls, c.join_z, Vec3(c.fall_x, 0, c.join_z))) << "the stream's way down is closed";
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

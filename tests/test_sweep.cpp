@@ -113,3 +113,34 @@ TEST(Video, MissingFfmpegIsSaidClearly) {
 
 }  // namespace
 }  // namespace dem::test
+
+#include <numbers>
+
+#include "case/yaml_check.h"
+#include "equipment.h"
+
+namespace dem::test {
+namespace {
+
+// The shipped angled-transfer sweep (cases/angled_transfer_sweep.yaml): every variant is a case
+// that reads and expands, and its chute has the variant's plan angle and rock box ledge.
+TEST(Sweep, ShippedAngledTransferSweepVariesPlanAngleAndLedge) {
+  const std::string path = std::string(DEMDESIGN_SOURCE_DIR) + "/cases/angled_transfer_sweep.yaml";
+  const YAML::Node root = read_yaml_file(path, "the case file");
+  const app::SweepPlan plan = app::read_sweep(root, path);
+  ASSERT_EQ(plan.paths, (std::vector<std::string>{"equipment.transfer_chute.plan_angle_deg", "equipment.transfer_chute.rock_box.ledge_depth"}));
+  ASSERT_EQ(plan.variants.size(), 3u);
+  for (size_t k = 0; k < plan.variants.size(); ++k) {
+    SCOPED_TRACE(plan.label(k));
+    CaseSpec spec = parse_case_node(app::variant_case(root, plan, k), path);
+    equipment::expand_equipment(spec);
+    const equipment::TransferChuteLayout c = equipment::transfer_chute_layout(*spec.equipment);
+    EXPECT_NEAR(c.plan_angle * 180 / std::numbers::pi, plan.variants[k][0].as<double>(), 1e-9);
+    EXPECT_NEAR(c.ledge_depth, plan.variants[k][1].as<double>(), 1e-12);
+    EXPECT_TRUE(c.rock_box);
+    EXPECT_FALSE(c.spoon_profile.empty()) << "the sweep's spoon is drawn as a profile";
+  }
+}
+
+}  // namespace
+}  // namespace dem::test

@@ -225,6 +225,9 @@ struct EquipmentSpec {
   std::shared_ptr<const YAML::Node> params;  ///< the map under the type key
   std::string file;                          ///< case file, for errors and relative paths
   SourceLocation location;
+  /// [m] the largest particle diameter the case's inlets and particle sets draw, which openings
+  /// and beds are checked against; filled by equipment::expand_equipment; 0: not known (unchecked).
+  double largest_particle = 0;
 };
 
 struct ParticleSetSpec {
