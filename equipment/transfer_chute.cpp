@@ -821,7 +821,9 @@ void set_design(const TransferChuteLayout& c, double largest_particle, Generated
       {"receiving_belt_speed_m_s", c.receiving_speed},
       {"feed_belt_width_m", c.feed_width},
       {"receiving_belt_width_m", c.receiving_width},
-      {"troughing_angle_deg", c.feed_trough * 180 / kPi},
+      {"troughing_angle_deg", c.feed_trough * 180 / kPi},  // the feed belt's, as feed_belt_troughing_angle_deg
+      {"feed_belt_troughing_angle_deg", c.feed_trough * 180 / kPi},
+      {"receiving_belt_troughing_angle_deg", c.receiving_trough * 180 / kPi},
       {"drop_height_m", c.drop_height},
       {"pulley_diameter_m", 2 * c.pulley_radius},
       {"discharge_ratio_v2_gr", pulley_ratio},
