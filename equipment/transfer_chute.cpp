@@ -47,6 +47,12 @@
 //  - Receiving belt surface at z = 0 from the spoon lip - tail_length [to 0.5 behind the chute]
 //    to the lip + length [3]; skirts at y = +-skirt_width/2 [min(chute_width, 0.9 width)] from
 //    0.05 behind the lip for skirt_length [1.5], skirt_height [0.3] high.
+//  - Sensors: flow planes at the spoon lip (spoon_exit) and 0.3 before the belt's end
+//    (belt_discharge); load boxes on the belt from the lip for 1 m (loading_zone) and for 0.5 m
+//    after it (stream_belt, 12 bins across the belt; over the loading zone on a belt too short
+//    for both); and a box across the chute's narrowest section (stream_chute, 12 bins across the
+//    chute): the throat at the hood's exit height between the hood's lower edge and the spoon's
+//    back plate (choke_section gives the reasons).
 //
 // Angled transfer (plan_angle_deg in (0, 180]): the receiving side (spoon, receiving belt, skirts,
 // discharge outlet, sensors) is laid out as above with x along the receiving belt and turned by
@@ -758,6 +764,13 @@ void add_discharge_outlet(const ChuteBuild& chute, Generated& out) {
   out.outlets.push_back(discharge);
 }
 
+/// [m] Where the loading zone (the load box after the spoon lip) ends along the receiving belt:
+/// 1 m past the lip, or 0.4 m short of the belt's end on a shorter belt.
+double loading_zone_end(const TransferChuteLayout& c) { return c.spoon_lip_x + std::min(1.0, c.receiving_x_max - c.spoon_lip_x - 0.4); }
+
+/// [m] The belt_discharge plane along the receiving belt: 0.3 m before its end.
+double discharge_plane_x(const TransferChuteLayout& c) { return c.receiving_x_max - 0.3; }
+
 /// Sensors: flow through the spoon lip and near the belt end; load on the belt after the lip.
 void add_sensors(const ChuteBuild& chute, Generated& out) {
   const TransferChuteLayout& c = chute.layout;
@@ -771,7 +784,7 @@ void add_sensors(const ChuteBuild& chute, Generated& out) {
   out.sensors.push_back(spoon_exit);
   SensorSpec belt_discharge;
   belt_discharge.kind = SensorSpec::Kind::plane, belt_discharge.name = "belt_discharge";
-  const double x_end = c.receiving_x_max - 0.3;
+  const double x_end = discharge_plane_x(c);
   belt_discharge.point = turned(c, Vec3(x_end, 0, 0));
   belt_discharge.normal = turned_direction(c, Vec3::UnitX());
   std::tie(belt_discharge.region_min, belt_discharge.region_max) =
@@ -780,10 +793,142 @@ void add_sensors(const ChuteBuild& chute, Generated& out) {
   SensorSpec loading;
   loading.kind = SensorSpec::Kind::box, loading.name = "loading_zone";
   loading.across = turned_direction(c, Vec3::UnitY());
-  const double loading_end = c.spoon_lip_x + std::min(1.0, c.receiving_x_max - c.spoon_lip_x - 0.4);
+  const double loading_end = loading_zone_end(c);
   std::tie(loading.region_min, loading.region_max) =
       turned_box(c, Vec3(c.spoon_lip_x, -belt_half, -0.05), Vec3(loading_end, belt_half, 0.5));
   out.sensors.push_back(loading);
+}
+
+// ---- the narrowest section and the stream profiles -------------------------------------------
+
+/// Lateral bins of the stream profile sensors (stream_chute, stream_belt): a 0.7 m chute in 58 mm
+/// bins, a 1.2 m belt in 100 mm bins.
+constexpr int kStreamBins = 12;
+/// [m] How far the stream_chute box reaches along the fall line on either side of the hood's exit
+/// height, at most: long enough to hold a few particles' centres, short enough that the section
+/// stays the throat's.
+constexpr double kChokeReach = 0.1;
+
+/// A convex polygon in plan (x, y), counter-clockwise.
+using PlanPolygon = std::vector<Eigen::Vector2d>;
+
+/// The part of convex `subject` on the left of the directed line a -> b (Sutherland-Hodgman).
+PlanPolygon clip_left_of(const PlanPolygon& subject, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const auto side = [&](const Eigen::Vector2d& p) { return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x()); };
+  PlanPolygon out;
+  for (size_t k = 0; k < subject.size(); ++k) {
+    const Eigen::Vector2d& p = subject[k];
+    const Eigen::Vector2d& q = subject[(k + 1) % subject.size()];
+    const double at_p = side(p), at_q = side(q);
+    if (at_p >= 0) out.push_back(p);
+    if ((at_p >= 0) != (at_q >= 0)) out.push_back(Eigen::Vector2d(p + (at_p / (at_p - at_q)) * (q - p)));
+  }
+  return out;
+}
+
+/// [m^2] Area of a plan polygon (shoelace).
+double plan_area(const PlanPolygon& polygon) {
+  double twice = 0;
+  for (size_t k = 0; k < polygon.size(); ++k) {
+    const Eigen::Vector2d& p = polygon[k];
+    const Eigen::Vector2d& q = polygon[(k + 1) % polygon.size()];
+    twice += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * std::abs(twice);
+}
+
+/// The chute's narrowest section: its free plan area at the hood's exit height, and the box of
+/// the stream_chute sensor around it, `length` along the fall line.
+struct ChokeSection {
+  double area = 0;    // [m^2] 0: none found (a degenerate layout)
+  double height = 0;  // [m] the hood exit's
+  double length = 0;  // [m] the box's extent along the fall line
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // [m]
+};
+
+/// The free plan section at the hood's exit height: the hood's box (from behind the pulley, or
+/// from the pulley's front when the exit lies at the pulley's height, to the hood's exit) clipped
+/// to the spoon's (from its back plate forward between the side plates, turned about the fall
+/// line). Inline, the spoon's reaches to the side plates' end. Angled, the deck's cells on the
+/// opening's rim narrow it by less than a cell (kDeckCell); they are left out of the area.
+PlanPolygon choke_plan(const TransferChuteLayout& c) {
+  const double half = 0.5 * c.chute_width;
+  const double back = c.hood_exit_z > c.drop_height - 2 * c.pulley_radius ? c.pulley_radius : c.side_x_min;
+  if (!(c.hood_exit_x > back)) return {};
+  PlanPolygon section = {Eigen::Vector2d(back, -half), Eigen::Vector2d(c.hood_exit_x, -half), Eigen::Vector2d(c.hood_exit_x, half),
+                         Eigen::Vector2d(back, half)};
+  // The spoon's plan rectangle, counter-clockwise in its frame and so in the world once turned.
+  const double front = c.plan_angle == 0 ? c.side_x_max : c.spoon_box_x_max;
+  const Vec3 corners[4] = {turned(c, Vec3(c.spoon_top_x, -half, 0)), turned(c, Vec3(front, -half, 0)), turned(c, Vec3(front, half, 0)),
+                           turned(c, Vec3(c.spoon_top_x, half, 0))};
+  for (int k = 0; k < 4 && !section.empty(); ++k) {
+    const Vec3& a = corners[k];
+    const Vec3& b = corners[(k + 1) % 4];
+    section = clip_left_of(section, Eigen::Vector2d(a.x(), a.y()), Eigen::Vector2d(b.x(), b.y()));
+  }
+  return section;
+}
+
+/// The chute's narrowest section. The stream comes down the fall line from the hood's lower edge
+/// past the spoon's back plate (and, angled, through the deck's opening where the hood's box meets
+/// the spoon's): there it is held on all four sides, by the hood's edge in front, the back plate
+/// behind (spoon.setback behind the fall line, more behind a rock box's dam or along a turned
+/// spoon) and the side plates. Above, the hood's box is open back to behind the head pulley; below,
+/// the hood has ended and the front is open; in the spoon the stream slides on the liner with the
+/// chute's height above it. Rejected: the skirted section on the receiving belt, which is the
+/// belt's (belt_capacity.csv), not the chute's. The box reaches kChokeReach below the exit (not
+/// below the spoon's top edge) and, where the hood stands in front above its exit (run past
+/// vertical), as far above it (under the back plate's top, the rock box's ledge and the pulley).
+/// Between 0, 90 and 180 deg the box around a turned section is larger than it: the fill then
+/// reads high.
+ChokeSection choke_section(const TransferChuteLayout& c) {
+  ChokeSection choke;
+  const PlanPolygon plan = choke_plan(c);
+  if (plan.size() < 3 || plan_area(plan) < 1e-6) return choke;
+  choke.area = plan_area(plan);
+  choke.height = c.hood_exit_z;
+  const double below = std::min(kChokeReach, c.hood_exit_z - c.spoon_top_z);
+  double above = c.hood_end_angle <= 0 ? kChokeReach : 0.0;
+  if (c.plan_angle == 0) above = std::min(above, c.back_plate_top - c.hood_exit_z);
+  if (c.rock_box) above = std::min(above, std::max(c.ledge_z - c.hood_exit_z, 0.0));
+  above = std::min(above, std::max(c.drop_height - 2 * c.pulley_radius - c.hood_exit_z, 0.0));
+  choke.length = below + above;
+  Eigen::Vector2d lo = plan[0], hi = plan[0];
+  for (const Eigen::Vector2d& p : plan) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  choke.lo = Vec3(lo.x(), lo.y(), c.hood_exit_z - below);
+  choke.hi = Vec3(hi.x(), hi.y(), c.hood_exit_z + above);
+  return choke;
+}
+
+/// Stream profile sensors: `stream_chute` across the chute's narrowest section, down the fall
+/// line; `stream_belt` across the receiving belt after the loading zone, along the belt (over
+/// the loading zone itself on a belt too short for both).
+void add_stream_sensors(const ChuteBuild& chute, const ChokeSection& choke, Generated& out) {
+  const TransferChuteLayout& c = chute.layout;
+  if (choke.area > 0 && choke.length > 0) {
+    SensorSpec section;
+    section.kind = SensorSpec::Kind::box, section.name = "stream_chute";
+    section.region_min = choke.lo, section.region_max = choke.hi;
+    section.across = Vec3::UnitY(), section.along = Vec3(0, 0, -1), section.bins = kStreamBins;
+    out.sensors.push_back(section);
+  }
+  double from = loading_zone_end(c), to = std::min(from + 0.5, discharge_plane_x(c) - 0.1);  // [m] along the belt
+  if (to - from < 0.1) from = c.spoon_lip_x, to = loading_zone_end(c);
+  SensorSpec belt;
+  belt.kind = SensorSpec::Kind::box, belt.name = "stream_belt";
+  belt.across = turned_direction(c, Vec3::UnitY()), belt.along = turned_direction(c, Vec3::UnitX()), belt.bins = kStreamBins;
+  std::tie(belt.region_min, belt.region_max) = turned_box(c, Vec3(from, -chute.receiving_half, -0.05), Vec3(to, chute.receiving_half, 0.5));
+  out.sensors.push_back(belt);
+}
+
+/// The design values of the chute's narrowest section: its free area, the stream_chute box's
+/// length along the fall line, and its height (the hood exit's); the report's choke fill is the
+/// box's mass over bulk density x area x length.
+void choke_design(const ChokeSection& choke, std::vector<std::pair<std::string, double>>& design) {
+  if (!(choke.area > 0 && choke.length > 0)) return;
+  design.push_back({"choke_section_area_m2", choke.area});
+  design.push_back({"choke_section_length_m", choke.length});
+  design.push_back({"choke_section_at_height_m", choke.height});
 }
 
 /// The design values of a profile spoon: its points, trough and the slope it leaves the lip at.
@@ -870,9 +1015,12 @@ Generated transfer_chute(MapReader& reader, const EquipmentSpec& spec) {
   add_feed_port(c, out);
   add_discharge_outlet(chute, out);
   add_sensors(chute, out);
+  const ChokeSection choke = choke_section(c);
+  add_stream_sensors(chute, choke, out);
 
   set_domain(out, margin, -1.0);
   set_design(c, spec.largest_particle, out);
+  choke_design(choke, out.design);
   return out;
 }
 

@@ -661,7 +661,7 @@ TEST(Equipment, ExpandFillsPortsDomainAndDesign) {
   EXPECT_EQ(spec.equipment_camera, "side");
   EXPECT_FALSE(spec.design.empty());
   EXPECT_EQ(spec.outlets.size(), 1u);
-  EXPECT_EQ(spec.sensors.size(), 3u);
+  EXPECT_EQ(spec.sensors.size(), 5u);  // spoon_exit, belt_discharge, loading_zone, stream_chute, stream_belt
 
   const auto message = [](CaseSpec s) {
     try {

@@ -368,7 +368,7 @@ std::pair<std::vector<double>, std::uint64_t> bed_on_meshes(int threads, int ste
   for (int k = 0; k < steps; ++k) sim.advance();
   std::vector<double> out;
   for (const TriangleRecords& r : sim.state.records)
-    for (const auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) out.insert(out.end(), c->begin(), c->end());
+    for (const std::vector<double>* c : r.columns()) out.insert(out.end(), c->begin(), c->end());
   const MeshLoads& l = sim.state.mesh_loads;
   for (const auto* c : {&l.fx, &l.fy, &l.fz, &l.tx, &l.ty, &l.tz, &l.power}) out.insert(out.end(), c->begin(), c->end());
   return {out, state_hash(sim.state, sim.model.history_width)};

@@ -40,6 +40,7 @@
 #include "output/results_hdf5.h"
 #include "output/run.h"
 #include "report/compare_runs.h"
+#include "report/liner_loads.h"
 #include "report/report.h"
 #include "report/report_wear.h"
 #include "statistics/diagnostics.h"
@@ -125,8 +126,19 @@ std::vector<std::vector<double>> wall_rate(const dem::Model& model, const dem::S
   return out;
 }
 
-/// The run's report folder: renders of the flow and of the wear fields on the walls, then the
-/// report itself (throughput, power, wear, belt loading at steady state).
+/// Per-triangle mean pressure [kPa] over the recording interval (report/liner_loads.h).
+std::vector<std::vector<double>> pressure_kilopascals(const dem::Model& model, const dem::State& state) {
+  const dem::report::LinerLoads loads = dem::report::liner_loads(model, state, model.output.records_from);
+  std::vector<std::vector<double>> out;
+  for (const dem::report::LinerLoad& load : loads.meshes) {
+    out.push_back(load.pressure);
+    for (double& p : out.back()) p *= 1e-3;  // Pa to kPa
+  }
+  return out;
+}
+
+/// The run's report folder: renders of the flow and of the wear fields and the liner pressure on
+/// the walls, then the report itself (throughput, power, wear, belt loading at steady state).
 void write_run_report(const dem::Model& model, const dem::State& state, const dem::CaseSpec& spec, const dem::RunSummary& summary,
                       const std::string& case_path, const std::string& case_text) {
   const std::string out = summary.output_directory, report_dir = out + "/report";
@@ -161,6 +173,12 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
                                         model.output.records_from, state.time)});
     input.images.push_back({"Impact wear: impact energy rate", impact,
                             fmt::format("Normal impact energy per area and time on the walls, t = {:.2f} to {:.2f} s.", model.output.records_from, state.time)});
+    const std::string pressure = report_dir + "/pressure_map.png";
+    dem::app::render_wall_field(model, state, pressure_kilopascals(model, state), "mean pressure [kPa]", wear_view, pressure);
+    input.images.push_back({"Liner pressure: mean pressure", pressure,
+                            fmt::format("Normal impulse per area and time on the walls (the liners' mean pressure), t = {:.2f} to {:.2f} s; "
+                                        "the loads for a structural model are in report/fea/.",
+                                        model.output.records_from, state.time)});
   }
   const dem::report::RunMetrics metrics = dem::report::write_run_report(input, report_dir);
   std::cout << fmt::format("  report: {}/report.html ({})\n", report_dir, metrics.steady_text);
@@ -246,7 +264,8 @@ OutputFolder claim_output_folder(const RunArgs& args, const dem::CaseSpec& spec)
   claimed.caller_outputs = {"case.yaml",           "meshes/*.stl",       "renders/frame_*.png",
                             "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
                             "report/*.csv",        "report/*.png",       "report/plots/*.png",
-                            "report/plots/*.gp",   "report/plots/*.tsv"};
+                            "report/plots/*.gp",   "report/plots/*.tsv", "report/fea/*.vtk",
+                            "report/fea/*.inp"};
   if (dem::app::mpi::world().rank == 0) {
     std::vector<std::string> names = dem::run_output_names();
     names.insert(names.end(), claimed.caller_outputs.begin(), claimed.caller_outputs.end());

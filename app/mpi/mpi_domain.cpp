@@ -530,7 +530,7 @@ class MpiDomain final : public Domain {
       s.lost = 0, s.lost_mass = 0;
       for (OutletState& o : s.outlets) o = {};
       for (TriangleRecords& r : s.records)
-        for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) std::fill(c->begin(), c->end(), 0.0);
+        for (std::vector<double>* c : r.columns()) std::fill(c->begin(), c->end(), 0.0);
     }
   }
 

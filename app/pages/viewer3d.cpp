@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -77,12 +78,14 @@ const char* kScript = R"JS(
     var stops = [[0.267,0.005,0.329],[0.283,0.141,0.458],[0.254,0.265,0.530],[0.207,0.372,0.553],[0.164,0.471,0.558],[0.128,0.567,0.551],[0.135,0.659,0.518],[0.267,0.749,0.441],[0.478,0.821,0.318],[0.741,0.873,0.150],[0.993,0.906,0.144]];
     function cmap(t) { if (!(t >= 0)) t = 0; if (t > 1) t = 1; var x = t * (stops.length - 1), i = Math.min(Math.floor(x), stops.length - 2), w = x - i, a = stops[i], b = stops[i + 1]; return [a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])]; }
     var gradient = 'linear-gradient(to right,' + stops.map(function (c, i) { return 'rgb(' + c.map(function (v) { return Math.round(255 * v); }).join(',') + ') ' + Math.round(100 * i / (stops.length - 1)) + '%'; }).join(',') + ')';
-    function legend(id, title, max, unit, peak) {
+    // A reversed scale (life: short is hot) runs from the bright end at 0 to the dark end at max.
+    function legend(id, title, max, unit, peak, reverse) {
       var el = document.getElementById(id);
       el.innerHTML = '<span class="v3d-lt"></span><span class="v3d-bar"></span><span class="v3d-lt"></span>';
       el.children[0].textContent = title + ' [' + unit + ']: 0';
-      el.children[1].style.background = gradient;
-      el.children[2].textContent = Number(max).toPrecision(3) + (peak > max ? ' and above (peak ' + Number(peak).toPrecision(3) + ')' : '');
+      el.children[1].style.background = reverse ? gradient.replace('to right', 'to left') : gradient;
+      el.children[2].textContent = Number(max).toPrecision(3) + (reverse ? ' and longer' + (peak > 0 ? ' (shortest ' + Number(peak).toPrecision(3) + ')' : '')
+                                                                         : (peak > max ? ' and above (peak ' + Number(peak).toPrecision(3) + ')' : ''));
       el.style.display = '';
     }
     var setAttr = function (g, name, a) { if (g.setAttribute) g.setAttribute(name, a); else g.addAttribute(name, a); };
@@ -117,19 +120,22 @@ const char* kScript = R"JS(
       var mat = new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors !== undefined ? THREE.VertexColors : true, side: THREE.DoubleSide, transparent: true, opacity: 0.6, depthWrite: false });
       var mesh = new THREE.Mesh(g, mat);
       scene.add(mesh);
-      walls.push({ mesh: mesh, n: n, fields: { shear: m.shear ? f32(m.shear) : null, impact: m.impact ? f32(m.impact) : null } });
+      var fields = {};
+      ['shear', 'impact', 'pressure', 'life'].forEach(function (k) { fields[k] = m[k] ? f32(m[k]) : null; });
+      walls.push({ mesh: mesh, n: n, fields: fields });
     });
     function colourWalls(field) {
       var f = D.fields[field];
       walls.forEach(function (w) {
         var col = w.mesh.geometry.attributes.color, values = f ? w.fields[field] : null;
         for (var k = 0; k < w.n; ++k) {
-          var v = values ? values[k] : NaN, rgb = f && isFinite(v) ? cmap(f.max > 0 ? v / f.max : 0) : [0.72, 0.74, 0.78];
+          var v = values ? values[k] : NaN, s = f && f.max > 0 ? v / f.max : (f && f.reverse ? 1 : 0);
+          var rgb = f && isFinite(v) ? cmap(f.reverse ? 1 - s : s) : [0.72, 0.74, 0.78];
           for (var c = 0; c < 3; ++c) for (var j = 0; j < 3; ++j) col.array[9 * k + 3 * c + j] = rgb[j];
         }
         col.needsUpdate = true;
       });
-      if (f) legend('v3d-wall-legend', f.label, f.max, f.unit, f.peak); else document.getElementById('v3d-wall-legend').style.display = 'none';
+      if (f) legend('v3d-wall-legend', f.label, f.max, f.unit, f.peak, f.reverse); else document.getElementById('v3d-wall-legend').style.display = 'none';
     }
 
     // Particles: sphere sprites sized by radius in perspective, shaded as spheres.
@@ -226,48 +232,93 @@ const char* kStyle = R"(<style>
 </style>
 )";
 
-std::string build(const Model& model, const State& state, double records_from, const Options& options) {
-  std::string three_path;
-  const std::string three = read_three_js(options, three_path);
-  if (three.empty())
-    return missing("three.js not found at " + three_path + " (install the Debian package libjs-three to get the interactive view)");
+/// One colour field of the walls: its key (the select box's value and the meshes' entry), how it
+/// is labelled, and every triangle's finite value for its colour scale.
+struct WallField {
+  const char* name;
+  const char* label;   ///< the legend's title
+  const char* option;  ///< the select box's text
+  const char* unit;    ///< as JSON text
+  bool reverse = false;  ///< short is hot: life, whose scale runs from 0 (bright) to its top (dark)
+  bool present = false;  ///< some triangle has a value
+  std::vector<double> all;
+};
 
-  // Walls in their pose at the end, with the wall fields per triangle.
-  const double seconds = state.time - records_from;  // [s] the records' interval
-  std::vector<double> shear_all, impact_all;  // every triangle's finite rate, for the colour scale
-  bool recorded = false;
-  std::string meshes;
-  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-    const TriangleSurface& surface = *model.meshes[m].surface;
-    const Pose pose = model.meshes[m].motion.pose(state.time);
-    std::vector<float> position;
-    for (const auto& v : surface.vertices) {
-      const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
-      position.insert(position.end(), {float(w.x()), float(w.y()), float(w.z())});
-    }
-    std::vector<std::uint32_t> triangles;
-    for (const auto& t : surface.triangles) triangles.insert(triangles.end(), {std::uint32_t(t[0]), std::uint32_t(t[1]), std::uint32_t(t[2])});
-    std::string fields;
-    if (m < state.records.size() && seconds > 0) {
-      const TriangleRecords& rec = state.records[m];
-      auto rate = [&](const std::vector<double>& work, std::vector<double>& all) {
-        std::vector<float> out(surface.size(), std::nanf(""));
-        for (std::size_t t = 0; t < surface.size() && t < work.size(); ++t)
-          if (surface.areas[t] > 0 && std::isfinite(work[t])) out[t] = float(work[t] / (seconds * surface.areas[t])), all.push_back(out[t]);
-        return pack(out);
-      };
-      fields = ",\"shear\":\"" + rate(rec.shear_work, shear_all) + "\",\"impact\":\"" + rate(rec.impact_energy, impact_all) + "\"";
-      recorded = true;
-    }
-    meshes += fmt::format("{}{{\"name\":{},\"p\":\"{}\",\"t\":\"{}\"{}}}", meshes.empty() ? "" : ",", json_string(model.meshes[m].name),
-                          pack(position), pack(triangles), fields);
+/// The walls' fields in the select box's order.
+struct WallFields {
+  WallField shear{"shear", "shear work rate", "shear work rate (wear)", "W/m\\u00b2", false, false, {}};
+  WallField impact{"impact", "impact energy rate", "impact energy rate", "W/m\\u00b2", false, false, {}};
+  WallField pressure{"pressure", "mean pressure", "mean pressure [kPa]", "kPa", false, false, {}};
+  WallField life{"life", "liner life", "liner life [months], short is yellow", "months", true, false, {}};
+  std::vector<WallField*> all() { return {&shear, &impact, &pressure, &life}; }
+};
+
+/// `scale` x a record's total per area and second over `seconds` [s], per triangle; NaN on a
+/// triangle of no area or without a value.
+std::vector<double> per_area(const TriangleSurface& surface, const std::vector<double>& total, double seconds, double scale) {
+  std::vector<double> out(surface.size(), std::nan(""));
+  for (std::size_t t = 0; t < surface.size() && t < total.size(); ++t)
+    if (surface.areas[t] > 0 && std::isfinite(total[t])) out[t] = scale * total[t] / (seconds * surface.areas[t]);
+  return out;
+}
+
+/// A mesh's entry of `field` (",\"name\":\"base64\""), its finite values kept for the scale. An
+/// infinite value (a liner that does not wear) is sent as the largest float: the far end of the scale.
+std::string field_entry(WallField& field, const std::vector<double>& values) {
+  std::vector<float> out;
+  for (const double v : values) {
+    out.push_back(std::isinf(v) ? std::numeric_limits<float>::max() : float(v));
+    if (!std::isnan(v)) field.present = true;
+    if (std::isfinite(v)) field.all.push_back(v);
   }
+  return fmt::format(",\"{}\":\"{}\"", field.name, pack(out));
+}
 
-  // Particles of the final state, evenly subsampled above the limit.
+/// Mesh m in its pose at the end, with its wall fields over the records' interval `seconds` [s]:
+/// shear work and impact energy rates [W/m^2], mean pressure [kPa], and the liner life [months]
+/// the caller gave.
+std::string mesh_entry(const Model& model, const State& state, std::size_t m, double seconds, const Options& options, WallFields& fields) {
+  const TriangleSurface& surface = *model.meshes[m].surface;
+  const Pose pose = model.meshes[m].motion.pose(state.time);
+  std::vector<float> position;
+  for (const auto& v : surface.vertices) {
+    const Eigen::Vector3d w = pose.rotation * Eigen::Vector3d(v[0], v[1], v[2]) + pose.translation;
+    position.insert(position.end(), {float(w.x()), float(w.y()), float(w.z())});
+  }
+  std::vector<std::uint32_t> triangles;
+  for (const auto& t : surface.triangles) triangles.insert(triangles.end(), {std::uint32_t(t[0]), std::uint32_t(t[1]), std::uint32_t(t[2])});
+  std::string entry = fmt::format("{{\"name\":{},\"p\":\"{}\",\"t\":\"{}\"", json_string(model.meshes[m].name), pack(position), pack(triangles));
+  if (m < state.records.size() && seconds > 0) {
+    const TriangleRecords& rec = state.records[m];
+    entry += field_entry(fields.shear, per_area(surface, rec.shear_work, seconds, 1.0));
+    entry += field_entry(fields.impact, per_area(surface, rec.impact_energy, seconds, 1.0));
+    entry += field_entry(fields.pressure, per_area(surface, rec.normal_impulse, seconds, 1e-3));  // Pa to kPa
+  }
+  if (m < options.life_months.size()) entry += field_entry(fields.life, options.life_months[m]);
+  return entry + "}";
+}
+
+/// A field's colour scale. Rates and pressure: 0 to the 99th percentile over the triangles, as in
+/// the wear maps (app/pages/flow_images.cpp): one hot triangle does not turn every other one
+/// dark; the peak is in the legend. Life, reversed: 0 to the median over the worn triangles,
+/// longer lives at the dark end, the shortest in the legend (rejected: 1/life, a wear rate the
+/// other fields already show).
+std::string field_scale(WallField& field) {
+  std::vector<double>& all = field.all;
+  std::sort(all.begin(), all.end());
+  const auto rank = [&all](double q) { return all.empty() ? 0.0 : all[static_cast<std::size_t>(q * double(all.size() - 1))]; };
+  const double top = field.reverse ? rank(0.5) : rank(0.99);
+  const double peak = all.empty() ? 0.0 : field.reverse ? all.front() : all.back();
+  return fmt::format("\"{}\":{{\"label\":\"{}\",\"unit\":\"{}\",\"max\":{},\"peak\":{}{}}}", field.name, field.label, field.unit, json_number(top),
+                     json_number(peak), field.reverse ? ",\"reverse\":true" : "");
+}
+
+/// The particles of the final state, evenly subsampled above the limit, as JSON; their fastest speed [m/s].
+std::string particles_entry(const State& state, const Options& options, double& speed_max) {
   const std::size_t total = state.owned(), limit = std::max<std::size_t>(options.max_particles, 1);
   const std::size_t shown = std::min(total, limit);
   std::vector<float> position, radius, speed;
-  double speed_max = 0;
+  speed_max = 0;
   for (std::size_t k = 0; k < shown; ++k) {
     const std::size_t p = total > limit ? k * total / limit : k;
     const double s = std::sqrt(state.vx[p] * state.vx[p] + state.vy[p] * state.vy[p] + state.vz[p] * state.vz[p]);
@@ -276,44 +327,73 @@ std::string build(const Model& model, const State& state, double records_from, c
     speed.push_back(float(s));
     if (std::isfinite(s)) speed_max = std::max(speed_max, s);
   }
+  return fmt::format("{{\"n\":{},\"p\":\"{}\",\"r\":\"{}\",\"s\":\"{}\"}}", shown, pack(position), pack(radius), pack(speed));
+}
 
+/// The view's data: up, the meshes with their fields, the fields' scales, the particles.
+std::string view_data(const Model& model, const State& state, double records_from, const Options& options, WallFields& fields) {
+  const double seconds = state.time - records_from;  // [s] the records' interval
+  std::string meshes;
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) meshes += (meshes.empty() ? "" : ",") + mesh_entry(model, state, m, seconds, options, fields);
+  std::string scales;
+  for (WallField* f : fields.all())
+    if (f->present) scales += (scales.empty() ? "" : ",") + field_scale(*f);
+  double speed_max = 0;
+  const std::string particles = particles_entry(state, options, speed_max);
   Eigen::Vector3d up = -Eigen::Vector3d(model.gravity[0], model.gravity[1], model.gravity[2]);
   if (!(up.norm() > 0)) up = Eigen::Vector3d::UnitZ();
   up.normalize();
-  // Colour scale 0 to the 99th percentile over the triangles, as in the wear maps (app/pages/flow_images.cpp):
-  // one hot triangle does not turn every other one dark; the peak is in the legend.
-  auto field = [](const char* name, const char* label, std::vector<double>& all) {
-    std::sort(all.begin(), all.end());
-    const double top = all.empty() ? 0 : all[static_cast<std::size_t>(0.99 * double(all.size() - 1))], peak = all.empty() ? 0 : all.back();
-    return fmt::format("\"{}\":{{\"label\":\"{}\",\"unit\":\"W/m\\u00b2\",\"max\":{},\"peak\":{}}}", name, label, json_number(top),
-                       json_number(peak));
-  };
-  std::string fields = "{";
-  if (recorded) fields += field("shear", "shear work rate", shear_all) + "," + field("impact", "impact energy rate", impact_all);
-  fields += "}";
-  const std::string data = fmt::format(
-      "{{\"up\":[{},{},{}],\"meshes\":[{}],\"fields\":{},\"speedMax\":{},\"particles\":{{\"n\":{},\"p\":\"{}\",\"r\":\"{}\",\"s\":\"{}\"}}}}",
-      json_number(up.x()), json_number(up.y()), json_number(up.z()), meshes, fields, json_number(speed_max), shown, pack(position),
-      pack(radius), pack(speed));
+  return fmt::format("{{\"up\":[{},{},{}],\"meshes\":[{}],\"fields\":{{{}}},\"speedMax\":{},\"particles\":{}}}", json_number(up.x()),
+                     json_number(up.y()), json_number(up.z()), meshes, scales, json_number(speed_max), particles);
+}
 
-  std::string h = "<h2 id=\"view3d\">3D view</h2>\n";
-  h += fmt::format("<p>The walls in their pose at t = {} s and the {} particles of the final state, coloured by speed. "
-                   "Drag to orbit, right-drag or shift-drag to pan, the wheel zooms.",
-                   html::num(state.time, 4), total);
+/// What the view shows, above it.
+std::string intro(const Model& model, const State& state, double records_from, const Options& options, const WallFields& fields) {
+  const std::size_t total = state.owned(), limit = std::max<std::size_t>(options.max_particles, 1);
+  std::string h = fmt::format("<p>The walls in their pose at t = {} s and the {} particles of the final state, coloured by speed. "
+                              "Drag to orbit, right-drag or shift-drag to pan, the wheel zooms.",
+                              html::num(state.time, 4), total);
   if (total > limit)
     h += fmt::format(" <b>Subsampled:</b> {} of the {} particles are shown (evenly over the particle slots, about 1 in {:.3g}), "
-                     "to keep this file small.", shown, total, double(total) / double(limit));
-  if (recorded)
-    h += fmt::format(" Wall fields are averaged over t = {} to {} s, per triangle area; the colour scale runs from 0 to the 99th percentile over the triangles (the peak is beside it).",
+                     "to keep this file small.", limit, total, double(total) / double(limit));
+  if (fields.shear.present)
+    h += fmt::format(" Wall fields are averaged over t = {} to {} s, per triangle area (mean pressure: normal impulse per area and "
+                     "time, in kPa); the colour scale runs from 0 to the 99th percentile over the triangles (the peak is beside it).",
                      html::num(records_from, 3), html::num(state.time, 4));
   else if (!model.meshes.empty())
     h += " No wall records yet (recording starts at " + html::num(records_from, 3) + " s): the walls are plain.";
-  h += "</p>\n" + std::string(kStyle);
-  h += "<div class=\"v3d-tools\"><label>Walls coloured by <select id=\"v3d-field\">";
-  if (recorded) h += "<option value=\"shear\" selected>shear work rate (wear)</option><option value=\"impact\">impact energy rate</option>";
-  h += "<option value=\"plain\">plain</option></select></label><button type=\"button\" id=\"v3d-reset\">Reset view</button>"
-       "<span class=\"v3d-legend\" id=\"v3d-wall-legend\" style=\"display:none\"></span>"
-       "<span class=\"v3d-legend\" id=\"v3d-speed-legend\" style=\"display:none\"></span></div>\n";
+  if (fields.life.present)
+    h += " Liner life: months until the liner is worn through at each triangle, from its sliding and impact wear rates at the "
+         "report&#39;s operating hours; short lives are yellow, the scale runs from 0 to the median life over the worn triangles "
+         "(longer lives are dark, the shortest is beside it), grey where a mesh has no liner.";
+  return h + "</p>\n";
+}
+
+/// The tools above the canvas: the select box of the wall fields, the reset button, the legends.
+std::string tools(const WallFields& fields) {
+  std::string h = "<div class=\"v3d-tools\"><label>Walls coloured by <select id=\"v3d-field\">";
+  const std::vector<const WallField*> all = {&fields.shear, &fields.impact, &fields.pressure, &fields.life};
+  bool first = true;
+  for (const WallField* f : all) {
+    if (!f->present) continue;
+    h += fmt::format("<option value=\"{}\"{}>{}</option>", f->name, first ? " selected" : "", html::esc(f->option));
+    first = false;
+  }
+  return h + "<option value=\"plain\">plain</option></select></label><button type=\"button\" id=\"v3d-reset\">Reset view</button>"
+             "<span class=\"v3d-legend\" id=\"v3d-wall-legend\" style=\"display:none\"></span>"
+             "<span class=\"v3d-legend\" id=\"v3d-speed-legend\" style=\"display:none\"></span></div>\n";
+}
+
+std::string build(const Model& model, const State& state, double records_from, const Options& options) {
+  std::string three_path;
+  const std::string three = read_three_js(options, three_path);
+  if (three.empty())
+    return missing("three.js not found at " + three_path + " (install the Debian package libjs-three to get the interactive view)");
+  WallFields fields;
+  const std::string data = view_data(model, state, records_from, options, fields);
+  std::string h = "<h2 id=\"view3d\">3D view</h2>\n";
+  h += intro(model, state, records_from, options, fields);
+  h += std::string(kStyle) + tools(fields);
   h += "<div id=\"v3d\" data-state=\"loading\"><div id=\"v3d-msg\" style=\"display:none\"></div>"
        "<noscript>The 3D view needs JavaScript and WebGL.</noscript></div>\n";
   h += "<script>/* three.js (MIT licence), inlined from " + html::esc(three_path) + " */\n" + three + "\n</script>\n";

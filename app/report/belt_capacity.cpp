@@ -137,17 +137,6 @@ MeshBelt measure_belt(const MeshWall& mesh, const Eigen::Vector3d& up) {
 
 // ---- the material on the belt -------------------------------------------------------------------
 
-/// What the capacity needs of the material the inlets feed: its name, bulk density [kg/m^3] and
-/// where it comes from, and a measured angle of repose [deg] (NaN without one).
-struct MaterialFacts {
-  std::string name;
-  double bulk_density = kNaN;
-  std::string bulk_source;
-  bool bulk_assumed = false;
-  double repose = kNaN;
-  std::string repose_source;
-};
-
 /// The material the inlets feed (the inlet of the largest mass rate), else the first particle
 /// set's; -1 without either.
 int fed_material(const Model& model) {
@@ -218,9 +207,11 @@ void measured_facts(const MaterialSpec& spec, MaterialFacts& facts) {
   }
 }
 
-/// The fed material's bulk density: a design value bulk_density_kg_m3, else measured for its
-/// calibration, else stated in its library file's source of `density`, else kAssumedPacking x its
-/// solid density (assumed); and its measured angle of repose.
+}  // namespace
+
+// The fed material's bulk density: a design value bulk_density_kg_m3, else measured for its
+// calibration, else stated in its library file's source of `density`, else kAssumedPacking x its
+// solid density (assumed); and its measured angle of repose.
 MaterialFacts material_facts(const RunReportInput& in) {
   const Model& model = *in.model;
   MaterialFacts facts;
@@ -242,6 +233,8 @@ MaterialFacts material_facts(const RunReportInput& in) {
   }
   return facts;
 }
+
+namespace {
 
 // ---- one belt -------------------------------------------------------------------------------
 

@@ -83,6 +83,23 @@ const std::vector<FlowabilityClass>& cema_flowability_classes();
 /// deg, the default the report assumes without a measured angle) when the angle is NaN.
 const FlowabilityClass& cema_flowability(double repose_deg);
 
+/// What the report knows of the material the inlets feed (the inlet of the largest mass rate,
+/// else the first particle set's): its name, bulk density [kg/m^3] of the real material (not
+/// mass-scaled) and where it comes from, and a measured angle of repose [deg] (NaN without one).
+struct MaterialFacts {
+  std::string name;
+  double bulk_density = kNaN;
+  std::string bulk_source;
+  bool bulk_assumed = false;
+  double repose = kNaN;
+  std::string repose_source;
+};
+/// The fed material's facts: its bulk density from a design value bulk_density_kg_m3, else
+/// measured (the poured bulk density tests of a calibrated material's measurement file), else
+/// stated in its library file's source of `density`, else 0.6 x its solid density, assumed; and
+/// its measured angle of repose. Needs in.model; reads in.case_text and in.design.
+MaterialFacts material_facts(const RunReportInput& in);
+
 /// One receiving belt with a load box: its CEMA capacity, where each input came from, and the
 /// run's throughput onto it against that capacity. `missing` says why there is no capacity
 /// (no belt width, no speed); the other numbers are then NaN.

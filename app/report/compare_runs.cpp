@@ -141,7 +141,8 @@ FigureGroup metric_group(const std::string& name) {
     if (starts(name, prefix)) return FigureGroup::throughput;
   for (const char* prefix : {"drive_", "power_"})
     if (starts(name, prefix)) return FigureGroup::drives;
-  if (starts(name, "force_")) return FigureGroup::loads;
+  for (const char* prefix : {"force_", "liner_pressure_"})
+    if (starts(name, prefix)) return FigureGroup::loads;
   for (const char* prefix : {"wear_", "liner_life_", "shear_power_max", "impact_power_max"})
     if (starts(name, prefix)) return FigureGroup::wear;
   return FigureGroup::other;
@@ -151,7 +152,7 @@ FigureGroup metric_group(const std::string& name) {
 /// endings first, so "_m_s" is not read as seconds.
 std::string metric_unit(const std::string& name) {
   static constexpr std::pair<const char*, const char*> kEndings[] = {
-      {"_mm_per_Mt", "mm/Mt"}, {"_W_m2", "W/m²"}, {"_mm_yr", "mm/yr"}, {"_months", "months"}, {"_percent", "%"},
+      {"_mm_per_Mt", "mm/Mt"}, {"_W_m2", "W/m²"}, {"_mm_yr", "mm/yr"}, {"_months", "months"}, {"_percent", "%"}, {"_kPa", "kPa"},
       {"_N_m", "N m"},         {"_t_h", "t/h"},   {"_m_s", "m/s"},     {"_pct", "%"},          {"_kg", "kg"},
       {"_W", "W"},             {"_N", "N"},       {"_J", "J"},         {"_s", "s"}};
   for (const auto& [ending, unit] : kEndings)

@@ -25,6 +25,8 @@
 #include "case/liner_materials.h"
 #include "output/run.h"
 #include "pages/plot.h"
+#include "report/liner_loads.h"
+#include "report/choke.h"
 #include "report/report_analysis.h"
 #include "report/report_internal.h"
 #include "report/report_wear.h"
@@ -509,6 +511,36 @@ std::string wear(const Page& page) {
   return h;
 }
 
+/// Liner pressure: per mesh its mean, 95th percentile and peak pressure and the material's mean
+/// force over the records' window, and the files a structural model reads ("" without records).
+std::string liner_pressure(const Page& page, const LinerLoads& loads) {
+  if (page.model.meshes.empty() || !loads.recorded()) return "";
+  std::string h = fmt::format(
+      "<h2>Liner pressure</h2>\n<p>The material&#39;s pressure on each mesh over the wall records&#39; window t = {} s to {} s: per "
+      "triangle the normal impulse / (area &times; window); its mean weighted by area, the 95th percentile by area (95 % of the "
+      "area carries no more) and the peak, with the peak triangle&#39;s centroid; and the material&#39;s mean force on the mesh, "
+      "friction included. Positions and forces are in each mesh&#39;s own frame (the case&#39;s coordinates for a mesh without "
+      "motion). Also in liner_loads.csv; the map of the mean pressure is among the images (pressure_map.png).</p>\n<table>\n",
+      num(loads.t0, 3), num(loads.t1, 4));
+  h += table_row({"mesh", "area [m&sup2;]", "mean [kPa]", "p95 [kPa]", "peak [kPa]", "peak at x, y, z [m]", "F<sub>x</sub> [kN]",
+                  "F<sub>y</sub> [kN]", "F<sub>z</sub> [kN]", "for FEA"},
+                 true);
+  for (const LinerLoad& l : loads.meshes) {
+    const std::string stem = esc(fea_name(l.name));
+    h += table_row({esc(l.name), num(l.area), num(1e-3 * l.mean), num(1e-3 * l.p95), num(1e-3 * l.peak), vector_text(l.peak_centroid),
+                    num(1e-3 * l.total_force.x()), num(1e-3 * l.total_force.y()), num(1e-3 * l.total_force.z()),
+                    fmt::format("<code>fea/{}.inp</code>, <code>fea/{}.vtk</code>", stem, stem)});
+  }
+  return h + "</table>\n<p>For a structural model, <code>fea/MESH.inp</code> is a CalculiX / Abaqus input fragment in the mesh&#39;s own "
+             "frame, in N, m and Pa: the mesh&#39;s nodes (<code>*NODE</code>) and triangles as S3 shells (<code>*ELEMENT</code>), then "
+             "two load blocks that are alternatives, use one: <code>*CLOAD</code>, each triangle&#39;s mean force (pressure and "
+             "friction) split equally over its three nodes, or <code>*DLOAD</code>, each element&#39;s pressure (positive P acts "
+             "against the element normal of its node order; friction left out). Give the elements a <code>*SHELL SECTION</code> with "
+             "the liner&#39;s thickness and material and put the chosen block into a <code>*STEP</code> (CalculiX CrunchiX User&#39;s "
+             "Manual, *CLOAD, *DLOAD). <code>fea/MESH.vtk</code> shows the same in ParaView (pressure_kPa, shear_stress_kPa, "
+             "traction_Pa) in world coordinates at the pose of the run&#39;s end, as walls.h5.</p>\n";
+}
+
 /// What the capacity table states: the CEMA cross-section, the capacity, the throughput and the verdicts.
 std::string belt_capacity_intro(const Page& page) {
   return fmt::format(
@@ -584,6 +616,71 @@ std::string belt_loading(const Page& page) {
   page.set_band(p);
   p.lines.push_back({0.0, "centred"});
   h += figure(p, page.dir, "centring_offset", "Offset of the load's centroid from the box centre along <code>across</code>.");
+  return h;
+}
+
+/// The narrowest section's fill against the design rule, or why there is none ("" without a choke sensor).
+std::string choke_table(const Page& page) {
+  const ChokeResult& c = page.run.choke;
+  if (c.sensor.empty()) return "";
+  if (!c.missing.empty()) return fmt::format("<p>Narrowest section (box sensor <code>{}</code>): no fill, {}.</p>\n", esc(c.sensor), esc(c.missing));
+  std::string h = fmt::format("<p>{} The mass m is the box sensor&#39;s mean over {} &plusmn; the standard error of the mean (batch means){}. "
+                              "Also in choke.csv.</p>\n<table>\n",
+                              esc(kChokeRule), page.run.interval_text, page.model.mass_scaling != 1 ? ", divided by the mass scaling" : "");
+  h += table_row({"quantity", "value", "unit", "note"}, true);
+  const std::string height = std::isnan(c.height) ? std::string() : ", at height " + num(c.height, 4) + " m";
+  h += table_row({"free area of the section A", num(c.area, 4), "m&sup2;", "design value choke_section_area_m2" + height});
+  h += table_row({"box length along the flow L", num(c.length, 3), "m", "design value choke_section_length_m"});
+  h += table_row({"mass in the box m", pm(c.mass, c.mass_error), "kg", "box sensor " + esc(c.sensor)});
+  h += table_row({"poured bulk density &rho;", num(c.material.bulk_density, 4) + (c.material.bulk_assumed ? " <i>(assumed)</i>" : ""), "kg/m&sup3;",
+                  esc(c.material.name + ": " + c.material.bulk_source)});
+  h += table_row({"fill m / (&rho; A L)", pm(c.fill.fill, c.fill.fill_error, 3), "&ndash;", fmt::format("{} % of the section", num(100 * c.fill.fill, 3))});
+  h += table_row({"choke margin 1 &minus; fill", pm(c.fill.margin, c.fill.fill_error, 3), "&ndash;", ""});
+  h += table_row({"verdict", "<b>" + esc(choke_verdict_text(c.fill.verdict)) + "</b>", "",
+                  "ample below 1/3 (the design rule, assumed), adequate below 2/3, tight below 1, else choked"});
+  return h + "</table>\n";
+}
+
+/// A stream profile's depth and velocity against the lateral position: two plots.
+std::string stream_profile_figures(const Page& page, const StreamProfile& profile) {
+  const ChokeResult& c = page.run.choke;
+  plot::Plot depth;
+  depth.title = "Stream depth across " + profile.sensor;
+  depth.x_label = "lateral position along across [m]";
+  depth.y_label = "depth [mm]";
+  depth.series = {{"depth at the poured bulk density", profile.lateral, scaled(profile.depth, 1000.0)}};
+  // Across the chute's narrowest section, the section's own depth (its area over the box's width).
+  const double box_width = profile.width * static_cast<double>(profile.lateral.size());  // [m]
+  if (profile.sensor == kChokeSensor && c.area > 0 && box_width > 0) depth.lines.push_back({1000 * c.area / box_width, "depth of the section"});
+  std::string h = figure(depth, page.dir, "stream_depth_" + key(profile.sensor),
+                         fmt::format("Depth of the stream in each of the {} bins of <code>{}</code> ({} mm wide, over {} mm along the flow).",
+                                     profile.lateral.size(), esc(profile.sensor), num(1000 * profile.width, 3), num(1000 * profile.length, 3)));
+  plot::Plot velocity;
+  velocity.title = "Stream velocity across " + profile.sensor;
+  velocity.x_label = depth.x_label;
+  velocity.y_label = "velocity along the flow [m/s]";
+  velocity.series = {{"mass-weighted mean", profile.lateral, profile.velocity}};
+  h += figure(velocity, page.dir, "stream_velocity_" + key(profile.sensor),
+              fmt::format("Velocity along the flow in each bin of <code>{}</code>, weighted by mass and time; empty bins are left out.", esc(profile.sensor)));
+  return h;
+}
+
+/// The chute's narrowest section and the stream profiles ("" without either).
+std::string choke_and_stream_profile(const Page& page) {
+  const RunAnalysis& run = page.run;
+  if (run.choke.sensor.empty() && run.profiles.empty()) return "";
+  std::string h = "<h2>Choke and stream profile</h2>\n" + choke_table(page);
+  if (run.profiles.empty()) return h;
+  if (!(run.profiles.front().window > 0))
+    return h + fmt::format("<p>No stream profiles: their records start at t = {} s, and the run ended at t = {} s.</p>\n",
+                           num(page.in.records_from, 4), num(page.state.time, 4));
+  const MaterialFacts& material = run.choke.material;
+  h += fmt::format("<p>Stream profiles: each bin&#39;s time-mean mass and its velocity along the flow, weighted by mass and time, over the "
+                   "records window of {} s from t = {} s (the run&#39;s stream_profiles.csv). Depth = mean mass / (&rho; &times; bin "
+                   "width &times; the box&#39;s length along the flow), at the poured bulk density &rho; = {} kg/m&sup3; ({}): on a belt, "
+                   "the bed&#39;s depth; across the chute, how much of the section&#39;s depth the stream takes.</p>\n",
+                   num(run.profiles.front().window, 4), num(page.in.records_from, 4), num(material.bulk_density, 4), esc(material.bulk_source));
+  for (const StreamProfile& profile : run.profiles) h += stream_profile_figures(page, profile);
   return h;
 }
 
@@ -713,18 +810,25 @@ std::string reproducibility(const Page& page) {
 /// The list of the files beside the report, and the end of the page.
 std::string page_foot() {
   return "<p class=\"note\">Files beside this report: metrics.csv, steady_state.csv, drives.csv (with moving parts), "
-         "mesh_loads.csv (with meshes), wear_hotspots.csv, wear_life.csv (with meshes), belt_capacity.csv (with a belt&#39;s "
-         "capacity), plots/*.png with their data "
+         "mesh_loads.csv (with meshes), wear_hotspots.csv, wear_life.csv, liner_loads.csv and fea/ (with meshes), belt_capacity.csv "
+         "(with a belt&#39;s capacity), plots/*.png with their data "
          "(*.tsv) and gnuplot scripts (*.gp).</p>\n</body></html>\n";
 }
 
 }  // namespace
 
 RunMetrics write_run_report(const RunReportInput& in, const std::string& report_dir) {
-  const RunAnalysis run = analyse_run(in);
+  RunAnalysis run = analyse_run(in);
+  // The liners' pressure and loads (liner_loads.h): metrics.csv gets their metrics, fea/ their files.
+  const LinerLoads loads = liner_loads(*in.model, *in.state, in.records_from);
+  add_liner_pressure_metrics(loads, run.metrics);
   const Page page{in, run, *in.model, *in.state, report_dir};
   fs::create_directories(fs::path(report_dir) / "plots");
   write_run_tables(run, page.model, report_dir);
+  write_liner_loads(loads, page.model, in.case_path, report_dir);
+  // The 3D view gets the liners' life per triangle (report_wear.h).
+  viewer3d::Options viewer = in.viewer;
+  viewer.life_months = triangle_life_months(in);
 
   std::string h = page_head(page);
   h += banners(page);
@@ -734,8 +838,10 @@ RunMetrics write_run_report(const RunReportInput& in, const std::string& report_
   h += drives_and_loads(page);
   h += first_arrivals(page);
   h += wear(page);
+  h += liner_pressure(page, loads);
   h += belt_loading(page);
-  h += viewer3d::section(page.model, page.state, in.records_from, in.viewer);
+  h += choke_and_stream_profile(page);
+  h += viewer3d::section(page.model, page.state, in.records_from, viewer);
   h += images(page);
   h += time_series(page);
   h += steady_state_detection(page);

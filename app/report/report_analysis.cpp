@@ -538,7 +538,8 @@ void belt_loading(const AnalysisInput& input, RunAnalysis& run) {
     b.vertical = b.velocity.dot(up);
     b.lateral = b.velocity.dot(across);
     b.along = (b.velocity - b.vertical * up - b.lateral * across).norm();
-    std::tie(b.belt_name, b.belt_speed) = belt_speed_for(in.design, s.name);
+    // The box across a chute's narrowest section (choke.h) lies on no belt.
+    if (s.name != kChokeSensor) std::tie(b.belt_name, b.belt_speed) = belt_speed_for(in.design, s.name);
     boxes.push_back(std::move(b));
   }
 }
@@ -622,6 +623,7 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
     }
   }
   add_belt_capacity_metrics(run);
+  add_choke_metrics(run);
   metric("kinetic_energy_J", run.kinetic.at_run.mean);
 }
 
@@ -740,6 +742,7 @@ RunAnalysis analyse_run(const RunReportInput& in) {
   wear_per_triangle(input, run);
   belt_loading(input, run);
   find_belt_capacities(in, run);
+  find_choke_and_profiles(in, run);
   other_series(input, run);
   add_metrics(input, run);
   return run;
@@ -781,6 +784,7 @@ void write_run_tables(const RunAnalysis& run, const Model& model, const std::str
   write_drives_csv(run, report_dir);
   write_wear_life_csv(run, model, report_dir);
   write_belt_capacity_csv(run, report_dir);
+  write_choke_csv(run, report_dir);
 
 }
 

@@ -2,9 +2,10 @@
 // run with its own steady state and its average over the run's interval, the mass balance,
 // spillage and blockage, the drives of the moving parts and the loads on every mesh, wear per
 // triangle and the liners' life (report_wear.h), belt loading and the receiving belts against
-// their CEMA capacity (belt_capacity.h), and the metrics. report_analysis.cpp computes them and
+// their CEMA capacity (belt_capacity.h), the chute's narrowest section against the stream's fill
+// and the stream profiles (choke.h), and the metrics. report_analysis.cpp computes them and
 // writes the report's tables (steady_state.csv, wear_hotspots.csv, wear_life.csv,
-// belt_capacity.csv, metrics.csv); report.cpp draws the plots and writes report.html.
+// belt_capacity.csv, choke.csv, metrics.csv); report.cpp draws the plots and writes report.html.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "report/belt_capacity.h"
+#include "report/choke.h"
 #include "report/report.h"
 #include "report/report_internal.h"
 #include "report/report_wear.h"
@@ -169,6 +171,10 @@ struct RunAnalysis {
   std::vector<BoxResult> boxes;
   /// Per receiving belt with a load box and a speed: its CEMA capacity and the run's loading of it.
   std::vector<BeltCapacity> belts;
+  /// The chute's narrowest section against the stream's fill (a box sensor stream_chute with the
+  /// generator's choke_section_* design values), and the profiles of the box sensors with bins.
+  ChokeResult choke;
+  std::vector<StreamProfile> profiles;
   std::vector<RunEvent> events;                ///< first arrivals, in the order they happened
   Quantity kinetic, particles, holdup_q, contacts;
   RunMetrics metrics;
@@ -179,8 +185,8 @@ struct RunAnalysis {
 /// The numbers of the run report (input.model and input.state are required).
 RunAnalysis analyse_run(const RunReportInput& in);
 /// steady_state.csv, mesh_loads.csv (with meshes), drives.csv (with moving parts),
-/// wear_hotspots.csv, wear_life.csv (with meshes), belt_capacity.csv (with a belt's capacity) and
-/// metrics.csv into report_dir.
+/// wear_hotspots.csv, wear_life.csv (with meshes), belt_capacity.csv (with a belt's capacity),
+/// choke.csv (with a chute's narrowest section) and metrics.csv into report_dir.
 void write_run_tables(const RunAnalysis& run, const Model& model, const std::string& report_dir);
 
 }  // namespace dem::report

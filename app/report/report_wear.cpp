@@ -118,6 +118,27 @@ std::optional<Liner> liner_of(const RunReportInput& input, const std::string& na
   return std::nullopt;
 }
 
+std::vector<std::vector<double>> triangle_life_months(const RunReportInput& input) {
+  std::vector<std::vector<double>> out;
+  if (!input.model || !input.state) return out;
+  const Model& model = *input.model;
+  const State& state = *input.state;
+  const double interval = state.time - input.records_from;  // [s] the records' interval
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+    const TriangleSurface& surface = *model.meshes[m].surface;
+    out.emplace_back(surface.size(), kNaN);
+    const std::optional<Liner> liner = liner_of(input, model.meshes[m].name);
+    if (!liner || m >= state.records.size() || !(interval > 0)) continue;
+    // Each triangle as a zone of its own: its friction work and impact energy on its area.
+    const TriangleRecords& rec = state.records[m];
+    for (std::size_t t = 0; t < surface.size(); ++t)
+      if (surface.areas[t] > 0)
+        out[m][t] = wear_zone(*liner, at(rec.shear_work, t), at(rec.impact_energy, t), surface.areas[t], interval, input.operating_hours_per_year, kNaN)
+                        .life_months;
+  }
+  return out;
+}
+
 void add_liner_metrics(RunAnalysis& run, const Model& model) {
   const auto metric = [&run](const std::string& name, double value) {
     if (std::isfinite(value)) run.metrics.values.emplace_back(key(name), value);

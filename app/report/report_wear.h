@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "case/spec.h"
 #include "core/model.h"
@@ -65,6 +66,12 @@ std::map<std::string, Liner> liners_for(const CaseSpec& spec, const Model& model
 /// The liner the report uses for mesh `name`: input.liners, else a sliding coefficient alone
 /// from input.wear_coefficient; none when neither names it.
 std::optional<Liner> liner_of(const RunReportInput& input, const std::string& name);
+
+/// [months] Per mesh, per triangle: the life of the mesh's liner there (wear_zone of the
+/// triangle's friction work and impact energy over the records' interval, at the operating hours
+/// of `input`), for the 3D view's life field. NaN on a mesh without a liner or a thickness, on a
+/// triangle of no area and everywhere without records; infinite where a liner does not wear.
+std::vector<std::vector<double>> triangle_life_months(const RunReportInput& input);
 
 /// Appends to run.metrics, per mesh with a liner: wear_sliding_MESH_mm_yr and
 /// wear_impact_MESH_mm_yr (at the worst triangle), liner_life_MESH_months (worst triangle),

@@ -202,10 +202,15 @@ struct OutletSpec {
   SourceLocation location;
 };
 
+/// The most lateral bins a box sensor may have (SensorSpec::bins).
+inline constexpr int kMostSensorBins = 200;
+
 /// Measures the flow without touching it. A plane sensor gives the mass flow through a plane
 /// (within a box), estimated from the particles in a thin slab: Q = sum(m v.n) / thickness. A box
 /// sensor gives the mass inside, its mean velocity and the offset of its centroid along `across`
-/// from the box centre (the centring of the load on a belt).
+/// from the box centre (the centring of the load on a belt); with `bins`, also a stream profile:
+/// per lateral bin across the box, the time-mean mass and the mass-weighted velocity along `along`
+/// over the records window (statistics/stream_profile.h, stream_profiles.csv).
 struct SensorSpec {
   enum class Kind { plane, box } kind = Kind::box;
   std::string name;
@@ -213,7 +218,11 @@ struct SensorSpec {
   Vec3 point{0, 0, 0};    // [m] plane: a point on it
   Vec3 normal{1, 0, 0};   // plane: unit normal, flow along it counts positive
   double thickness = 0;   // [m] plane: slab thickness; 0: twice the largest particle diameter
-  Vec3 across{0, 1, 0};   // box: unit lateral axis for the centring offset
+  Vec3 across{0, 1, 0};   // box: unit lateral axis for the centring offset and the bins
+  int bins = 0;           ///< box: equal lateral bins along `across` for a stream profile; 0: none
+  /// box: unit flow direction the bins' velocity is taken along and the depth's length is measured
+  /// along (YAML default: across x up, the horizontal perpendicular to `across`).
+  Vec3 along{1, 0, 0};
   SourceLocation location;
 };
 

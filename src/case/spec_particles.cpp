@@ -2,9 +2,12 @@
 // particle sets placed at the start, clump templates, inlets, outlets and sensors.
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "case/spec.h"
 #include "case/spec_reading.h"
@@ -75,6 +78,27 @@ void read_box(MapReader& map, const std::string& key, const std::string& file, V
   hi = box.vec3("max", Vec3::Zero());
   if (!(hi.array() > lo.array()).all()) box.fail("max", "each component must exceed min");
   box.finish();
+}
+
+/// What a stream profile's `bins` key is, for the messages that refuse it where it does not belong.
+std::string bins_help() {
+  return fmt::format("valid: bins in a box sensor, `box: {{min, max, across, bins: N, along: [x, y, z]}}`, N a whole number from 0 "
+                     "(none) to {} lateral bins along `across`", kMostSensorBins);
+}
+
+/// A box sensor's stream profile: `bins` lateral bins along `across` (0: none) and the flow
+/// direction `along`, by default across x up (the horizontal perpendicular to a horizontal
+/// `across`; [1, 0, 0] when `across` is vertical, where bins then need `along` given).
+void read_profile_bins(MapReader& box, SensorSpec& s) {
+  s.bins = static_cast<int>(box.integer("bins", 0, 0, kMostSensorBins));
+  const Vec3 level = s.across.normalized().cross(Vec3(0, 0, 1));
+  const bool horizontal = level.norm() > 1e-6;
+  s.along = box.vec3("along", horizontal ? Vec3(level.normalized()) : Vec3(1, 0, 0));
+  if (s.along.norm() < 1e-12) box.fail("along", "must not be zero; give the unit direction of the flow, e.g. [1, 0, 0]");
+  if (std::abs(s.along.normalized().dot(s.across.normalized())) > 0.01)
+    box.fail("along", "must be perpendicular to `across` (the bins lie along `across`, the flow crosses them along `along`)");
+  if (s.bins > 0 && !horizontal && !box.has("along"))
+    box.fail("bins", "need `along` here: `across` is vertical, so no horizontal flow direction follows from it; give `along: [x, y, z]`");
 }
 
 }  // namespace
@@ -152,9 +176,12 @@ SensorSpec read_sensor(const YAML::Node& node, const std::string& file, size_t i
   s.name = map.string("name", fmt::format("sensor{}", index));
   if (map.has("plane") == map.has("box"))
     map.fail("plane", "give exactly one of `plane: {point, normal, thickness}` (a flow plane) or `box: {min, max, across}`");
+  if (map.has("bins"))
+    map.fail("bins", fmt::format("{}; {}", map.has("box") ? "belongs inside `box:`" : "a plane sensor has no bins", bins_help()));
   if (const YAML::Node plane = map.node("plane")) {
     s.kind = SensorSpec::Kind::plane;
     MapReader p(plane, file, map.key_path("plane"));
+    if (p.has("bins")) p.fail("bins", fmt::format("a plane sensor has no bins (it measures the flow through a plane); {}", bins_help()));
     s.point = p.vec3("point", Vec3::Zero());
     s.normal = p.vec3("normal", Vec3(1, 0, 0));
     if (s.normal.norm() < 1e-12) p.fail("normal", "must not be zero");
@@ -169,6 +196,7 @@ SensorSpec read_sensor(const YAML::Node& node, const std::string& file, size_t i
     if (!(s.region_max.array() > s.region_min.array()).all()) b.fail("max", "each component must exceed min");
     s.across = b.vec3("across", s.across);
     if (s.across.norm() < 1e-12) b.fail("across", "must not be zero");
+    read_profile_bins(b, s);
     b.finish();
   }
   map.finish();

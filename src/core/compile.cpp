@@ -453,15 +453,28 @@ void check_inlet_ports(const CaseSpec& spec) {
                                   spec.inlets[k].location.str(), k, spec.inlets[k].port));
 }
 
-/// Sensors: unit directions, a slab a couple of particles thick, unique names.
+/// A stream profile's bins (SensorSpec::bins) of a sensor a generator or a test built: the case
+/// reader checks those of a file, with their lines.
+void check_sensor_bins(const SensorSpec& sensor, size_t k) {
+  if (sensor.bins == 0) return;
+  std::string wrong;
+  if (sensor.kind != SensorSpec::Kind::box) wrong = "a plane sensor has no bins";
+  else if (sensor.bins < 0 || sensor.bins > kMostSensorBins) wrong = fmt::format("{} is out of range; valid: [0, {}]", sensor.bins, kMostSensorBins);
+  else if (sensor.along.norm() < 1e-12) wrong = "need a flow direction `along`, which is zero";
+  if (!wrong.empty()) throw CaseError(fmt::format("{}: sensors[{}].bins: {} (sensor '{}')", sensor.location.str(), k, wrong, sensor.name));
+}
+
+/// Sensors: unit directions, a slab a couple of particles thick, unique names, bins only in boxes.
 void add_sensors(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.sensors.size(); ++k) {
     SensorSpec sensor = spec.sensors[k];
     for (size_t j = 0; j < k; ++j)
       if (spec.sensors[j].name == sensor.name)
         throw CaseError(fmt::format("{}: sensors[{}].name: '{}' is used twice; sensor names must differ", sensor.location.str(), k, sensor.name));
+    check_sensor_bins(sensor, k);
     sensor.normal.normalize();
     sensor.across.normalize();
+    if (sensor.along.norm() > 0) sensor.along.normalize();
     if (sensor.kind == SensorSpec::Kind::plane && sensor.thickness <= 0) sensor.thickness = 4.0 * model.radius_max;
     model.sensors.push_back(sensor);
   }

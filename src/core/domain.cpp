@@ -13,7 +13,7 @@ namespace {
 /// Every column of a mesh's wear records, one loop for packing, zeroing and summing.
 template <typename Records, typename F>
 void each_record_column(Records& r, F&& f) {
-  for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) f(*c);
+  for (auto* c : r.columns()) f(*c);
 }
 
 }  // namespace

@@ -441,6 +441,11 @@ void sum_mesh_records(const Model& model, State& s, Workspace& work, long begin,
         r.shear_impulse[t] += std::sqrt(std::max(total * total - fn * fn, 0.0)) * dt;
         r.shear_work[t] += slot_results.shear_power[at] * dt;
         if (slot_results.impact_energy[at] >= 0) r.impacts[t] += 1.0, r.impact_energy[t] += slot_results.impact_energy[at];
+        // The particle's push on the mesh, -F, in the mesh's own frame: R^T (-F).
+        const double push[3] = {-ftx, -fty, -ftz};
+        double local[3];
+        mul_transposed(work.mesh_rotation[m], push, local);
+        r.force_impulse_x[t] += local[0] * dt, r.force_impulse_y[t] += local[1] * dt, r.force_impulse_z[t] += local[2] * dt;
       }
       // The particle pushes the mesh with -F; torque about the motion origin; power F . v_wall.
       loads.fx[m] -= ftx, loads.fy[m] -= fty, loads.fz[m] -= ftz;

@@ -199,7 +199,7 @@ State initial_state(const Model& model) {
   state.mesh_history_width = static_cast<size_t>(model.history_width);
   for (const MeshWall& mesh : model.meshes) {
     TriangleRecords r;
-    for (auto* c : {&r.normal_impulse, &r.shear_impulse, &r.shear_work, &r.impacts, &r.impact_energy}) c->assign(mesh.surface->size(), 0.0);
+    for (std::vector<double>* c : r.columns()) c->assign(mesh.surface->size(), 0.0);
     state.records.push_back(std::move(r));
   }
   for (const PlaneWall& w : model.planes) {

@@ -69,13 +69,26 @@ struct MeshContacts {
 };
 
 /// What each mesh triangle has received, summed over the run (differences between two times
-/// give the rates over that interval). Per triangle: 5 doubles.
+/// give the rates over that interval). Per triangle: 8 doubles.
 struct TriangleRecords {
   std::vector<double> normal_impulse;  // [N s] integral of the normal force
   std::vector<double> shear_impulse;   // [N s] integral of the tangential force magnitude
   std::vector<double> shear_work;      // [J] friction work, sum |Ft . v_slip| dt (Archard wear input)
   std::vector<double> impacts;         // [-] contacts that started on the triangle
   std::vector<double> impact_energy;   // [J] sum of 1/2 m* vn^2 at the start of each contact
+  /// [N s] Integral of the force the particles put on the triangle (normal and friction), in the
+  /// mesh's own frame: the frame its vertices are stored in, which its pose places in the world.
+  /// Rejected: the world frame, in which the mean load on a turning part says nothing of where it
+  /// acts on the part.
+  std::vector<double> force_impulse_x, force_impulse_y, force_impulse_z;
+
+  /// Every column, for code that treats them alike (sizing, zeroing, packing, summing).
+  std::array<std::vector<double>*, 8> columns() {
+    return {&normal_impulse, &shear_impulse, &shear_work, &impacts, &impact_energy, &force_impulse_x, &force_impulse_y, &force_impulse_z};
+  }
+  std::array<const std::vector<double>*, 8> columns() const {
+    return {&normal_impulse, &shear_impulse, &shear_work, &impacts, &impact_energy, &force_impulse_x, &force_impulse_y, &force_impulse_z};
+  }
 };
 
 /// Per mesh, from the last force evaluation.
@@ -108,6 +121,19 @@ struct MeshLoads {
   }
   /// A row was written: the next one averages from here.
   void restart_interval() { std::fill(interval.begin(), interval.end(), 0.0), interval_time = 0; }
+};
+
+/// The stream profiles of the box sensors with bins (SensorSpec::bins), integrated over time from
+/// output.records_from on (statistics/stream_profile.h): each row of scalars adds each bin's mass
+/// and momentum along the flow, held for the time since the row before. The rows' parts are summed
+/// over the ranks of a decomposed run before any rank integrates them, so every rank holds the
+/// same values, as it holds the time. 2 doubles a bin.
+struct StreamProfiles {
+  std::vector<double> mass_time;      // [kg s] (bins of the binned sensors in the model's order) integral of each bin's mass
+  std::vector<double> momentum_time;  // [kg m] integral of each bin's momentum along its sensor's `along`
+  double window = 0;                  // [s] time integrated so far
+  double last_row_time = 0;           // [s] of the last row seen
+  bool has_row = false;               ///< a row has been seen (the first only starts the clock)
 };
 
 /// Buffers State::permute gathers columns into, one per element type and column length: a
@@ -180,6 +206,7 @@ struct State {
   std::array<double, 3> lists_drift_velocity = {0.0, 0.0, 0.0};
   std::vector<TriangleRecords> records;  ///< per mesh
   MeshLoads mesh_loads;
+  StreamProfiles stream_profiles;
   /// Positions at the last rebuild of the contact lists: the lists stay valid until a sphere
   /// has used up its share of the skin from here (DriftLimits, verlet.h). Part of the state so
   /// a restart rebuilds when the uninterrupted run would.

@@ -17,23 +17,29 @@ namespace dem {
 
 namespace {
 
-/// Version 8: magic, model hash, run id, the State with the mesh loads integrated since the last
-/// row of scalars (MeshLoads::interval; visit).
-constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '8'};
+/// Version 9: magic, model hash, run id, the State with the force impulses of the wall records
+/// (TriangleRecords::force_impulse_x, _y, _z) and the stream profiles (State::stream_profiles; visit).
+constexpr char kMagic[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '9'};
+/// Version 8 lacks the force impulses: read as zeros, so a run resumed from it counts the mean
+/// traction and the liner loads (report/liner_loads.h) from the resume on, though its pressure
+/// counts from output.records_from.
+constexpr char kMagic8[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '8'};
 /// Version 7 lacks MeshLoads::interval: read as empty, so the first row after resuming averages
 /// the mesh loads from the resume on.
 constexpr char kMagic7[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '7'};
 /// Version 6 has no run id (read as 0).
 constexpr char kMagic6[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '6'};
-/// A rank's share: magic, model hash, step, rank, ranks, count, then `count` doubles.
-constexpr char kShareMagic[8] = {'D', 'E', 'M', 'S', 'H', 'A', 'R', '1'};
+/// A rank's share: magic, model hash, step, rank, ranks, count, then `count` doubles (pack_share,
+/// core/domain.h). Version 2 packs the eight columns of the wall records; a share of version 1
+/// (five columns) is refused as not of this version.
+constexpr char kShareMagic[8] = {'D', 'E', 'M', 'S', 'H', 'A', 'R', '2'};
 /// Version 5 lacks State::lists_drift_velocity: read as zero, which is always a valid drift
 /// (verlet.h), so its runs resume.
 constexpr char kMagic5[8] = {'D', 'E', 'M', 'C', 'K', 'P', 'T', '5'};
 
-/// Every field of the State, in one order, for both directions (`version` 5 to 8; 7 stores the State as 6).
+/// Every field of the State, in one order, for both directions (`version` 5 to 9; 7 stores the State as 6).
 template <typename Io, typename S>
-void visit(Io& io, S& s, int version = 8) {
+void visit(Io& io, S& s, int version = 9) {
   io(s.time), io(s.step), io(s.next_id), io(s.lost), io(s.lost_mass);
   for (auto* c : {&s.x, &s.y, &s.z, &s.vx, &s.vy, &s.vz, &s.wx, &s.wy, &s.wz, &s.fx, &s.fy, &s.fz, &s.tx, &s.ty, &s.tz,
                   &s.radius, &s.inv_mass, &s.inv_inertia, &s.offset_x, &s.offset_y, &s.offset_z, &s.x_built, &s.y_built,
@@ -57,11 +63,25 @@ void visit(Io& io, S& s, int version = 8) {
   std::uint64_t meshes = s.records.size();
   io(meshes);
   if constexpr (!std::is_const_v<S>) s.records.resize(meshes);
-  for (auto& r : s.records) io(r.normal_impulse), io(r.shear_impulse), io(r.shear_work), io(r.impacts), io(r.impact_energy);
+  for (auto& r : s.records) {
+    io(r.normal_impulse), io(r.shear_impulse), io(r.shear_work), io(r.impacts), io(r.impact_energy);
+    // Before version 9 the force impulses were not kept: zeros, one per triangle.
+    if (version >= 9) {
+      io(r.force_impulse_x), io(r.force_impulse_y), io(r.force_impulse_z);
+    } else if constexpr (!std::is_const_v<S>) {
+      for (auto* c : {&r.force_impulse_x, &r.force_impulse_y, &r.force_impulse_z}) c->assign(r.normal_impulse.size(), 0.0);
+    }
+  }
   for (auto* c : {&s.mesh_loads.fx, &s.mesh_loads.fy, &s.mesh_loads.fz, &s.mesh_loads.tx, &s.mesh_loads.ty, &s.mesh_loads.tz,
                   &s.mesh_loads.power})
     io(*c);
   if (version >= 8) io(s.mesh_loads.interval), io(s.mesh_loads.interval_time);
+  // Version 9 also keeps the stream profiles (State::stream_profiles); before it they are empty,
+  // and a resumed run's profiles count from the resume on (their window says how long).
+  if (version >= 9) {
+    auto& p = s.stream_profiles;
+    io(p.mass_time), io(p.momentum_time), io(p.window), io(p.last_row_time), io(p.has_row);
+  }
 }
 
 struct Writer {
@@ -127,7 +147,8 @@ State load_checkpoint(const std::string& path, const Model& model, std::uint64_t
   Reader reader{in, path, static_cast<std::uint64_t>(std::filesystem::file_size(path))};
   char magic[sizeof kMagic];
   reader.read(magic, sizeof magic);
-  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0     ? 8
+  const int version = std::memcmp(magic, kMagic, sizeof kMagic) == 0     ? 9
+                      : std::memcmp(magic, kMagic8, sizeof kMagic8) == 0 ? 8
                       : std::memcmp(magic, kMagic7, sizeof kMagic7) == 0 ? 7
                       : std::memcmp(magic, kMagic6, sizeof kMagic6) == 0 ? 6
                       : std::memcmp(magic, kMagic5, sizeof kMagic5) == 0 ? 5

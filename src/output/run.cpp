@@ -21,6 +21,7 @@
 #include "core/step.h"
 #include "output/checkpoint.h"
 #include "output/results_hdf5.h"
+#include "statistics/stream_profile.h"
 
 namespace dem {
 
@@ -186,6 +187,23 @@ FrameWriter make_frame_writer(const Model& model, const std::string& directory) 
                       {"time_step_s", fmt::format("{:.9g}", model.dt)}});
 }
 
+/// Fields mean_traction_x_Pa, _y_Pa, _z_Pa of a mesh: the particles' force per area over the
+/// records' interval (per_area_rate), kept in the mesh's own frame and turned here by its pose
+/// at the end of the run, the pose the vertices are written in (the identity for a mesh without
+/// motion).
+template <typename PerAreaRate>
+void add_mean_traction(MeshFieldSet& set, const TriangleRecords& r, const Pose& pose, PerAreaRate per_area_rate) {
+  const std::vector<double> local[3] = {per_area_rate(r.force_impulse_x), per_area_rate(r.force_impulse_y), per_area_rate(r.force_impulse_z)};
+  std::vector<double> world[3];
+  for (size_t t = 0; t < local[0].size() && t < local[1].size() && t < local[2].size(); ++t) {
+    const Eigen::Vector3d v = pose.rotation * Eigen::Vector3d(local[0][t], local[1][t], local[2][t]);
+    for (int a = 0; a < 3; ++a) world[a].push_back(v[a]);
+  }
+  set.fields.push_back({"mean_traction_x_Pa", std::move(world[0])});
+  set.fields.push_back({"mean_traction_y_Pa", std::move(world[1])});
+  set.fields.push_back({"mean_traction_z_Pa", std::move(world[2])});
+}
+
 /// The wear inputs of every mesh triangle, as run totals and per-area rates over the run.
 void write_mesh_records(const Model& model, const State& s, const std::string& out) {
   std::vector<MeshFieldSet> sets;
@@ -215,6 +233,7 @@ void write_mesh_records(const Model& model, const State& s, const std::string& o
                   {"shear_work_J", r.shear_work},
                   {"impact_energy_J", r.impact_energy},
                   {"impacts", r.impacts}};
+    add_mean_traction(set, r, pose, per_area_rate);
     sets.push_back(std::move(set));
   }
   write_mesh_fields(out, sets, s.time);
@@ -516,10 +535,14 @@ Scalars measure_row(const RunSetup& s, RowTotals& totals) {
   return row;
 }
 
-/// A row of scalars measured and, by the process that writes the results, kept.
+/// A row of scalars measured and, by the process that writes the results, kept; its bins added
+/// to the stream profiles on every rank alike, and then dropped from the row (the profiles hold
+/// them; a run of many rows keeps no bins per row).
 void add_row(const RunSetup& s, RunSummary& summary, RowTotals& totals) {
   Scalars row = measure_row(s, totals);
   s.state.mesh_loads.restart_interval();
+  accumulate_stream_profiles(s.model, row, s.state);
+  for (SensorReading& reading : row.sensors) reading.bin_mass = std::vector<double>(), reading.bin_momentum = std::vector<double>();
   totals.particles = static_cast<double>(row.particles);
   if (s.writer) summary.scalars.push_back(std::move(row));
 }
@@ -869,6 +892,9 @@ void write_results(const RunParts& parts) {
   const State& state = s.state;
   const State& final_state = *parts.results.state;
   if (!model.meshes.empty()) write_mesh_records(model, final_state, s.out);
+  // The binned box sensors' profiles over the records window (the same on every rank).
+  const bool profiles = profile_bin_total(model) > 0;
+  if (profiles) write_file_atomically(s.out + "/stream_profiles.csv", stream_profiles_csv(stream_profile_rows(model, state.stream_profiles)));
   write_tables(parts);
   // The end state's hash: a resumed run and an uninterrupted one compare equal when bitwise equal.
   write_file_atomically(s.out + "/run_info.yaml",
@@ -876,8 +902,9 @@ void write_results(const RunParts& parts) {
                                                       "  state_hash: {:016x}\n",
                                                       state.step >= parts.schedule.last_step ? "true" : "false", state.time, state.step,
                                                       final_state.size(), state_hash(final_state, model.history_width)));
-  fmt::print(s.log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}\n", s.out,
-             parts.outputs.frames ? parts.outputs.frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", s.out));
+  fmt::print(s.log, "  wrote {0}/scalars.csv, {0}/particles.xdmf ({1} frames), {0}/run_info.yaml{2}{3}\n", s.out,
+             parts.outputs.frames ? parts.outputs.frames->frames().size() : 0, model.meshes.empty() ? "" : fmt::format(", {}/walls.xdmf", s.out),
+             profiles ? fmt::format(", {}/stream_profiles.csv", s.out) : "");
 }
 
 /// Under domain decomposition: what it cost rank 0, and how the frames were written.

@@ -163,7 +163,7 @@ RunRecord read_run_record(const std::string& directory) {
 std::vector<std::string> run_output_names() {
   return {"run_info.yaml",       "scalars.csv",    "events.csv",      "particles.xdmf",       "frames/frame_*.h5",
           "open_in_paraview.py", "walls.h5",       "walls.xdmf",      "checkpoint.bin",       "checkpoint.ranks.bin",
-          "checkpoint.ranks/step-*.bin"};
+          "checkpoint.ranks/step-*.bin", "stream_profiles.csv"};
 }
 
 std::uint64_t new_run_id() {

@@ -2,6 +2,7 @@
 
 #include "bodies/rigid_body.h"
 #include "core/neighbors.h"
+#include "statistics/stream_profile.h"
 
 #include <fmt/format.h>
 
@@ -43,8 +44,8 @@ std::uint64_t mix(std::uint64_t h, double v) {
 
 /// Plane: Q = sum(m v.n) / h over the particles in a slab of thickness h around the plane (the
 /// flux estimator of continuum averaging: each particle crossing spends h / (v.n) in the slab).
-/// Box: mass, mass-weighted velocity, centroid offset along `across`. Clumps count once, at
-/// their centre of mass.
+/// Box: mass, mass-weighted velocity, centroid offset along `across`, and with bins each bin's
+/// mass and momentum along `along`. Clumps count once, at their centre of mass.
 namespace {
 
 /// Where each part of the scalars lies in ScalarParts::sums.
@@ -53,17 +54,26 @@ struct PartsLayout {
                           kLostMass = 6, kFixed = 7;
   static constexpr size_t kPerMesh = 7;    // fx, fy, fz, tx, ty, tz, power
   static constexpr size_t kPerSensor = 8;  // flow, count_flow, vx, vy, vz (weighted sums), carried weight, mass, moment
-  size_t outlets, meshes, sensors;
-  explicit PartsLayout(const Model& model) : outlets(model.outlets.size()), meshes(model.meshes.size()), sensors(model.sensors.size()) {}
+  static constexpr size_t kPerBin = 2;     // mass, momentum along the flow (binned box sensors, after all sensors)
+  size_t outlets, meshes, sensors, bins;
+  explicit PartsLayout(const Model& model)
+      : outlets(model.outlets.size()), meshes(model.meshes.size()), sensors(model.sensors.size()), bins(profile_bin_total(model)) {}
   size_t outlet(size_t k) const { return kFixed + k; }
   size_t mesh(size_t m) const { return kFixed + outlets + kPerMesh * m; }
   size_t sensor(size_t k) const { return kFixed + outlets + kPerMesh * meshes + kPerSensor * k; }
-  size_t size() const { return sensor(sensors); }
+  size_t profiles() const { return sensor(sensors); }
+  size_t size() const { return profiles() + kPerBin * bins; }
 };
 
-/// The sensors' sums over the owned particles and bodies (PartsLayout::kPerSensor each).
-void sum_sensors(const Model& model, const State& s, double* sums) {
+/// The sensors' sums over the owned particles and bodies (PartsLayout::kPerSensor each into
+/// `sums`) and, for the binned box sensors, each bin's (PartsLayout::kPerBin into `bin_sums`).
+void sum_sensors(const Model& model, const State& s, double* sums, double* bin_sums) {
   if (model.sensors.empty()) return;
+  // Each binned sensor's bins and where they begin in bin_sums (a few per row, not per particle).
+  std::vector<ProfileBins> bins(model.sensors.size());
+  std::vector<size_t> first_bin(model.sensors.size(), 0);
+  for (size_t k = 0, next = 0; k < model.sensors.size(); ++k)
+    if (has_profile(model.sensors[k])) bins[k] = profile_bins(model.sensors[k]), first_bin[k] = next, next += static_cast<size_t>(bins[k].count);
   auto add = [&](double x, double y, double z, double vx, double vy, double vz, double m) {
     for (size_t k = 0; k < model.sensors.size(); ++k) {
       const SensorSpec& sensor = model.sensors[k];
@@ -83,9 +93,15 @@ void sum_sensors(const Model& model, const State& s, double* sums) {
         }
       } else {
         const Vec3 centre = 0.5 * (sensor.region_min + sensor.region_max);
+        const double lateral = (x - centre.x()) * sensor.across.x() + (y - centre.y()) * sensor.across.y() + (z - centre.z()) * sensor.across.z();
         r[6] += m;
         r[2] += m * vx, r[3] += m * vy, r[4] += m * vz;
-        r[7] += m * ((x - centre.x()) * sensor.across.x() + (y - centre.y()) * sensor.across.y() + (z - centre.z()) * sensor.across.z());
+        r[7] += m * lateral;
+        if (bins[k].count > 0) {
+          double* bin = bin_sums + PartsLayout::kPerBin * (first_bin[k] + static_cast<size_t>(bins[k].bin(lateral)));
+          bin[0] += m;
+          bin[1] += m * (vx * sensor.along.x() + vy * sensor.along.y() + vz * sensor.along.z());
+        }
       }
     }
   };
@@ -144,7 +160,7 @@ ScalarParts measure_parts(const Model& model, const State& s, const Workspace& w
     double* l = sums + at.mesh(m);
     for (size_t c = 0; c < 7; ++c) l[c] = loads.mean(m, c);  // over the row's interval
   }
-  sum_sensors(model, s, sums + at.sensor(0));
+  sum_sensors(model, s, sums + at.sensor(0), sums + at.profiles());
   return out;
 }
 
@@ -186,6 +202,16 @@ Scalars finish_scalars(const Model& model, const State& s, const ScalarParts& pa
       reading.vx /= weight, reading.vy /= weight, reading.vz /= weight;
       if (model.sensors[k].kind != SensorSpec::Kind::plane) reading.offset = r[7] / weight;
     }
+  }
+  // The binned box sensors' bins, in the model's order after all sensors.
+  for (size_t k = 0, next = 0; k < at.sensors; ++k) {
+    if (!has_profile(model.sensors[k])) continue;
+    const size_t n = static_cast<size_t>(model.sensors[k].bins);
+    const double* b = sums + at.profiles() + PartsLayout::kPerBin * next;
+    SensorReading& reading = out.sensors[k];
+    reading.bin_mass.resize(n), reading.bin_momentum.resize(n);
+    for (size_t j = 0; j < n; ++j) reading.bin_mass[j] = b[PartsLayout::kPerBin * j], reading.bin_momentum[j] = b[PartsLayout::kPerBin * j + 1];
+    next += n;
   }
   for (size_t m = 0; m < at.meshes && s.mesh_loads.fx.size() > m; ++m) {
     const double* l = sums + at.mesh(m);

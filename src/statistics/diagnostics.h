@@ -15,7 +15,7 @@
 namespace dem {
 
 /// What a sensor (SensorSpec) saw at one instant. Plane sensors fill `flow`, `count_flow` and
-/// the velocity; box sensors `mass`, the velocity and `offset`.
+/// the velocity; box sensors `mass`, the velocity and `offset`, and with bins their bins.
 struct SensorReading {
   double flow = 0;        // [kg/s] plane: mass flow through it along its normal
   double count_flow = 0;  // [1/s] plane: particles through it along its normal (net)
@@ -25,6 +25,10 @@ struct SensorReading {
   /// second, m |v.n| (the velocity a flux-averaging probe would give; both directions count).
   double vx = 0, vy = 0, vz = 0;
   double offset = 0;      // [m] box: centroid offset along `across` from the box centre
+  /// Box with bins (SensorSpec::bins): per lateral bin, the mass inside [kg] and its momentum
+  /// along `along` [kg m/s]; empty otherwise. Not in scalars.csv: the run integrates them into
+  /// State::stream_profiles (statistics/stream_profile.h) and keeps its rows without them.
+  std::vector<double> bin_mass, bin_momentum;
 };
 
 struct Scalars {
