@@ -9,6 +9,7 @@
 
 #include "calibration/calibrated_material.h"
 #include "case/calibration_record.h"
+#include "model/library.h"
 #include "model/material_model.h"
 
 namespace dem::materials {
@@ -68,11 +69,12 @@ TEST(CalibratedMaterial, RoundTripsThroughTheLibraryAndACase) {
   }
   EXPECT_NEAR(r.chi2_per_n, 0.9, 1e-12);
   EXPECT_NE(std::find(r.effects.begin(), r.effects.end(), "epsd"), r.effects.end());
-  // A case names it from its own folder and gets the fitted values with their record.
+  // A case names it from its own folder and gets the fitted values with their record (steel from
+  // the material library).
   const CaseSpec spec = parse_case_text(
       "simulation: {duration: 0.001}\nmaterials:\n  g: {library: gravel_calibrated}\n  steel: {library: steel}\n"
       "particles:\n  - {material: g, diameter: 0.01, positions: [[0, 0, 0]]}\n",
-      (dir / "case.yaml").string());
+      (dir / "case.yaml").string(), library_lookup());
   const auto g = std::find_if(spec.materials.begin(), spec.materials.end(), [](const MaterialSpec& m) { return m.name == "g"; });
   ASSERT_NE(g, spec.materials.end());
   ASSERT_TRUE(g->calibration.has_value());

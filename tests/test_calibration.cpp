@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <random>
@@ -315,6 +317,7 @@ TEST(Calibration, ABatchStartsItsLongestSimulationsFirst) {
   std::vector<int> started;
   CalibrationOptions options;
   options.parallel = 2;
+  options.context = std::make_shared<detail::CommandContext>();  // one command: its later batches know what the first cost
   options.simulator = [&](const MaterialModel&, const TestSetup& setup, const TestOptions&) {
     const int which = static_cast<int>(setup.numbers.at("which"));
     {
@@ -347,6 +350,80 @@ TEST(Calibration, ABatchStartsItsLongestSimulationsFirst) {
   out = detail::run_batch(jobs, options, none, fatal);
   EXPECT_EQ(out[0].error, BatchOutcome::Error::none);
   EXPECT_EQ(out[1].error, BatchOutcome::Error::input);
+}
+
+// A command's count and the costs it measured (CommandContext) are its own: two comparisons in
+// one process each count their simulations and estimate the time left from their own costs, and
+// the comparisons a calibration calls count into the calibration's one count.
+TEST(Calibration, ACommandSharesItsCountAndCostsOnlyWithTheCommandsItCalls) {
+  const Analytic sim;
+  MaterialModel truth = dry_spheres();
+  set_parameter(truth, "friction", 0.5);
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  const MeasurementSet measured = synthesise(set, truth, sim, 5);
+  // Options whose simulations each say they took `seconds`, with progress lines of their own.
+  const auto options_with = [&](double seconds, std::vector<std::string>& lines) {
+    CalibrationOptions o = analytic_options([&sim, seconds](const MaterialModel& m, const TestSetup& s, const TestOptions& t) {
+      SimulatedOutcome out = sim(m, s, t);
+      out.wall_seconds = seconds;
+      return out;
+    });
+    o.most_replicas = o.replicas;  // no packings added: 2 experiments x 3 replicas
+    o.progress = [&lines](const std::string& line) { lines.push_back(line); };
+    return o;
+  };
+
+  // Two comparisons with the options as a library user leaves them (no context): after its first
+  // simulation each expects its 5 others at its own cost, 10 s and 25 s (with the first
+  // comparison's costs in the second's estimate it would say 12 s), and counts 1 to 6 of 6.
+  std::vector<std::string> first_lines, second_lines;
+  compare(dry_spheres(), measured, options_with(2.0, first_lines));
+  compare(dry_spheres(), measured, options_with(5.0, second_lines));
+  ASSERT_EQ(first_lines.size(), 6u);
+  ASSERT_EQ(second_lines.size(), 6u);
+  EXPECT_TRUE(first_lines.front().ends_with(" elapsed, about 10 s left")) << first_lines.front();
+  EXPECT_TRUE(second_lines.front().ends_with(" elapsed, about 25 s left")) << second_lines.front();
+  for (const std::vector<std::string>* lines : {&first_lines, &second_lines})
+    for (size_t k = 0; k < lines->size(); ++k)
+      EXPECT_NE((*lines)[k].find(fmt::format("; compare: simulation {} of about 6, ", k + 1)), std::string::npos) << (*lines)[k];
+
+  // Given contexts hold each command's own count and costs.
+  std::vector<std::string> quiet;
+  CalibrationOptions first = options_with(2.0, quiet), second = options_with(5.0, quiet);
+  first.context = std::make_shared<detail::CommandContext>();
+  second.context = std::make_shared<detail::CommandContext>();
+  compare(dry_spheres(), measured, first);
+  compare(dry_spheres(), measured, second);
+  for (const CalibrationOptions* o : {&first, &second}) {
+    EXPECT_FALSE(o->context->count.active());
+    EXPECT_EQ(o->context->count.done(), 6);
+    EXPECT_EQ(o->context->count.left(), 0);
+  }
+  EXPECT_DOUBLE_EQ(first.context->costs.estimate("bulk_density/density"), 2.0);
+  EXPECT_DOUBLE_EQ(second.context->costs.estimate("bulk_density/density"), 5.0);
+
+  // A calibration's comparisons count into the calibration: one count over all its simulations,
+  // its first comparison's included.
+  std::vector<std::string> nested_lines;
+  CalibrationOptions nested = options_with(5.0, nested_lines);
+  nested.context = std::make_shared<detail::CommandContext>();
+  calibrate(dry_spheres(), measured, fit_parameters(dry_spheres(), {"friction"}), nested);
+  ASSERT_FALSE(nested_lines.empty());
+  EXPECT_TRUE(nested_lines.front().starts_with("compare: simulation 1 of 6 done")) << nested_lines.front();
+  EXPECT_NE(nested_lines.front().find("; calibrate: simulation 1 of about "), std::string::npos) << nested_lines.front();
+  int counted = 0;
+  for (const std::string& line : nested_lines) {
+    const size_t at = line.find("; calibrate: simulation ");
+    if (at == std::string::npos) continue;
+    int done = 0, planned = 0;
+    ASSERT_EQ(std::sscanf(line.c_str() + at, "; calibrate: simulation %d of about %d", &done, &planned), 2) << line;
+    EXPECT_EQ(done, ++counted) << line;
+  }
+  EXPECT_GT(counted, 6);
+  EXPECT_EQ(nested.context->count.done(), counted);
+  EXPECT_EQ(first.context->count.done(), 6) << "the calibration left the first comparison's count alone";
 }
 
 TEST(Calibration, AnObservablesOwnExtractionErrorBoundsItsSimulationNoise) {

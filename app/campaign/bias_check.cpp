@@ -9,6 +9,7 @@
 
 #include "case/spec.h"
 #include "case/yaml_check.h"
+#include "model/library.h"
 #include "pages/html.h"
 #include "output/run.h"
 
@@ -50,7 +51,7 @@ void add_bias_check(SweepPlan& plan, const YAML::Node& root, const std::string& 
   YAML::Node plain = YAML::Clone(root);
   plain.remove("sweep");
   plain.remove("bias_check");
-  const CaseSpec spec = parse_case_node(plain, file);
+  const CaseSpec spec = parse_case_node(plain, file, materials::library_lookup());
   const double stiffness = spec.simulation.stiffness_scaling, mass = spec.simulation.mass_scaling;
   // The runs of the check: the case as it is, stiffer particles, and lighter ones when scaled.
   struct Run {

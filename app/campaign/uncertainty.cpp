@@ -14,6 +14,7 @@
 #include "case/calibration_record.h"
 #include "case/spec.h"
 #include "case/yaml_check.h"
+#include "model/library.h"
 #include "pages/html.h"
 #include "output/run.h"
 #include "pages/plot.h"
@@ -142,7 +143,7 @@ void add_uncertainty(SweepPlan& plan, const YAML::Node& root, const std::string&
   YAML::Node plain = YAML::Clone(root);
   plain.remove("sweep");
   plain.remove("uncertainty");
-  const CaseSpec spec = parse_case_node(plain, file);
+  const CaseSpec spec = parse_case_node(plain, file, materials::library_lookup());
   std::vector<std::string> paths;
   std::vector<std::vector<double>> columns;  // per path, one value per sample
   for (size_t m = 0; m < spec.materials.size(); ++m) {

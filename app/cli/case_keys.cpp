@@ -384,7 +384,6 @@ void contact_tables(std::string& out, bool markdown) {
 std::string default_source_dir() { return fs::path(materials::library_folder()).parent_path().string(); }
 
 std::string case_key_reference(const std::string& source_dir, bool markdown) {
-  materials::use_material_library();
   const fs::path root = fs::absolute(source_dir).lexically_normal();
   const std::string defaults_file = "(defaults)";
   // The shipped cases, then a case that uses the sections none of them does.
@@ -407,7 +406,7 @@ std::string case_key_reference(const std::string& source_dir, bool markdown) {
     equipment::generate(spec);
   }
   for (const fs::path& file : cases) {
-    CaseSpec spec = parse_case_file(file.string());
+    CaseSpec spec = parse_case_file(file.string(), materials::library_lookup());
     equipment::expand_equipment(spec);
     read_sweep(read_yaml_file(file.string(), "the case file"), file.string());
   }

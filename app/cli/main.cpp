@@ -79,7 +79,7 @@ YAML::Node load_case_yaml(const std::string& path, std::string* text_out = nullp
 
 /// Reads a case with its equipment expanded: what every command compiles.
 dem::CaseSpec read_case(const std::string& path) {
-  dem::CaseSpec spec = dem::parse_case_file(path);
+  dem::CaseSpec spec = dem::parse_case_file(path, dem::materials::library_lookup());
   dem::equipment::expand_equipment(spec);
   return spec;
 }
@@ -198,7 +198,7 @@ int check_case(const std::string& path) {
   dem::CaseSpec first;
   for (size_t k = 0; k < plan.variants.size(); ++k) {
     try {
-      dem::CaseSpec spec = dem::parse_case_node(dem::app::variant_case(root, plan, k), path);
+      dem::CaseSpec spec = dem::parse_case_node(dem::app::variant_case(root, plan, k), path, dem::materials::library_lookup());
       dem::equipment::expand_equipment(spec);
       if (k == 0) first = std::move(spec);
     } catch (const dem::CaseError& e) {
@@ -230,7 +230,8 @@ CaseAsRun read_case_as_written(const std::string& path) {
 int run_every_variant(const RunArgs& args, const dem::app::SweepPlan& plan, const YAML::Node& root) {
   dem::app::SweepOptions sweep;
   sweep.case_path = args.case_path;
-  sweep.out = !args.out.empty() ? args.out : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path).output.directory;
+  sweep.out = !args.out.empty() ? args.out
+                                : dem::parse_case_node(dem::app::variant_case(root, plan, 0), args.case_path, dem::materials::library_lookup()).output.directory;
   sweep.threads = args.threads, sweep.duration = args.duration, sweep.max_steps = args.max_steps, sweep.quiet = args.quiet;
   return dem::app::run_sweep(plan, sweep, std::cout);  // under MPI: the variants shared among the ranks
 }
@@ -379,7 +380,7 @@ int run_case(const RunArgs& args) {
   if (!plan.variants.empty() && args.variant < 0) return run_every_variant(args, plan, as_run.root);
   if (args.variant >= 0) select_variant(args, plan, as_run);
   if (args.duration > 0) write_duration_into_case(args, as_run);
-  dem::CaseSpec spec = dem::parse_case_node(as_run.root, args.case_path);
+  dem::CaseSpec spec = dem::parse_case_node(as_run.root, args.case_path, dem::materials::library_lookup());
   dem::equipment::expand_equipment(spec);
   const OutputFolder output = claim_output_folder(args, spec);
   const dem::Model model = compile_case(spec);
@@ -411,7 +412,7 @@ int render_results(const std::string& out, const std::string& which, const dem::
   // resolve against the original case file.
   dem::CaseSpec spec;
   if (std::filesystem::exists(out + "/case.yaml")) {
-    spec = dem::parse_case_node(load_case_yaml(out + "/case.yaml"), case_path);
+    spec = dem::parse_case_node(load_case_yaml(out + "/case.yaml"), case_path, dem::materials::library_lookup());
     dem::equipment::expand_equipment(spec);
   } else {
     spec = read_case(case_path);
@@ -624,7 +625,6 @@ int run_command(CLI::App& app, const CommandLine& line, dem::app::CalibrationCom
 
 int main(int argc, char** argv) {
   dem::tune_allocator();
-  dem::materials::use_material_library();  // cases find `library:` materials outside their own folders
   // MPI only when mpirun (or another MPI launcher) started this process; see app/campaign/mpi_campaign.h.
   dem::app::mpi::Session mpi_session(&argc, &argv);
   CLI::App app{"demdesign: DEM simulation for the design of bulk-materials-handling equipment"};

@@ -22,6 +22,7 @@
 #include "case/spec.h"
 #include "core/model.h"
 #include "lab/measurements.h"
+#include "model/library.h"
 #include "output/run.h"
 #include "pages/html.h"
 #include "report/report_analysis.h"
@@ -152,7 +153,7 @@ int fed_material(const Model& model) {
 std::optional<MaterialSpec> material_spec(const RunReportInput& in, const std::string& name) {
   if (in.case_text.empty()) return std::nullopt;
   try {
-    const CaseSpec spec = parse_case_text(in.case_text, in.case_path.empty() ? std::string("<report>") : in.case_path);
+    const CaseSpec spec = parse_case_text(in.case_text, in.case_path.empty() ? std::string("<report>") : in.case_path, materials::library_lookup());
     for (const MaterialSpec& m : spec.materials)
       if (m.name == name) return m;
   } catch (const std::exception&) {

@@ -378,7 +378,7 @@ std::string plan_for_budget(const CalibrationOptions& given, Clock::time_point t
     budget_words = fmt::format("Planned for the budget of {}: about {} after the first comparison{}.", detail::duration_text(given.budget_seconds),
                                detail::duration_text(plan.seconds), plan.given_up.empty() ? "" : "; given up: " + join(plan.given_up, "; "));
     if (options.progress) options.progress(budget_words);
-    if (command.outermost()) detail::CommandProgress::shared().plan_remaining(n * detail::calibration_passes(options, p));
+    if (command.outermost()) command.count().plan_remaining(n * detail::calibration_passes(options, p));
   } else if (command.outermost() && options.progress) {
     // Without a budget the whole plan, at what the first comparison's simulations cost.
     CalibrationOptions unlimited = options;
@@ -668,7 +668,7 @@ void refine_around_best(const Fit& fit, Search& search, Progress& progress, Cali
     if (options.progress) options.progress(fmt::format("calibrate: {}: one more round around the best point simulated so far", why));
     const int n_experiments = static_cast<int>(fit.measured.experiments.size());
     for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.points);
-    if (detail::CommandProgress::shared().active()) detail::CommandProgress::shared().plan_more(n_experiments * (fit.points + std::max(1, options.replicas)));
+    if (detail::CommandProgress& count = options.context->count; count.active()) count.plan_more(n_experiments * (fit.points + std::max(1, options.replicas)));
     search.x_best = centre;
     design_round(fit, fit.rounds + refine, search, progress, result);
     result.after = confirm_optimum(fit, search, result);
@@ -798,14 +798,16 @@ void draw_contours(int p, const Surrogate& full_range, CalibrationResult& result
 CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementSet& measured, std::vector<FitParameter> parameters,
                             const CalibrationOptions& given, const Comparison* before, const EarlierPoints& earlier) {
   const Clock::time_point t0 = Clock::now();
-  CalibrationOptions options = given;  // a budget may reduce it
+  // A budget may reduce the options; the walls' fit and the comparisons it calls share its context.
+  CalibrationOptions options = detail::within_command(given);
   CalibrationResult result;
   choose_parameters(given_model, parameters, result);
   const int p = static_cast<int>(parameters.size());
   const WallStage walls = fit_walls_stage(given_model, measured, parameters, earlier, options, result);
 
   const int n = static_cast<int>(measured.experiments.size());
-  const detail::CommandScope command("calibrate", n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
+  const detail::CommandScope command(options.context, "calibrate",
+                                     n * ((before ? 0 : std::max(1, options.replicas)) + detail::calibration_passes(options, p)));
   compare_start(given_model, measured, options, before, result);
   const std::string budget_words = plan_for_budget(given, t0, command, n, p, result.before, options);
   const Targets targets = numeric_targets(result.before);

@@ -38,6 +38,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,6 +74,10 @@ using BatchRunner = std::function<std::vector<BatchOutcome>(size_t count, const 
                                                             const std::function<bool(const BatchOutcome&)>& fatal)>;
 
 struct Diagnosis;
+
+namespace detail {
+struct CommandContext;  // calibration_support.h
+}
 
 /// What shrinking the apparatus does to one observation (term `experiment/observable`), measured
 /// once, at the start values: the full-size mean minus the shrunk mean, and the standard error of
@@ -172,6 +177,12 @@ struct CalibrationOptions {
   std::function<void(const Diagnosis&, const std::string& stage)> on_partial;
   /// Final state of every simulation (the app renders the last); may be empty.
   std::function<void(const Model&, const State&)> on_final;
+  /// The command these options run in: its count of simulations done and planned, its clock, and
+  /// what its simulations cost (detail::CommandContext). Every copy of the options shares it, so
+  /// the compare and the calibrations a diagnosis calls count into the diagnosis and use the costs
+  /// it measured. Empty (the default): compare, calibrate and diagnose each begin a command of
+  /// their own, and two calls share nothing.
+  std::shared_ptr<detail::CommandContext> context;
 };
 
 // ---- comparison ---------------------------------------------------------------------------

@@ -1,5 +1,6 @@
-// What compare, calibrate and diagnose share inside the library (not part of its interface):
-// progress with the time left, joining words, and running simulations as batches.
+// What compare, calibrate and diagnose share inside the library (not part of its interface): the
+// context of a command (its count, clock and costs), progress with the time left, joining words,
+// and running simulations as batches.
 #pragma once
 
 #include <fmt/format.h>
@@ -11,6 +12,8 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -31,13 +34,9 @@ inline std::string duration_text(double s) {
 }
 
 /// The measured wall time of a simulation of each experiment (by test and id), shared by every
-/// phase of a command in this process: a phase's estimate uses what earlier phases measured.
+/// phase of a command (CommandContext): a phase's estimate uses what earlier phases measured.
 class SimulationCosts {
  public:
-  static SimulationCosts& shared() {
-    static SimulationCosts costs;
-    return costs;
-  }
   void add(const std::string& key, double seconds) {
     auto& [sum, count] = by_key_[key];
     sum += seconds, ++count;
@@ -70,16 +69,27 @@ class SimulationCosts {
   int all_count_ = 0;
 };
 
+/// Wall seconds the last simulation of each set-up took in a command (CommandContext), so that a
+/// batch can start its longest simulations first. Only the order of a batch depends on it, never
+/// an outcome. The workers of a batch note their simulations from their own threads.
+class SetupCosts {
+ public:
+  /// [s]; when no simulation of this set-up has run yet, longer than any that has, ordered by
+  /// what usually takes longest (simulation_batch.cpp).
+  double of(const TestSetup& setup) const;
+  void note(const TestSetup& setup, double seconds);
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, double> seconds_;
+};
+
 /// The whole command's count: the simulations planned in all (compare, calibrate and diagnose
 /// each plan theirs when they begin; a diagnosis plans again as it learns how many candidates it
-/// confirms), those done, and when the command began. The outermost command's CommandScope owns
+/// confirms), those done, and when the command began. The outermost command's CommandScope starts
 /// it; the commands it calls run inside its count.
 class CommandProgress {
  public:
-  static CommandProgress& shared() {
-    static CommandProgress command;
-    return command;
-  }
   bool active() const { return depth_ > 0; }
   const std::string& what() const { return what_; }
   int done() const { return done_; }
@@ -95,39 +105,64 @@ class CommandProgress {
  private:
   friend class CommandScope;
   friend class Uncounted;
-  int depth_ = 0, planned_ = 0, done_ = 0;
+  int depth_ = 0, planned_ = 0, done_ = 0;  ///< depth: the commands running, one inside the other
   std::string what_;
   Clock::time_point t0_;
 };
+
+/// What a command shares with the commands it calls (the compare and the calibrations inside a
+/// diagnosis, the fit of the walls' drops inside a calibration): its count, its clock and what its
+/// simulations have cost so far. The outermost command makes it (within_command) and hands it down
+/// in CalibrationOptions::context, which every copy of the options shares; two commands that do
+/// not call each other (two tests in a row, a sweep that calibrates twice) have one each.
+/// Rejected: one count and one table of costs per process (function-local statics), through which
+/// such commands shared their counts and costs by accident.
+struct CommandContext {
+  CommandProgress count;
+  SimulationCosts costs;   ///< by experiment: the time left in progress lines
+  SetupCosts setup_costs;  ///< by set-up: which simulations of a batch start first
+};
+
+/// `options` as a command runs with them: their context when they carry one (a command called by
+/// another), else a new one (the outermost command).
+inline CalibrationOptions within_command(const CalibrationOptions& options) {
+  CalibrationOptions out = options;
+  if (!out.context) out.context = std::make_shared<CommandContext>();
+  return out;
+}
 
 /// Simulations run inside it are left out of the command's count (the cheap single-contact fit
 /// that precedes a calibration): the count and the plan are as they were before it.
 class Uncounted {
  public:
-  Uncounted() : done_(CommandProgress::shared().done_), planned_(CommandProgress::shared().planned_) {}
-  ~Uncounted() { CommandProgress::shared().done_ = done_, CommandProgress::shared().planned_ = planned_; }
+  explicit Uncounted(CommandContext& context) : count_(context.count), done_(count_.done_), planned_(count_.planned_) {}
+  ~Uncounted() { count_.done_ = done_, count_.planned_ = planned_; }
   Uncounted(const Uncounted&) = delete;
   Uncounted& operator=(const Uncounted&) = delete;
 
  private:
+  CommandProgress& count_;
   int done_, planned_;
 };
 
-/// Marks a command's run: the outermost scope starts the command's count with `planned`
-/// simulations; nested scopes (the calibration inside a diagnosis) leave it as it is.
+/// Marks a command's run in its context: the outermost scope starts the command's count with
+/// `planned` simulations; nested scopes (the calibration inside a diagnosis) leave it as it is.
 class CommandScope {
  public:
-  CommandScope(std::string what, int planned) {
-    CommandProgress& c = CommandProgress::shared();
+  CommandScope(std::shared_ptr<CommandContext> context, std::string what, int planned) : context_(std::move(context)) {
+    CommandProgress& c = context_->count;
     if (c.depth_++ == 0) c.what_ = std::move(what), c.done_ = 0, c.planned_ = planned, c.t0_ = Clock::now();
     outermost_ = c.depth_ == 1;
   }
-  ~CommandScope() { --CommandProgress::shared().depth_; }
+  ~CommandScope() { --context_->count.depth_; }
   CommandScope(const CommandScope&) = delete;
   CommandScope& operator=(const CommandScope&) = delete;
   bool outermost() const { return outermost_; }
+  /// The count of the outermost command this one runs in.
+  CommandProgress& count() const { return context_->count; }
 
  private:
+  std::shared_ptr<CommandContext> context_;
   bool outermost_ = false;
 };
 
@@ -204,21 +239,26 @@ inline int workers(const CalibrationOptions& o, size_t jobs) {
 /// left from what each remaining simulation costs (SimulationCosts), not from the phase's mean,
 /// shared among the simulations that run at once. When a command is counting
 /// (CommandProgress), the line also gives the whole command's count and time left.
-/// Lines go to options.progress (the app writes them line-buffered, one per line).
+/// Lines go to options.progress (the app writes them line-buffered, one per line). The costs and
+/// the count are those of options.context; options without one (a phase run outside any
+/// command) get a context of their own, which no command counts.
 class Progress {
  public:
-  Progress(const CalibrationOptions& options, std::string what) : options_(options), what_(std::move(what)) {}
+  Progress(const CalibrationOptions& options, std::string what)
+      : options_(options), context_(options.context ? options.context : std::make_shared<CommandContext>()), what_(std::move(what)) {}
+  /// The command it counts into.
+  CommandContext& context() const { return *context_; }
   /// Plans `count` simulations of `experiment`.
   void plan(const Experiment& experiment, int count = 1) {
     for (int k = 0; k < count; ++k) planned_.push_back(key(experiment));
   }
   /// Simulation of `experiment` finished (`label` says which: point, replica, candidate).
   void step(const Experiment& experiment, const std::string& label, double seconds) {
-    SimulationCosts& costs = SimulationCosts::shared();
+    SimulationCosts& costs = context_->costs;
     if (seconds > 0) costs.add(key(experiment), seconds);  // (a stored outcome costs nothing, and says nothing of the cost)
     if (const auto it = std::find(planned_.begin(), planned_.end(), key(experiment)); it != planned_.end()) planned_.erase(it);
     ++done_;
-    CommandProgress& command = CommandProgress::shared();
+    CommandProgress& command = context_->count;
     if (command.active()) command.step();
     if (!options_.progress) return;
     double left = 0;
@@ -243,6 +283,7 @@ class Progress {
   std::string size_tag() const { return options_.size_factor < 1 ? fmt::format("@{:g}", options_.size_factor) : std::string(); }
   std::string key(const Experiment& e) const { return e.setup.test + "/" + e.id + size_tag(); }
   const CalibrationOptions& options_;
+  const std::shared_ptr<CommandContext> context_;
   std::string what_;
   std::vector<std::string> planned_;
   int done_ = 0;

@@ -128,8 +128,9 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
   return c;
 }
 
-Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& options) {
-  const detail::CommandScope command("compare", static_cast<int>(measured.experiments.size()) * std::max(1, options.replicas));
+Comparison compare(const MaterialModel& model, const MeasurementSet& measured, const CalibrationOptions& given) {
+  const CalibrationOptions options = detail::within_command(given);
+  const detail::CommandScope command(options.context, "compare", static_cast<int>(measured.experiments.size()) * std::max(1, options.replicas));
   Progress progress{options, "compare"};
   for (const Experiment& e : measured.experiments) progress.plan(e, std::max(1, options.replicas));
   std::vector<ExperimentRun> runs = simulate_experiments(model, measured.experiments, options, options.replicas, &progress, "");
@@ -157,7 +158,7 @@ Comparison compare(const MaterialModel& model, const MeasurementSet& measured, c
     std::vector<const Experiment*> experiments;
     std::vector<ExperimentRun*> extended;
     for (size_t k : more) experiments.push_back(&measured.experiments[k]), extended.push_back(&runs[k]), progress.plan(measured.experiments[k]);
-    if (detail::CommandProgress::shared().active()) detail::CommandProgress::shared().plan_more(static_cast<int>(more.size()));
+    command.count().plan_more(static_cast<int>(more.size()));
     if (options.progress)
       options.progress(fmt::format("compare: chi^2/n {:.2f} is near the line of {:.2f}; one more packing of {}", c.chi2_per_n(), options.fits_within_noise,
                                    fmt::join(experiments | std::views::transform([](const Experiment* e) { return e->id; }), ", ")));

@@ -85,49 +85,29 @@ BatchOutcome run_caught(const Job& job, const CalibrationOptions& options) {
   return b;
 }
 
-/// Wall seconds the last simulation of each set-up took in this process, so that a batch can
-/// start its longest simulations first. Only the order of a batch depends on it, never an outcome.
-class SetupCosts {
- public:
-  static SetupCosts& shared() {
-    static SetupCosts costs;
-    return costs;
-  }
-  /// [s]; when no simulation of this set-up has run yet, longer than any that has, ordered by
-  /// what usually takes longest (a hopper's discharge, the smaller orifice first; a drum, the
-  /// slower first; a lifted cylinder; a pour; a drop).
-  double of(const TestSetup& setup) const {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = seconds_.find(key(setup));
-    return it == seconds_.end() ? 1e12 * (1 + usual_rank(setup)) : it->second;
-  }
-  void note(const TestSetup& setup, double seconds) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    seconds_[key(setup)] = seconds;
-  }
+/// Where a set-up usually ranks by its cost, before any simulation of it has run: a hopper's
+/// discharge (the smaller orifice first), a shear test, a drum (the slower first), a lifted
+/// cylinder, a pour, a drop.
+double usual_rank(const TestSetup& setup) {
+  const auto number = [&](const char* key, double otherwise) {
+    const auto it = setup.numbers.find(key);
+    return it == setup.numbers.end() || !(it->second > 0) ? otherwise : it->second;
+  };
+  if (setup.test == "hopper_discharge") return 5 + 1 / (1 + 100 * number("orifice_diameter", 1.0));  // [m]
+  if (setup.test == "direct_shear") return 4;
+  if (setup.test == "rotating_drum") return 3 + 1 / (1 + number("rpm", 1e9));
+  if (setup.test == "angle_of_repose_cylinder") return 2;
+  if (setup.test == "bulk_density") return 1;
+  return 0;
+}
 
- private:
-  static double usual_rank(const TestSetup& setup) {
-    const auto number = [&](const char* key, double otherwise) {
-      const auto it = setup.numbers.find(key);
-      return it == setup.numbers.end() || !(it->second > 0) ? otherwise : it->second;
-    };
-    if (setup.test == "hopper_discharge") return 5 + 1 / (1 + 100 * number("orifice_diameter", 1.0));  // [m]
-    if (setup.test == "direct_shear") return 4;
-    if (setup.test == "rotating_drum") return 3 + 1 / (1 + number("rpm", 1e9));
-    if (setup.test == "angle_of_repose_cylinder") return 2;
-    if (setup.test == "bulk_density") return 1;
-    return 0;
-  }
-  static std::string key(const TestSetup& setup) {
-    std::string out = setup.test;
-    for (const auto& [k, v] : setup.numbers) out += fmt::format(";{}={}", k, v);
-    for (const auto& [k, v] : setup.words) out += fmt::format(";{}={}", k, v);
-    return out;
-  }
-  mutable std::mutex mutex_;
-  std::map<std::string, double> seconds_;
-};
+/// A set-up's test and every value of it, as one word.
+std::string setup_key(const TestSetup& setup) {
+  std::string out = setup.test;
+  for (const auto& [k, v] : setup.numbers) out += fmt::format(";{}={}", k, v);
+  for (const auto& [k, v] : setup.words) out += fmt::format(";{}={}", k, v);
+  return out;
+}
 
 /// Appends one replica's outcome to a run (values, extraction errors, flags, cost).
 void append_replica(ExperimentRun& run, const SimulatedOutcome& out, std::map<std::string, int>& flags) {
@@ -180,6 +160,17 @@ std::vector<BatchOutcome> run_batch_or_throw(const std::vector<Job>& jobs, const
 
 }  // namespace
 
+double detail::SetupCosts::of(const TestSetup& setup) const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = seconds_.find(setup_key(setup));
+  return it == seconds_.end() ? 1e12 * (1 + usual_rank(setup)) : it->second;
+}
+
+void detail::SetupCosts::note(const TestSetup& setup, double seconds) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  seconds_[setup_key(setup)] = seconds;
+}
+
 [[noreturn]] void detail::rethrow(const BatchOutcome& b) {
   if (b.error == BatchOutcome::Error::input) throw CaseError(b.message);
   if (b.error == BatchOutcome::Error::numerical) throw NumericalError(b.message);
@@ -207,13 +198,16 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
     }
     return out;
   }
-  // Workers take the jobs longest first, by what each set-up last cost in this process (a set-up
+  // Workers take the jobs longest first, by what each set-up last cost in this command (a set-up
   // not yet run counts as longer than any that has, in the order of what usually takes longest,
   // and jobs of equal cost keep their batch order): the batch ends when its last simulation does, and a hopper discharge started last would keep one core
   // busy alone for a minute. After a fatal outcome only jobs before it in batch order still
   // start, so every job before the first fatal one has its outcome, as in the serial loop.
+  // A batch run outside any command (options without a context) knows no costs.
+  SetupCosts own;
+  SetupCosts& setup_costs = options.context ? options.context->setup_costs : own;
   std::vector<double> cost(jobs.size());
-  for (size_t k = 0; k < jobs.size(); ++k) cost[k] = SetupCosts::shared().of(*jobs[k].setup);
+  for (size_t k = 0; k < jobs.size(); ++k) cost[k] = setup_costs.of(*jobs[k].setup);
   std::vector<size_t> order(jobs.size());
   std::iota(order.begin(), order.end(), size_t{0});
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
@@ -226,7 +220,7 @@ std::vector<BatchOutcome> detail::run_batch(const std::vector<Job>& jobs, const 
       const size_t k = order[i];
       if (k > first_fatal) continue;
       out[k] = simulate(k);
-      if (out[k].error == BatchOutcome::Error::none && !out[k].stored) SetupCosts::shared().note(*jobs[k].setup, out[k].outcome.wall_seconds);
+      if (out[k].error == BatchOutcome::Error::none && !out[k].stored) setup_costs.note(*jobs[k].setup, out[k].outcome.wall_seconds);
       const std::lock_guard<std::mutex> lock(reporting);
       done(k, out[k]);
       if (fatal(out[k])) first_fatal = std::min(first_fatal.load(), k);

@@ -44,7 +44,7 @@ WallsFirst fit_walls_first(const MaterialModel& model, const MeasurementSet& mea
       drops.experiments.push_back(std::move(only));
     }
     if (drops.experiments.empty()) continue;
-    CalibrationOptions sub = options;
+    CalibrationOptions sub = within_command(options);  // inside the calibration's command, left out of its count below
     sub.walls_first = false;
     sub.budget_seconds = 0;  // a few hundred drops of a tenth of a second: outside any budget
     sub.rounds = 2, sub.design_factor = 2.0, sub.design_points = 0;
@@ -54,7 +54,7 @@ WallsFirst fit_walls_first(const MaterialModel& model, const MeasurementSet& mea
     const double before = get_parameter(out.model, key);
     CalibrationResult fit;
     {
-      const Uncounted aside;
+      const Uncounted aside(*sub.context);
       fit = calibrate(out.model, drops, {box}, sub);
     }
     if (!fit.unidentified.empty()) {

@@ -156,13 +156,14 @@ class DiagnosisRun {
         measured_(measured),
         parameters_(parameters.empty() ? fit_parameters(model) : std::move(parameters)),
         given_(given),
-        options_(given),
+        options_(detail::within_command(given)),
         experiments_(static_cast<int>(measured.experiments.size())),
         fitted_(static_cast<int>(parameters_.size())),
         walls_(static_cast<int>(wall_parameter_candidates(model, parameters_).size())),
         lacking_(static_cast<int>(missing_effects(model).size())),
-        command_("diagnose", experiments_ * (std::max(1, options_.replicas) + detail::diagnosis_passes(options_, fitted_, lacking_, walls_))),
-        count_(detail::CommandProgress::shared()) {}
+        command_(options_.context, "diagnose",
+                 experiments_ * (std::max(1, options_.replicas) + detail::diagnosis_passes(options_, fitted_, lacking_, walls_))),
+        count_(command_.count()) {}
 
   void calibrate_as_it_is();
   void check_at_full_size();
@@ -184,7 +185,7 @@ class DiagnosisRun {
   const MeasurementSet& measured_;
   const std::vector<FitParameter> parameters_;
   const CalibrationOptions& given_;
-  CalibrationOptions options_;  ///< a budget may reduce it
+  CalibrationOptions options_;  ///< a budget may reduce it; the commands it calls share its context
   const int experiments_, fitted_, walls_, lacking_;
   const detail::CommandScope command_;
   detail::CommandProgress& count_;

@@ -131,7 +131,7 @@ SeparationSearch separating_experiments(const MaterialModel& a, const std::strin
   const int replicas = std::max(1, std::min(options.replicas, options.signature_replicas));
   detail::Progress progress{options, fmt::format("experiments that could separate {} from {}", name_a, name_b)};
   for (const Experiment& e : candidates) progress.plan(e, 2 * replicas);
-  detail::CommandProgress& command = detail::CommandProgress::shared();
+  detail::CommandProgress& command = progress.context().count;
   if (command.active()) command.plan_remaining(command.left() + 2 * replicas * static_cast<int>(candidates.size()));
   // Both models on every candidate, one batch; a candidate either cannot run (a set-up out of
   // range for these particles) is skipped.

@@ -19,15 +19,15 @@ std::vector<std::string> library_folders() {
   return out;
 }
 
-void use_material_library() {
-  set_library_lookup([](const std::string& file, const std::string&, std::string& searched) {
+LibraryLookup library_lookup() {
+  return [](const std::string& file, const std::string&, std::string& searched) {
     for (const std::string& folder : library_folders()) {
       const std::filesystem::path candidate = std::filesystem::path(folder) / (file + ".yaml");
       searched += "\n  " + candidate.lexically_normal().string();
       if (std::filesystem::is_regular_file(candidate)) return candidate;
     }
     return std::filesystem::path();
-  });
+  };
 }
 
 std::vector<LibraryEntry> list_library(const std::string& folder) {

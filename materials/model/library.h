@@ -3,11 +3,13 @@
 // calibration, diagnosis). A case uses a library material with
 //   materials: {ore: {library: gravel}}
 // (the case reader, src/case/spec_materials.cpp, reads the file; where it is found is said here:
-// use_material_library). `demdesign materials` lists what is there.
+// library_lookup). `demdesign materials` lists what is there.
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "case/spec.h"
 
 namespace dem::materials {
 
@@ -28,8 +30,10 @@ std::string library_folder();
 /// $DEMDESIGN_MATERIALS (when set), then the shipped library.
 std::vector<std::string> library_folders();
 
-/// Makes the case reader find library materials in library_folders() (dem::set_library_lookup).
-/// Programs that read cases call it once at start; read_material_model calls it itself.
-void use_material_library();
+/// Where a case finds its library materials beyond its own folders: library_folders(), read when
+/// a case asks. A program passes it where it parses a case (dem::parse_case_file(path,
+/// library_lookup()); why it is passed and not set once: dem::LibraryLookup, case/spec.h);
+/// read_material_model passes it itself.
+LibraryLookup library_lookup();
 
 }  // namespace dem::materials

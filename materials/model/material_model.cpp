@@ -83,7 +83,6 @@ double typical_diameter(const SizeDistributionSpec& d) {
 }  // namespace
 
 MaterialModel read_material_model(const std::string& path) {
-  use_material_library();
   if (!fs::is_regular_file(path)) throw CaseError(fmt::format("{}: cannot open the material file", path));
   const fs::path file = fs::absolute(path).lexically_normal();
   const std::string stem = file.stem().string();
@@ -102,7 +101,7 @@ MaterialModel read_material_model(const std::string& path) {
   }
   case_text += fmt::format("particles:\n  - {{material: \"{}\", diameter: 0.01, positions: [[0, 0, 0]]}}\n", stem);
   // Named as a file beside the material, so `library:` finds this very file first.
-  const CaseSpec spec = parse_case_text(case_text, (file.parent_path() / "__material_model__.yaml").string());
+  const CaseSpec spec = parse_case_text(case_text, (file.parent_path() / "__material_model__.yaml").string(), library_lookup());
 
   MaterialModel model;
   model.name = stem;

@@ -143,7 +143,7 @@ struct LibraryContacts {
 };
 
 /// `materials`: each entry read in place or from the material library.
-void read_materials(MapReader& top, const std::string& file, CaseSpec& spec, LibraryContacts& library) {
+void read_materials(MapReader& top, const std::string& file, const LibraryLookup& lookup, CaseSpec& spec, LibraryContacts& library) {
   const YAML::Node materials = top.node("materials");
   if (!materials || !materials.IsMap() || materials.size() == 0)
     top.fail("materials", "missing: a map of material names to {density, youngs_modulus, ...}");
@@ -151,7 +151,7 @@ void read_materials(MapReader& top, const std::string& file, CaseSpec& spec, Lib
     const std::string name = kv.first.as<std::string>();
     if (kv.second.IsMap() && kv.second["library"]) {
       MapReader entry(kv.second, file, "materials." + name);
-      LibraryMaterial lib = read_library_material(name, entry, file);
+      LibraryMaterial lib = read_library_material(name, entry, file, lookup);
       if (lib.contact && library.file.empty()) library.contact = lib.contact, library.file = lib.file;
       for (auto& wall : lib.walls) library.walls.push_back({name, {wall.first, wall.second}});
       spec.materials.push_back(std::move(lib.material));
@@ -303,7 +303,7 @@ void refuse_two_wear_rates(const MapReader& top, const CaseSpec& spec) {
                                   top.where("wear_coefficients").str(), name, name, liner.location.line));
 }
 
-CaseSpec read_case(const YAML::Node& root, const std::string& file) {
+CaseSpec read_case(const YAML::Node& root, const std::string& file, const LibraryLookup& lookup) {
   MapReader top(root, file, "");
   CaseSpec spec;
   spec.path = file;
@@ -311,7 +311,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
   spec.simulation = read_simulation(top.node("simulation"), file);
   if (!top.has("simulation")) top.fail("simulation", "missing: give at least {duration: SECONDS}");
   LibraryContacts library;
-  read_materials(top, file, spec, library);
+  read_materials(top, file, lookup, spec, library);
   read_interactions(top, file, spec);
   // The contact model: the case's, else the one the first library material was calibrated with.
   if (top.has("contact") || library.file.empty()) spec.contact = read_contact(top.node("contact"), file);
@@ -333,28 +333,28 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file) {
 
 }  // namespace
 
-CaseSpec parse_case_node(const YAML::Node& root, const std::string& file) {
+CaseSpec parse_case_node(const YAML::Node& root, const std::string& file, const LibraryLookup& library) {
   try {
-    return read_case(root, file);
+    return read_case(root, file, library);
   } catch (const YAML::Exception& e) {
     throw CaseError(fmt::format("{}:{}:{}: {}", file, e.mark.line + 1, e.mark.column + 1, e.msg));
   }
 }
 
-CaseSpec parse_case_text(const std::string& text, const std::string& name) {
+CaseSpec parse_case_text(const std::string& text, const std::string& name, const LibraryLookup& library) {
   try {
-    return read_case(parse_yaml(text, name), name);
+    return read_case(parse_yaml(text, name), name, library);
   } catch (const YAML::Exception& e) {
     throw CaseError(fmt::format("{}:{}:{}: {}", name, e.mark.line + 1, e.mark.column + 1, e.msg));
   }
 }
 
-CaseSpec parse_case_file(const std::string& path) {
+CaseSpec parse_case_file(const std::string& path, const LibraryLookup& library) {
   std::ifstream in(path);
   if (!in) throw CaseError(fmt::format("{}: cannot open the case file", path));
   std::stringstream text;
   text << in.rdbuf();
-  return parse_case_text(text.str(), path);
+  return parse_case_text(text.str(), path, library);
 }
 
 }  // namespace dem

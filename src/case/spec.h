@@ -361,18 +361,21 @@ struct CaseSpec {
 
 /// Finds the file of a library material (`materials: {NAME: {library: FILE}}`): FILE.yaml for the
 /// case file `case_file`, or an empty path after adding each place it looked to `searched`.
+/// The case reader looks in the case's own folders first (the case's folder, its materials/ and
+/// ../materials/), then asks the lookup it was given. The engine does not know where a material
+/// library lives: a program that has one passes its lookup to the readers below
+/// (dem::materials::library_lookup, materials/model/library.h). Rejected: one lookup set for the
+/// whole process at start-up, with which a case found a material or not depending on what the
+/// process had read before (reading a material file set it); and a default here that searches
+/// the shipped library, which would make the engine know where the library lives.
 using LibraryLookup = std::function<std::filesystem::path(const std::string& file, const std::string& case_file, std::string& searched)>;
-/// Where the case reader looks for library materials beyond the case's own folders (the case's
-/// folder, its materials/ and ../materials/, which it always searches first). The engine does
-/// not know where a material library lives: the material library sets this
-/// (dem::materials::use_material_library, materials/model/library.h). Process-wide; not thread-safe.
-void set_library_lookup(LibraryLookup lookup);
 
-/// Reads and checks a case file. Throws CaseError naming file, line and key.
-CaseSpec parse_case_file(const std::string& path);
+/// Reads and checks a case file. Throws CaseError naming file, line and key. `library`: where
+/// `library:` materials are looked for beyond the case's own folders (empty: nowhere else).
+CaseSpec parse_case_file(const std::string& path, const LibraryLookup& library = {});
 /// Same for an already loaded YAML tree (sweep variants: the case with a parameter replaced);
 /// `file` names it in errors and resolves relative paths.
-CaseSpec parse_case_node(const YAML::Node& root, const std::string& file);
+CaseSpec parse_case_node(const YAML::Node& root, const std::string& file, const LibraryLookup& library = {});
 
 /// Reads a size distribution from the map that holds it under `key`: `diameter:` of inlets, particle
 /// sets and measurement files, `size:` of a material file.
@@ -384,6 +387,6 @@ SizeDistributionSpec read_size_distribution(MapReader& parent, const std::string
 Motion read_motion(const YAML::Node& node, const std::string& file, const std::string& key_path,
                    const std::string& base_dir);
 /// Same for YAML text (tests keep their model inline); `name` stands in for the file name.
-CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>");
+CaseSpec parse_case_text(const std::string& text, const std::string& name = "<inline>", const LibraryLookup& library = {});
 
 }  // namespace dem

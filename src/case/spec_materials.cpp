@@ -30,21 +30,16 @@ std::vector<std::string> all_param_keys() {
   return keys;
 }
 
-LibraryLookup& library_lookup() {
-  static LibraryLookup lookup;
-  return lookup;
-}
-
 /// Where `materials: {NAME: {library: gravel}}` finds gravel.yaml, first match wins: the case's
-/// folder, its `materials/` and `../materials/` folders, then the lookup the material library set.
-std::filesystem::path find_library_file(const std::string& wanted, const std::string& case_file, std::string& searched) {
+/// folder, its `materials/` and `../materials/` folders, then `lookup` (a material library's).
+std::filesystem::path find_library_file(const std::string& wanted, const std::string& case_file, const LibraryLookup& lookup, std::string& searched) {
   const std::filesystem::path dir = std::filesystem::path(case_file).parent_path();
   for (const std::filesystem::path& folder : {dir, dir / "materials", dir / ".." / "materials"}) {
     const std::filesystem::path candidate = folder / (wanted + ".yaml");
     searched += "\n  " + candidate.lexically_normal().string();
     if (std::filesystem::is_regular_file(candidate)) return candidate;
   }
-  return library_lookup() ? library_lookup()(wanted, case_file, searched) : std::filesystem::path();
+  return lookup ? lookup(wanted, case_file, searched) : std::filesystem::path();
 }
 
 ContactSpec::Choice read_choice(const YAML::Node& node, const std::string& file, const std::string& path,
@@ -117,10 +112,10 @@ MaterialSpec read_material(const std::string& name, const YAML::Node& node, cons
   return m;
 }
 
-LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file) {
+LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file, const LibraryLookup& lookup) {
   const std::string wanted = entry.string("library", "");
   std::string searched;
-  const std::filesystem::path found = find_library_file(wanted, case_file, searched);
+  const std::filesystem::path found = find_library_file(wanted, case_file, lookup, searched);
   if (found.empty()) entry.fail("library", fmt::format("no material file '{}.yaml' found; looked in:{}", wanted, searched));
   LibraryMaterial lib;
   lib.file = found.lexically_normal().string();
@@ -218,7 +213,5 @@ ContactSpec read_contact(const YAML::Node& node, const std::string& file) {
 }
 
 }  // namespace spec_reading
-
-void set_library_lookup(LibraryLookup lookup) { library_lookup() = std::move(lookup); }
 
 }  // namespace dem

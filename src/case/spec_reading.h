@@ -30,7 +30,8 @@ struct LibraryMaterial {
   std::vector<std::pair<std::string, YAML::Node>> walls;
 };
 
-LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file);
+/// `lookup`: where it is looked for after the case's own folders (LibraryLookup, spec.h).
+LibraryMaterial read_library_material(const std::string& name, MapReader& entry, const std::string& case_file, const LibraryLookup& lookup);
 ContactSpec read_contact(const YAML::Node& node, const std::string& file);
 
 // Equipment, meshes and walls (spec_walls.cpp).
