@@ -1,14 +1,19 @@
 // Liner pressure and the loads for a structural model (app/report/liner_loads.h): a bed of beads
 // at rest on a meshed plate against its weight, the force kept in the frame of a mesh that was
-// swung into place, the VTK and CalculiX / Abaqus files of two triangles against hand numbers, the
-// section, map field and metrics of the run report, and the force impulses through a checkpoint.
+// swung into place, the VTK and CalculiX / Abaqus files of two triangles against hand numbers,
+// each liner's own pressure map seen face on (app/pages/flow_images.h, checked by pixel coverage
+// bands, never byte for byte), the section, gallery, map field and metrics of the run report, and
+// the force impulses through a checkpoint.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -18,10 +23,16 @@
 #include <vector>
 
 #include "output/checkpoint.h"
+#include "pages/flow_images.h"
 #include "pages/viewer3d.h"
+#include "render/render.h"
 #include "report/liner_loads.h"
 #include "report/report.h"
 #include "sim.h"
+
+// For sanitizer builds (DEMDESIGN_SANITIZE): Mesa keeps a few hundred bytes until the process
+// ends, which LeakSanitizer would report as ours (as in test_render.cpp).
+extern "C" const char* __lsan_default_suppressions() { return "leak:libOSMesa.so\n"; }
 
 namespace dem::test {
 namespace {
@@ -344,6 +355,125 @@ TEST(LinerLoads, VtkAndInpOfTwoTrianglesHoldTheHandNumbers) {
   EXPECT_DOUBLE_EQ(metrics.get("liner_pressure_plate_peak_kPa"), 2.0);
 }
 
+// ---- each liner's own pressure map ------------------------------------------------------------
+
+TEST(LinerLoads, FaceOnDirectionLooksAtAPlateFromItsLoadedSideAndAlongTheLoadIntoABox) {
+  // A unit square in the x-y plane, normal +z by its winding.
+  const std::vector<std::array<double, 3>> square{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::vector<std::array<std::int32_t, 3>> halves{{0, 1, 2}, {0, 2, 3}};
+  const Eigen::Vector3d up(0, 0, 1), down(0, 0, -1);
+  // Face on: looking down at it when pushed down (the particles above), up at it when pushed up;
+  // without a push, or with one in its plane, from the side its normal points to.
+  EXPECT_NEAR((app::face_on_direction(square, halves, 3.0 * down) - down).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((app::face_on_direction(square, halves, Eigen::Vector3d(0.5, 0, 2)) - up).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((app::face_on_direction(square, halves, Eigen::Vector3d(0, 0, 0)) - down).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((app::face_on_direction(square, halves, Eigen::Vector3d(1, 0, 0)) - down).norm(), 0.0, 1e-12);
+  // A closed unit box (its faces wound outward) has no face: the camera looks along the push,
+  // else along the iso preset's (-1, 1, -1).
+  std::vector<std::array<double, 3>> corners;
+  for (int i = 0; i < 8; ++i) corners.push_back({i & 1 ? 1.0 : 0.0, i & 2 ? 1.0 : 0.0, i & 4 ? 1.0 : 0.0});
+  std::vector<std::array<std::int32_t, 3>> box;
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) box.push_back({q[0], q[1], q[2]}), box.push_back({q[0], q[2], q[3]});
+  const Eigen::Vector3d push(0.3, 0, -1);
+  EXPECT_NEAR((app::face_on_direction(corners, box, push) - push.normalized()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((app::face_on_direction(corners, box, Eigen::Vector3d(0, 0, 0)) - Eigen::Vector3d(-1, 1, -1).normalized()).norm(), 0.0, 1e-12);
+}
+
+/// A known field [kPa] on bed_case's plate, by its columns of squares along x: none recorded on
+/// the first (NaN: grey), 0 on the second (blue), 1.5 on the other two (red: the 99th percentile).
+std::vector<double> column_field(std::size_t triangles) {
+  std::vector<double> field(triangles);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const std::size_t column = (t / 2) % static_cast<std::size_t>(kCells);  // two triangles a square, rows of kCells
+    field[t] = column == 0 ? std::nan("") : column == 1 ? 0.0 : 1.5;
+  }
+  return field;
+}
+
+/// A map's pixels left of its colour bar (the right quarter is left out): those of a clearly
+/// red or clearly blue hue (coolwarm's two ends, shaded), and their mean columns [px].
+struct MapPixels {
+  double red = 0, blue = 0;                // [px]
+  double red_column = 0, blue_column = 0;  // [px]
+};
+
+MapPixels map_pixels(const render::Image& image) {
+  MapPixels m;
+  for (int row = 0; row < image.height; ++row)
+    for (int column = 0; column < image.width * 3 / 4; ++column) {
+      const std::uint8_t* p = image.pixel(column, row);
+      if (p[0] > p[1] + 60 && p[0] > p[2] + 60) m.red += 1, m.red_column += column + 0.5;
+      else if (p[2] > p[0] + 60 && p[2] > p[1] + 60) m.blue += 1, m.blue_column += column + 0.5;
+    }
+  if (m.red > 0) m.red_column /= m.red;
+  if (m.blue > 0) m.blue_column /= m.blue;
+  return m;
+}
+
+/// The map of column_field on bed_case's plate in 480 x 300 px, seen face on. Its bounding
+/// sphere (radius 40 mm / sqrt 2) spans 85 % of the height: the plate is a square of
+/// 0.85 x 300 / sqrt 2 = 180 px, 22.6 % of the image, three of its four columns coloured, 16.9 %.
+/// Seen from the iso direction it would cover 0.58 of that (9.8 %), edge on next to nothing: a
+/// band of 15 % to 19 % says face on and framed. Seen from above (x to the right) the red columns
+/// lie right of the blue one, from below left of it; the unrecorded column is grey.
+void expect_face_on(const render::Image& image, bool from_above, const std::string& what) {
+  ASSERT_EQ(image.width, 480) << what;
+  ASSERT_EQ(image.height, 300) << what;
+  const MapPixels m = map_pixels(image);
+  const double coloured = (m.red + m.blue) / (480.0 * 300.0);
+  EXPECT_GT(coloured, 0.15) << what;
+  EXPECT_LT(coloured, 0.19) << what;
+  EXPECT_NEAR(m.red / std::max(m.blue, 1.0), 2.0, 0.2) << what << ": two red columns to one blue";
+  EXPECT_EQ(m.red_column > m.blue_column, from_above) << what << ": red at " << m.red_column << " px, blue at " << m.blue_column << " px";
+  // The middle of the unrecorded column (3/8 of the plate's side from its centre): grey.
+  const double pixels_per_metre = 0.85 * 300 / (std::numbers::sqrt2 * kPlate);
+  const int column = static_cast<int>(240 + (from_above ? -1 : 1) * 0.375 * kPlate * pixels_per_metre);
+  const std::uint8_t* p = image.pixel(column, 150);
+  EXPECT_LT(std::abs(p[0] - p[2]) + std::abs(p[1] - p[2]), 16) << what << ": grey at column " << column;
+  EXPECT_GT(p[1], 90) << what;
+  EXPECT_LT(p[1], 220) << what << ": drawn, not background";
+}
+
+TEST(LinerLoads, PressureMapOfOneLinerShowsItFaceOnFromTheParticlesSide) {
+  const Model flat = compile(bed_case(false)), swung = compile(bed_case(true));
+  const std::vector<double> field = column_field(flat.meshes[0].surface->size());
+  const fs::path dir = fs::temp_directory_path() / "demdesign_liner_loads_map";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  app::ImageOptions options;
+  options.width = 480, options.height = 300;
+  const auto map_of = [&](const Model& model, double time, const Eigen::Vector3d& load, const std::string& name) {
+    State state;
+    state.time = time;
+    const std::string png = (dir / name).string();
+    app::render_mesh_field(model, state, 0, field, load, "mean pressure [kPa]", options, png);
+    return render::read_png(png);
+  };
+  expect_face_on(map_of(flat, 0.0, Eigen::Vector3d(0, 0, -1), "above.png"), true, "pushed down: seen from above");
+  expect_face_on(map_of(flat, 0.0, Eigen::Vector3d(0, 0, 2), "below.png"), false, "pushed up: seen from below");
+  // The swung plate stands in its own frame (normal +y) and lies flat from 10 ms on: a push
+  // along its own +y is, turned by its pose, one from below in the world (not turned, it would
+  // lie in the plate and the camera would look from above).
+  expect_face_on(map_of(swung, 0.4, Eigen::Vector3d(0, 1, 0), "swung.png"), false, "swung flat, pushed along its own +y: seen from below");
+  fs::remove_all(dir);
+}
+
+TEST(LinerLoads, LinerMapsLeaveOutBeltsAndMeshesThatCarryNothing) {
+  Model model = compile(parse_case_text(kTwoTriangles, "two_triangles.yaml"));
+  const report::LinerLoads loads = report::liner_loads(model, two_triangle_state(), 1.0);
+  EXPECT_EQ(report::liner_map_meshes(loads, model, {}), std::vector<std::size_t>{0});
+  // The plate as a belt: a map only when the case gives it a liner by name (liners_for's rule).
+  model.meshes[0].surface_velocity.kind = SurfaceVelocitySpec::Kind::linear;
+  model.meshes[0].surface_velocity.velocity = Vec3(1, 0, 0);
+  EXPECT_TRUE(report::liner_map_meshes(loads, model, {}).empty());
+  EXPECT_EQ(report::liner_map_meshes(loads, model, {{"plate", report::Liner{}}}), std::vector<std::size_t>{0});
+  // No records over the window: nothing carried, no map.
+  State unrecorded;
+  unrecorded.time = 3.0;
+  EXPECT_TRUE(report::liner_map_meshes(report::liner_loads(model, unrecorded, 1.0), model, {{"plate", report::Liner{}}}).empty());
+}
+
 TEST(LinerLoads, RunReportHasTheSectionTheFilesTheMetricsAndTheViewFields) {
   // The two triangles' records in a run report, with a liner 20 mm thick wearing at
   // k_s = 1e-12 m^3/J: friction work 30 and 120 J on 0.5 m^2 over 2 s.
@@ -366,6 +496,15 @@ TEST(LinerLoads, RunReportHasTheSectionTheFilesTheMetricsAndTheViewFields) {
   input.liners["plate"] = liner;
   const fs::path dir = fs::temp_directory_path() / "demdesign_liner_loads_report";
   fs::remove_all(dir);
+  fs::create_directories(dir);
+  // The plate's own pressure map, made as the run makes it (app/cli/main.cpp, write_liner_maps).
+  const report::LinerLoads loads = report::liner_loads(model, state, 1.0);
+  ASSERT_EQ(report::liner_map_meshes(loads, model, input.liners), std::vector<std::size_t>{0});
+  app::ImageOptions small;
+  small.width = 320, small.height = 240;
+  const std::string map = (dir / "pressure_map_plate.png").string();
+  app::render_mesh_field(model, state, 0, {2.0, 1.0}, loads.meshes[0].total_force, "mean pressure [kPa]", small, map);
+  input.liner_maps.push_back({"plate", map});
   const report::RunMetrics metrics = report::write_run_report(input, dir.string());
   EXPECT_DOUBLE_EQ(metrics.get("liner_pressure_plate_mean_kPa"), 1.5);
   EXPECT_DOUBLE_EQ(report::read_metrics((dir / "metrics.csv").string()).get("liner_pressure_plate_peak_kPa"), 2.0);
@@ -373,6 +512,13 @@ TEST(LinerLoads, RunReportHasTheSectionTheFilesTheMetricsAndTheViewFields) {
   EXPECT_NE(html.find("<h2>Liner pressure</h2>"), std::string::npos);
   EXPECT_NE(html.find("<code>fea/plate.inp</code>"), std::string::npos);
   EXPECT_LT(html.find("<h2>Wear</h2>"), html.find("<h2>Liner pressure</h2>")) << "after the wear and life section";
+  // The gallery in the Liner pressure section, under its table: each liner's map, name and peak.
+  const std::size_t section = html.find("<h2>Liner pressure</h2>"), gallery = html.find("<h3>Pressure map of each liner</h3>");
+  ASSERT_NE(gallery, std::string::npos);
+  EXPECT_LT(html.find("</table>", section), gallery);
+  EXPECT_LT(gallery, html.find("<h2>", section + 1)) << "before the next section";
+  EXPECT_NE(html.find("<div class=\"grid\">\n<figure><img alt=\"plate\" src=\"data:image/png;base64,", gallery), std::string::npos);
+  EXPECT_NE(html.find("<figcaption><b>plate</b> &middot; peak 2.000 kPa</figcaption>", gallery), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "fea" / "plate.inp"));
   EXPECT_TRUE(fs::exists(dir / "fea" / "plate.vtk"));
   EXPECT_EQ(read(dir / "liner_loads.csv"), "mesh,area_m2,mean_kPa,p95_kPa,peak_kPa,peak_x_m,peak_y_m,peak_z_m,force_x_N,force_y_N,force_z_N\n"

@@ -18,8 +18,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "base/allocator.h"
@@ -126,15 +128,35 @@ std::vector<std::vector<double>> wall_rate(const dem::Model& model, const dem::S
   return out;
 }
 
-/// Per-triangle mean pressure [kPa] over the recording interval (report/liner_loads.h).
-std::vector<std::vector<double>> pressure_kilopascals(const dem::Model& model, const dem::State& state) {
-  const dem::report::LinerLoads loads = dem::report::liner_loads(model, state, model.output.records_from);
-  std::vector<std::vector<double>> out;
-  for (const dem::report::LinerLoad& load : loads.meshes) {
-    out.push_back(load.pressure);
-    for (double& p : out.back()) p *= 1e-3;  // Pa to kPa
-  }
+/// One mesh's mean pressure [kPa] per triangle over the recording interval (report/liner_loads.h).
+std::vector<double> kilopascals(const dem::report::LinerLoad& load) {
+  std::vector<double> out = load.pressure;
+  for (double& p : out) p *= 1e-3;  // Pa to kPa
   return out;
+}
+
+/// Per-triangle mean pressure [kPa] of every mesh.
+std::vector<std::vector<double>> pressure_kilopascals(const dem::report::LinerLoads& loads) {
+  std::vector<std::vector<double>> out;
+  for (const dem::report::LinerLoad& load : loads.meshes) out.push_back(kilopascals(load));
+  return out;
+}
+
+/// Each liner's own pressure map, report/pressure_map_MESH.png (MESH as in fea/): the mesh alone,
+/// seen face on from the side its load comes from (the particles' mean force on it), for the
+/// gallery under the report's liner table. Liners as liner_map_meshes picks them.
+std::vector<dem::report::LinerMap> write_liner_maps(const dem::Model& model, const dem::State& state, const dem::report::LinerLoads& loads,
+                                                    const std::map<std::string, dem::report::Liner>& liners, const std::string& report_dir) {
+  dem::app::ImageOptions view;
+  view.width = 800, view.height = 600;  // shown small, side by side
+  std::vector<dem::report::LinerMap> maps;
+  for (const std::size_t m : dem::report::liner_map_meshes(loads, model, liners)) {
+    const dem::report::LinerLoad& load = loads.meshes[m];
+    const std::string path = fmt::format("{}/pressure_map_{}.png", report_dir, dem::report::fea_name(load.name));
+    dem::app::render_mesh_field(model, state, m, kilopascals(load), load.total_force, "mean pressure [kPa]", view, path);
+    maps.push_back({load.name, path});
+  }
+  return maps;
 }
 
 /// The run's report folder: renders of the flow and of the wear fields and the liner pressure on
@@ -174,11 +196,13 @@ void write_run_report(const dem::Model& model, const dem::State& state, const de
     input.images.push_back({"Impact wear: impact energy rate", impact,
                             fmt::format("Normal impact energy per area and time on the walls, t = {:.2f} to {:.2f} s.", model.output.records_from, state.time)});
     const std::string pressure = report_dir + "/pressure_map.png";
-    dem::app::render_wall_field(model, state, pressure_kilopascals(model, state), "mean pressure [kPa]", wear_view, pressure);
+    const dem::report::LinerLoads loads = dem::report::liner_loads(model, state, model.output.records_from);
+    dem::app::render_wall_field(model, state, pressure_kilopascals(loads), "mean pressure [kPa]", wear_view, pressure);
     input.images.push_back({"Liner pressure: mean pressure", pressure,
                             fmt::format("Normal impulse per area and time on the walls (the liners' mean pressure), t = {:.2f} to {:.2f} s; "
-                                        "the loads for a structural model are in report/fea/.",
+                                        "each liner's own map is in the Liner pressure section; the loads for a structural model are in report/fea/.",
                                         model.output.records_from, state.time)});
+    input.liner_maps = write_liner_maps(model, state, loads, input.liners, report_dir);
   }
   const dem::report::RunMetrics metrics = dem::report::write_run_report(input, report_dir);
   std::cout << fmt::format("  report: {}/report.html ({})\n", report_dir, metrics.steady_text);
@@ -266,7 +290,7 @@ OutputFolder claim_output_folder(const RunArgs& args, const dem::CaseSpec& spec)
                             "renders/flow.mp4",    "renders/flow.mp4.log", "report/*.html",
                             "report/*.csv",        "report/*.png",       "report/plots/*.png",
                             "report/plots/*.gp",   "report/plots/*.tsv", "report/fea/*.vtk",
-                            "report/fea/*.inp"};
+                            "report/fea/*.inp",    "report/pressure_map_*.png"};
   if (dem::app::mpi::world().rank == 0) {
     std::vector<std::string> names = dem::run_output_names();
     names.insert(names.end(), claimed.caller_outputs.begin(), claimed.caller_outputs.end());

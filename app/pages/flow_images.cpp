@@ -2,11 +2,16 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <limits>
 #include <span>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -190,6 +195,70 @@ void add_walls(const WallShapes& walls, render::Frame& frame) {
   for (const auto& corners : walls.plane_vertices) add_wall(corners, walls.quad, frame);
 }
 
+// ---- wall fields: the colour conventions of the pressure and wear maps ---------------------------
+
+/// A per-triangle field as a layer's values (NaN stays NaN: the renderer draws it grey).
+std::vector<float> field_values(const std::vector<double>& field) {
+  std::vector<float> values;
+  values.reserve(field.size());
+  for (double v : field) values.push_back(static_cast<float>(v));
+  return values;
+}
+
+/// The colour map of wall fields (one per mesh drawn), titled `label` with its units: coolwarm
+/// from 0 to the 99th percentile of the finite values, so that one hot triangle does not wash
+/// out the rest (the peak clamps to the top colour).
+render::ColourMap wall_field_colours(std::span<const std::vector<double>> fields, const std::string& label) {
+  std::vector<double> all;
+  for (const std::vector<double>& field : fields)
+    for (double v : field)
+      if (std::isfinite(v)) all.push_back(v);
+  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
+  if (!all.empty()) {
+    std::sort(all.begin(), all.end());
+    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
+  }
+  return colours;
+}
+
+// ---- one mesh seen face on -----------------------------------------------------------------------
+
+/// A mesh whose area-weighted mean normal is shorter than this (its unit normals averaged by
+/// area) has no face to look at. A flat plate has 1, a 90 degree bend 0.71, a half cylinder
+/// 2/pi = 0.64, a hood of equal roof, cheeks and back 0.35 (seen diagonally into it), a
+/// cylinder curled through 270 degrees 0.30, one curled through 300 degrees 0.19, a closed box 0.
+constexpr double kFaceOnMinimum = 0.25;
+/// The share of the image's smaller side the mesh's bounding sphere spans: the rest is a margin
+/// for the caption, the colour bar and the scale bar at the corners.
+constexpr double kSphereFill = 0.85;
+
+/// [m] A vertex as a vector.
+Eigen::Vector3d point(const std::array<double, 3>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+
+/// Up for a camera looking along `forward`: z, or y when it looks nearly straight down or up
+/// (as the top preset: x to the right, y up), where z would leave the picture's turn to chance.
+Eigen::Vector3d camera_up(const Eigen::Vector3d& forward) {
+  return std::abs(forward.z()) > 0.9 ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 1);
+}
+
+/// An orthographic camera looking along `forward` at the bounding sphere of `placed` (centred on
+/// its box [lo, hi], out to its farthest vertex), which spans kSphereFill of the smaller side.
+/// Orthographic so that the scale bar holds over the whole liner (rejected: perspective, whose
+/// scale bar holds at the target's depth only, and a curved spoon has many depths).
+render::Camera face_on_camera(std::span<const std::array<double, 3>> placed, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                              const Eigen::Vector3d& forward, double aspect) {
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  double radius = 1e-6;  // [m]
+  for (const auto& v : placed) radius = std::max(radius, (point(v) - centre).norm());
+  render::Camera camera;
+  camera.orthographic = true;
+  camera.target = centre;
+  camera.eye = centre - 2 * radius * forward;  // outside the sphere; the depth range is set per frame
+  camera.up = camera_up(forward);
+  camera.ortho_height = 2 * radius / (kSphereFill * std::min(1.0, aspect));
+  return camera;
+}
+
 }  // namespace
 
 void render_state(const Model& model, const State& s, const ImageOptions& options, const std::string& path) {
@@ -224,20 +293,12 @@ void render_wall_field(const Model& model, const State& s, const std::vector<std
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   std::vector<std::vector<std::array<double, 3>>> placed(model.meshes.size());
   std::vector<std::vector<float>> values(model.meshes.size());
-  std::vector<double> all;
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     place_mesh(model, m, s.time, placed[m], lo, hi);
-    for (double v : field[m]) {
-      values[m].push_back(static_cast<float>(v));
-      if (std::isfinite(v)) all.push_back(v);
-    }
+    values[m] = field_values(field[m]);
   }
   if (!std::isfinite(lo.x())) return;
-  render::ColourMap colours{"coolwarm", 0.0, 1.0, label};
-  if (!all.empty()) {
-    std::sort(all.begin(), all.end());
-    colours.max = std::max(all[static_cast<size_t>(0.99 * static_cast<double>(all.size() - 1))], 1e-30);
-  }
+  const render::ColourMap colours = wall_field_colours(field, label);
   for (size_t m = 0; m < model.meshes.size(); ++m) {
     render::MeshLayer layer;
     layer.vertices = placed[m];
@@ -254,6 +315,58 @@ void render_wall_field(const Model& model, const State& s, const std::vector<std
   frame.mesh_colours = colours;
   frame.camera = camera_for(model, options, lo, hi, double(frame.width) / frame.height);
   frame.caption = fmt::format("{}   {}", model.title.empty() ? model.source : model.title, label);
+  render::render_png(frame, path);
+}
+
+Eigen::Vector3d face_on_direction(std::span<const std::array<double, 3>> vertices,
+                                  std::span<const std::array<std::int32_t, 3>> triangles, const Eigen::Vector3d& load) {
+  // The area-weighted mean normal: the sum of the triangles' area vectors (twice the area times
+  // the unit normal) over the sum of their lengths (rejected: the least axis of the vertices'
+  // spread, which is blind to the side the faces look to and to which faces carry area).
+  Eigen::Vector3d area_vector(0, 0, 0);
+  double area = 0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d a = point(vertices[static_cast<size_t>(t[0])]);
+    const Eigen::Vector3d twice = (point(vertices[static_cast<size_t>(t[1])]) - a).cross(point(vertices[static_cast<size_t>(t[2])]) - a);
+    area_vector += twice, area += twice.norm();
+  }
+  const Eigen::Vector3d push = load.allFinite() && load.norm() > 0 ? Eigen::Vector3d(load.normalized()) : Eigen::Vector3d(0, 0, 0);
+  if (area > 0 && area_vector.norm() >= kFaceOnMinimum * area) {
+    // Face on: looking along the normal sees the back of the faces, against it their front.
+    const Eigen::Vector3d normal = area_vector.normalized();
+    return normal.dot(push) > 0 ? normal : Eigen::Vector3d(-normal);
+  }
+  // No face (a spoon curled nearly round, a closed hood): the camera on the particles' side
+  // of the mesh, looking along their push, which shows the faces they load; without a push, the
+  // iso preset's view, as the map of all meshes.
+  if (push.norm() > 0) return push;
+  return Eigen::Vector3d(-1, 1, -1).normalized();
+}
+
+void render_mesh_field(const Model& model, const State& s, std::size_t mesh, const std::vector<double>& field,
+                       const Eigen::Vector3d& load, const std::string& label, const ImageOptions& options, const std::string& path) {
+  if (mesh >= model.meshes.size())
+    throw std::invalid_argument(fmt::format("{}: mesh {} of a model with {} meshes", path, mesh, model.meshes.size()));
+  const MeshWall& wall = model.meshes[mesh];
+  // The mesh alone at its pose now; the frame's layer borrows `placed` and `values`.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<std::array<double, 3>> placed;
+  place_mesh(model, mesh, s.time, placed, lo, hi);
+  if (placed.empty()) return;
+  const std::vector<float> values = field_values(field);
+  render::Frame frame;
+  frame.width = options.width, frame.height = options.height;
+  render::MeshLayer layer;
+  layer.vertices = placed;
+  layer.triangles = wall.surface->triangles;
+  layer.triangle_value = values;
+  frame.meshes.push_back(layer);
+  frame.mesh_colours = wall_field_colours(std::span(&field, 1), label);
+  // Face on from the particles' side: their push turned from the mesh's frame into the world.
+  const Eigen::Vector3d world_load = wall.motion.pose(s.time).rotation * load;
+  const Eigen::Vector3d forward = face_on_direction(placed, wall.surface->triangles, world_load);
+  frame.camera = face_on_camera(placed, lo, hi, forward, double(frame.width) / frame.height);
+  frame.caption = fmt::format("{}   {}", wall.name, label);
   render::render_png(frame, path);
 }
 

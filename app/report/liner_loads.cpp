@@ -14,6 +14,7 @@
 
 #include "output/run.h"
 #include "report/report_internal.h"
+#include "report/report_wear.h"
 
 namespace dem::report {
 namespace {
@@ -210,6 +211,16 @@ void write_liner_loads(const LinerLoads& loads, const Model& model, const std::s
     write_file_atomically((fea / (stem + ".inp")).string(), liner_inp(loads, load, surface, case_name));
   }
   write_file_atomically((fs::path(report_dir) / "liner_loads.csv").string(), csv);
+}
+
+std::vector<std::size_t> liner_map_meshes(const LinerLoads& loads, const Model& model, const std::map<std::string, Liner>& liners) {
+  std::vector<std::size_t> meshes;
+  if (!loads.recorded()) return meshes;
+  for (std::size_t m = 0; m < model.meshes.size() && m < loads.meshes.size(); ++m) {
+    const bool named = liners.count(model.meshes[m].name) > 0;
+    if (loads.meshes[m].mean > 0 && (named || !has_surface_velocity(model.meshes[m]))) meshes.push_back(m);
+  }
+  return meshes;
 }
 
 void add_liner_pressure_metrics(const LinerLoads& loads, RunMetrics& metrics) {

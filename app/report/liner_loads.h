@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,12 @@ std::string fea_name(const std::string& mesh_name);
 /// Writes REPORT_DIR/liner_loads.csv and, per mesh, REPORT_DIR/fea/MESH.vtk and MESH.inp, each
 /// atomically; nothing without meshes or records. `case_name` is named in the .inp files.
 void write_liner_loads(const LinerLoads& loads, const Model& model, const std::string& case_name, const std::string& report_dir);
+
+/// The meshes that get a pressure map of their own (indices into model.meshes, in order): those
+/// that carry load (a mean pressure above zero over the records' window) and are liners by the
+/// rule of liners_for (report_wear.h): a belt or pulley (a mesh whose surface moves) only when
+/// `liners` names it. The liner table lists every mesh; a map of what carries nothing shows nothing.
+std::vector<std::size_t> liner_map_meshes(const LinerLoads& loads, const Model& model, const std::map<std::string, Liner>& liners);
 
 /// Appends per mesh liner_pressure_MESH_mean_kPa, _p95_kPa and _peak_kPa (nothing without records).
 void add_liner_pressure_metrics(const LinerLoads& loads, RunMetrics& metrics);

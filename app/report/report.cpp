@@ -511,8 +511,25 @@ std::string wear(const Page& page) {
   return h;
 }
 
+/// Each liner's own pressure map side by side, with its name and peak pressure ("" without any).
+std::string liner_map_gallery(const Page& page, const LinerLoads& loads) {
+  if (page.in.liner_maps.empty()) return "";
+  std::string h = "<h3>Pressure map of each liner</h3>\n<p>Each liner alone, seen face on (along its mean normal, weighted by area) "
+                  "from the side the material pushes it, in the same window; its colour scale ends at its own 99th percentile, so "
+                  "the peak may lie above it; grey: no records. Files pressure_map_MESH.png.</p>\n<div class=\"grid\">\n";
+  for (const LinerMap& map : page.in.liner_maps) {
+    // The peak from the table's numbers, found by the mesh's name.
+    const auto load = std::find_if(loads.meshes.begin(), loads.meshes.end(), [&](const LinerLoad& l) { return l.name == map.mesh; });
+    const double peak = load == loads.meshes.end() ? std::numeric_limits<double>::quiet_NaN() : 1e-3 * load->peak;  // [kPa]
+    h += fmt::format("<figure>{}<figcaption><b>{}</b> &middot; peak {} kPa</figcaption></figure>\n", embed_image(map.path, map.mesh),
+                     esc(map.mesh), num(peak));
+  }
+  return h + "</div>\n";
+}
+
 /// Liner pressure: per mesh its mean, 95th percentile and peak pressure and the material's mean
-/// force over the records' window, and the files a structural model reads ("" without records).
+/// force over the records' window, each liner's own map, and the files a structural model reads
+/// ("" without records).
 std::string liner_pressure(const Page& page, const LinerLoads& loads) {
   if (page.model.meshes.empty() || !loads.recorded()) return "";
   std::string h = fmt::format(
@@ -520,8 +537,8 @@ std::string liner_pressure(const Page& page, const LinerLoads& loads) {
       "triangle the normal impulse / (area &times; window); its mean weighted by area, the 95th percentile by area (95 % of the "
       "area carries no more) and the peak, with the peak triangle&#39;s centroid; and the material&#39;s mean force on the mesh, "
       "friction included. Positions and forces are in each mesh&#39;s own frame (the case&#39;s coordinates for a mesh without "
-      "motion). Also in liner_loads.csv; the map of the mean pressure is among the images (pressure_map.png).</p>\n<table>\n",
-      num(loads.t0, 3), num(loads.t1, 4));
+      "motion). Also in liner_loads.csv; the map of all meshes is among the images (pressure_map.png){}.</p>\n<table>\n",
+      num(loads.t0, 3), num(loads.t1, 4), page.in.liner_maps.empty() ? "" : "; each liner&#39;s own map follows the table");
   h += table_row({"mesh", "area [m&sup2;]", "mean [kPa]", "p95 [kPa]", "peak [kPa]", "peak at x, y, z [m]", "F<sub>x</sub> [kN]",
                   "F<sub>y</sub> [kN]", "F<sub>z</sub> [kN]", "for FEA"},
                  true);
@@ -531,7 +548,8 @@ std::string liner_pressure(const Page& page, const LinerLoads& loads) {
                     num(1e-3 * l.total_force.x()), num(1e-3 * l.total_force.y()), num(1e-3 * l.total_force.z()),
                     fmt::format("<code>fea/{}.inp</code>, <code>fea/{}.vtk</code>", stem, stem)});
   }
-  return h + "</table>\n<p>For a structural model, <code>fea/MESH.inp</code> is a CalculiX / Abaqus input fragment in the mesh&#39;s own "
+  h += "</table>\n" + liner_map_gallery(page, loads);
+  return h + "<p>For a structural model, <code>fea/MESH.inp</code> is a CalculiX / Abaqus input fragment in the mesh&#39;s own "
              "frame, in N, m and Pa: the mesh&#39;s nodes (<code>*NODE</code>) and triangles as S3 shells (<code>*ELEMENT</code>), then "
              "two load blocks that are alternatives, use one: <code>*CLOAD</code>, each triangle&#39;s mean force (pressure and "
              "friction) split equally over its three nodes, or <code>*DLOAD</code>, each element&#39;s pressure (positive P acts "

@@ -26,6 +26,13 @@ struct ImageRef {
   std::string title, path, caption;
 };
 
+/// A liner's own pressure map, the caller's render of one mesh (app/pages/flow_images.h,
+/// render_mesh_field), shown in the Liner pressure section with the mesh's peak pressure.
+struct LinerMap {
+  std::string mesh;  ///< the mesh's name, as in the liner pressure table
+  std::string path;  ///< the PNG
+};
+
 /// The liner of a mesh as the wear analysis reads it: what it is, how thick, and the volume it
 /// loses per joule by sliding and by impact (case/liner_materials.cpp has the laws and sources).
 struct Liner {
@@ -43,6 +50,9 @@ struct RunReportInput {
   std::string case_path, case_text, version;
   double wall_seconds = 0;  // [s] run wall time
   std::vector<ImageRef> images;
+  /// Per liner its own pressure map: a gallery under the liner pressure table (rejected: among
+  /// `images`, whose section comes last, far from the table the maps explain).
+  std::vector<LinerMap> liner_maps;
   /// Per mesh name: its liner (report/report_wear.h, liners_for, resolves them from a case).
   std::map<std::string, Liner> liners;
   /// Per mesh name not in `liners`: a sliding wear coefficient [m^3/J] (wear volume per friction

@@ -22,13 +22,6 @@ constexpr double kMonthsPerYear = 12.0;
 constexpr double kMillimetresPerMetre = 1e3;
 constexpr double kTonnesPerMegatonne = 1e6;
 
-/// Whether a mesh's surface moves (a belt, a pulley): it takes no `default` liner.
-bool has_surface_velocity(const MeshWall& mesh) {
-  const SurfaceVelocitySpec& s = mesh.surface_velocity;
-  return (s.kind == SurfaceVelocitySpec::Kind::linear && s.velocity.norm() > 0) ||
-         (s.kind == SurfaceVelocitySpec::Kind::rotation && s.angular_speed != 0);
-}
-
 /// The entry `name` (a mesh name or "default") of `wear.liners` or of `wear_coefficients` as a
 /// liner; none when neither has it (the case reader lets a name be in one of them only).
 std::optional<Liner> case_liner(const CaseSpec& spec, const std::string& name) {
@@ -96,6 +89,12 @@ WearZone wear_zone(const Liner& liner, double friction_work, double impact_energ
   z.life_months = life_months(liner.thickness, rate, hours_per_year);
   z.mm_per_megatonne = mm_per_megatonne(rate, throughput_t_h);
   return z;
+}
+
+bool has_surface_velocity(const MeshWall& mesh) {
+  const SurfaceVelocitySpec& s = mesh.surface_velocity;
+  return (s.kind == SurfaceVelocitySpec::Kind::linear && s.velocity.norm() > 0) ||
+         (s.kind == SurfaceVelocitySpec::Kind::rotation && s.angular_speed != 0);
 }
 
 std::map<std::string, Liner> liners_for(const CaseSpec& spec, const Model& model) {

@@ -58,6 +58,9 @@ struct WearZone {
 WearZone wear_zone(const Liner& liner, double friction_work, double impact_energy, double area, double interval,
                    double hours_per_year, double throughput_t_h);
 
+/// Whether a mesh's surface moves (a belt, a pulley): it takes no `default` liner.
+bool has_surface_velocity(const MeshWall& mesh);
+
 /// The liner of each mesh of `model` from the case: its own entry in `wear.liners` or in
 /// `wear_coefficients`, else the `default` of either for a mesh without a surface velocity
 /// (belts and pulleys take no default: only a liner given by their name). A mesh with neither
