@@ -1,9 +1,12 @@
 // Case reading: bad input gets an error naming file, line, key and what would be valid.
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
+#include <vector>
 
 #include "case/spec.h"
+#include "contact/effect.h"
 #include "core/model.h"
 
 namespace dem::test {
@@ -125,6 +128,30 @@ TEST(CaseReading, AnUnstatedParameterLeavesThePairTheOthersValue) {
   EXPECT_DOUBLE_EQ(model.pair_param(glass, rubber, "rolling_friction"), 0.2);  // both state it: arithmetic mean
   EXPECT_DOUBLE_EQ(model.pair_param(steel, rubber, "cohesion_energy_density"), 0.0);  // neither: the default
   EXPECT_DOUBLE_EQ(model.pair_param(steel, steel, "rolling_friction"), 0.0);
+}
+
+// The stages are declared once (kStageTable, contact/effect.h); ContactSpec maps each to its own
+// field: a single stage to one choice, an additive stage to a list. A stage added to the table
+// without its field fails here.
+TEST(Contact, EveryStageHasItsFieldInContactSpec) {
+  ContactSpec contact;
+  std::set<const void*> fields;
+  for (const Stage stage : kStages) {
+    const bool additive = stage_is_additive(stage);
+    EXPECT_EQ(contact.single(stage) != nullptr, !additive) << stage_name(stage);
+    EXPECT_EQ(contact.additive(stage) != nullptr, additive) << stage_name(stage);
+    fields.insert(additive ? static_cast<const void*>(contact.additive(stage)) : static_cast<const void*>(contact.single(stage)));
+  }
+  EXPECT_EQ(fields.size(), kStages.size()) << "two stages share a field of ContactSpec";
+}
+
+// compile switches the effects on by walking kStages: an adhesion list runs after damping and
+// before the tangential law, whatever the order of the YAML keys.
+TEST(Contact, EffectsSwitchOnInRunningOrder) {
+  const Model model = compile(parse_case_text(std::string(kGood) + "contact: {rolling: epsd, adhesion: [sjkr]}\n", "case.yaml"));
+  std::vector<std::string> order;
+  for (const ActiveEffect& e : model.effects) order.push_back(std::string(stage_name(e.spec->stage)) + ": " + std::string(e.spec->name));
+  EXPECT_EQ(order, (std::vector<std::string>{"normal: hertz", "damping: restitution", "adhesion: sjkr", "tangential: mindlin", "rolling: epsd"}));
 }
 
 }  // namespace

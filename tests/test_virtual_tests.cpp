@@ -4,7 +4,8 @@
 // a heap that steepens with it), the rotating drum's dynamic angle and wall slip, and hopper
 // discharge against Beverloo's law and arching. Apparatus shrunk (size_factor) and particles
 // coarse and soft so each simulation takes a few seconds. Also: a diagnosis candidate at its
-// `unchanged` values compiles to the model's own contact law.
+// `unchanged` values compiles to the model's own contact law, and every candidate effect's `moves`
+// names a test of the table and one of its observables.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -15,8 +16,12 @@
 #include <iostream>
 #include <numbers>
 #include <numeric>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "calibration/calibration.h"
+#include "contact/effect.h"
 #include "model/material_model.h"
 #include "lab/measurements.h"
 #include "sim.h"
@@ -73,6 +78,30 @@ TEST(VirtualTests, TableNamesEveryTestAndItsObservables) {
   EXPECT_EQ(observable_names("rotating_drum"), std::vector<std::string>{"dynamic_angle_deg"});
   EXPECT_EQ(observable_names("hopper_discharge"), std::vector<std::string>{"mass_flow_rate"});
   EXPECT_TRUE(observable_names("nonsense").empty());
+}
+
+/// Whether `entry`, written "test/observable", names a virtual test and one of its observables.
+bool names_an_observable(std::string_view entry) {
+  const size_t slash = entry.find('/');
+  if (slash == std::string_view::npos) return false;
+  const std::vector<std::string> observables = observable_names(std::string(entry.substr(0, slash)));
+  const std::string observable(entry.substr(slash + 1));
+  return std::find(observables.begin(), observables.end(), observable) != observables.end();
+}
+
+// A candidate effect lists the observables it moves (CandidateSpec::moves, in its own file under
+// src/contact/effects/); a diagnosis reads them by name, so each must be one the lab measures.
+TEST(VirtualTests, EveryCandidateMovesObservablesOfTheTable) {
+  int entries = 0;
+  for (const EffectSpec* effect : effect_table()) {
+    if (!effect->candidate) continue;
+    for (const std::string_view entry : effect->candidate->moves) {
+      ++entries;
+      EXPECT_TRUE(names_an_observable(entry)) << "effect '" << effect->name << "': moves '" << entry
+                                              << "' is not TEST/OBSERVABLE of a virtual test (materials/lab/virtual_tests.cpp)";
+    }
+  }
+  EXPECT_GT(entries, 0) << "no effect of the table declares a candidate";
 }
 
 TEST(VirtualTests, MissingOrBadSetupIsACaseErrorAtTheExperiment) {

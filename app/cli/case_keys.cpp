@@ -352,7 +352,7 @@ void contact_tables(std::string& out, bool markdown) {
   if (markdown) out += "| key | effect | unit | default | valid | pair value | tunable |\n|---|---|---|---|---|---|---|\n";
   for (const EffectSpec* e : effect_table())
     for (const ParamSpec& p : e->params) {
-      const std::string effect = fmt::format("contact.{}: {}", kStageKeys[static_cast<int>(e->stage)], e->name);
+      const std::string effect = fmt::format("contact.{}: {}", stage_name(e->stage), e->name);
       const std::string range = fmt::format("[{}, {}]", shown_number(p.min_value), shown_number(p.max_value));
       if (markdown)
         out += fmt::format("| `{}` | `{}` | {} | {} | {} | {} | {} |\n", p.key, effect, p.unit, shown_number(p.default_value), range,
@@ -362,11 +362,14 @@ void contact_tables(std::string& out, bool markdown) {
                            shown_number(p.default_value), range, mixing_name(p.mixing), p.tunable ? ", tunable" : "");
     }
   heading(out, 2, "Contact models and options", markdown);
-  out += "`contact.STAGE: MODEL` or `contact.STAGE: {model: MODEL, OPTION: VALUE}`; `adhesion` and `extra` take a "
-         "list of models.\n\n";
+  std::vector<std::string> additive;
+  for (const Stage stage : kStages)
+    if (stage_is_additive(stage)) additive.push_back(fmt::format("`{}`", stage_name(stage)));
+  out += fmt::format("`contact.STAGE: MODEL` or `contact.STAGE: {{model: MODEL, OPTION: VALUE}}`; {} take a list of models.\n\n",
+                     joined(additive, " and "));
   if (markdown) out += "| stage | model | option | values (first: default) |\n|---|---|---|---|\n";
   for (const EffectSpec* e : effect_table()) {
-    const std::string stage(kStageKeys[static_cast<int>(e->stage)]);
+    const std::string stage(stage_name(e->stage));
     if (e->options.empty()) {
       if (markdown) out += fmt::format("| `{}` | `{}` | | |\n", stage, e->name);
       else out += fmt::format("  contact.{}: {}\n", stage, e->name);

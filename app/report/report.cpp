@@ -768,7 +768,7 @@ std::string materials_and_contact_law(const Model& model) {
     h += table_row({esc(m.name), num(m.density), num(m.youngs_modulus), num(m.poisson_ratio, 3)});
   h += "</table>\n<h3>Contact law and pair parameters</h3>\n<ul>\n";
   for (const ActiveEffect& e : model.effects)
-    h += fmt::format("<li>{}: <b>{}</b> &ndash; {} ({})</li>\n", esc(std::string(kStageKeys[static_cast<int>(e.spec->stage)])),
+    h += fmt::format("<li>{}: <b>{}</b> &ndash; {} ({})</li>\n", esc(std::string(stage_name(e.spec->stage))),
                      esc(std::string(e.spec->name)), esc(std::string(e.spec->summary)), esc(std::string(e.spec->citation)));
   h += "</ul>\n<table>\n<tr><th>pair</th><th>E* [Pa]</th><th>G* [Pa]</th>";
   for (const ActiveEffect& e : model.effects)

@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 
+#include "contact/effect.h"
 #include "output/run.h"
 
 namespace dem::materials {
@@ -26,17 +28,25 @@ std::string choice(const ContactSpec::Choice& c) {
   return out + "}";
 }
 
-std::string contact_text(const ContactSpec& c) {
-  std::vector<std::string> parts;
-  for (const auto& [key, ch] : {std::pair{"normal", &c.normal}, {"damping", &c.damping}, {"tangential", &c.tangential}, {"rolling", &c.rolling},
-                                {"twisting", &c.twisting}})
-    if (ch->model != "none" && !ch->model.empty()) parts.push_back(fmt::format("{}: {}", key, choice(*ch)));
-  for (const auto& [key, list] : {std::pair{"adhesion", &c.adhesion}, {"extra", &c.extra}}) {
-    if (list->empty()) continue;
+/// `STAGE: MODEL` or `STAGE: [MODEL, ...]`; empty when the stage is off.
+std::string stage_text(const ContactSpec& c, Stage stage) {
+  const std::string_view key = stage_name(stage);
+  if (const std::vector<ContactSpec::Choice>* list = c.additive(stage)) {
+    if (list->empty()) return "";
     std::vector<std::string> items;
     for (const auto& ch : *list) items.push_back(choice(ch));
-    parts.push_back(fmt::format("{}: [{}]", key, fmt::join(items, ", ")));
+    return fmt::format("{}: [{}]", key, fmt::join(items, ", "));
   }
+  const ContactSpec::Choice& ch = *c.single(stage);
+  if (ch.model == "none" || ch.model.empty()) return "";
+  return fmt::format("{}: {}", key, choice(ch));
+}
+
+std::string contact_text(const ContactSpec& c) {
+  // Single stages, then the lists.
+  std::vector<std::string> parts;
+  for (const Stage stage : kStagesSingleFirst)
+    if (std::string part = stage_text(c, stage); !part.empty()) parts.push_back(std::move(part));
   return "{" + fmt::format("{}", fmt::join(parts, ", ")) + "}";
 }
 

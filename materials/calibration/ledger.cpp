@@ -12,15 +12,16 @@
 
 #include "calibration/calibration.h"
 #include "calibration/calibration_support.h"
+#include "contact/effect.h"
 
 namespace dem::materials {
 
 std::vector<std::string> model_effects(const MaterialModel& model) {
   std::vector<std::string> out;
-  for (const ContactSpec::Choice* c : {&model.contact.normal, &model.contact.damping, &model.contact.tangential, &model.contact.rolling, &model.contact.twisting})
-    if (c->model != "none") out.push_back(c->model);
-  for (const auto& c : model.contact.adhesion) out.push_back(c.model);
-  for (const auto& c : model.contact.extra) out.push_back(c.model);
+  // Single stages ("none" switches one off), then the lists.
+  for (const Stage stage : kStagesSingleFirst)
+    for (const ContactSpec::Choice* c : model.contact.choices(stage))
+      if (stage_is_additive(stage) || c->model != "none") out.push_back(c->model);
   if (!model.shape.empty()) out.push_back(fmt::format("clump (aspect {:.2f})", get_parameter(model, "clump_aspect_ratio")));
   return out;
 }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "contact/effect.h"
 #include "output/run.h"
 
 namespace dem::materials {
@@ -55,10 +56,9 @@ std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup
                      number(model.mass_scaling), number(model.stiffness_scaling));
   describe(out, "particle", model.particle);
   const ContactSpec& c = model.contact;
-  describe(out, "normal", c.normal), describe(out, "damping", c.damping), describe(out, "tangential", c.tangential);
-  describe(out, "rolling", c.rolling), describe(out, "twisting", c.twisting);
-  for (const auto& a : c.adhesion) describe(out, "adhesion", a);
-  for (const auto& e : c.extra) describe(out, "extra", e);
+  // Single stages, then the lists: the order the stored simulations are keyed by.
+  for (const Stage stage : kStagesSingleFirst)
+    for (const ContactSpec::Choice* choice : c.choices(stage)) describe(out, std::string(stage_name(stage)), *choice);
   const SizeDistributionSpec& d = model.diameter;
   out += fmt::format("diameter: {{kind: {}, value: {}, mean: {}, std: {}, min: {}, max: {}, values: [{}], mass_fractions: [{}]}}\n",
                      static_cast<int>(d.kind), number(d.value), number(d.mean), number(d.std_dev), number(d.min), number(d.max),

@@ -187,42 +187,22 @@ void set_parameter(MaterialModel& model, const std::string& key, double value) {
 
 namespace {
 
-/// The choices of an additive stage (nullptr for a single one); Contact is ContactSpec, const or not.
-template <class Contact>
-auto* additive_choices(Contact& contact, Stage stage) {
-  return stage == Stage::adhesion ? &contact.adhesion : stage == Stage::extra ? &contact.extra : nullptr;
-}
-
-/// The choice of a single stage (nullptr for an additive one).
-template <class Contact>
-auto* single_choice(Contact& contact, Stage stage) {
-  using Choice = std::remove_reference_t<decltype((contact.normal))>;
-  switch (stage) {
-    case Stage::normal: return &contact.normal;
-    case Stage::damping: return &contact.damping;
-    case Stage::tangential: return &contact.tangential;
-    case Stage::rolling: return &contact.rolling;
-    case Stage::twisting: return &contact.twisting;
-    default: return static_cast<Choice*>(nullptr);
-  }
-}
-
 /// Whether `effect` could be added to the contact model: its stage is free and its normal
 /// model is there.
 bool stage_free(const ContactSpec& contact, const EffectSpec& effect) {
   if (!effect.requires_normal.empty() && contact.normal.model != effect.requires_normal) return false;
-  if (const auto* choices = additive_choices(contact, effect.stage))
+  if (const auto* choices = contact.additive(effect.stage))
     return std::none_of(choices->begin(), choices->end(), [&](const ContactSpec::Choice& c) {
       const EffectSpec* other = find_effect(effect.stage, c.model);
       return c.model == effect.name || (other && other->candidate);
     });
-  const ContactSpec::Choice* choice = single_choice(contact, effect.stage);
+  const ContactSpec::Choice* choice = contact.single(effect.stage);
   return choice && choice->model == "none";
 }
 
 EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale& scale) {
   const CandidateSpec& spec = *effect.candidate;
-  const std::string stage(kStageKeys[static_cast<int>(effect.stage)]);
+  const std::string stage(stage_name(effect.stage));
   EffectCandidate c;
   c.name = std::string(effect.name);
   c.title = std::string(spec.title);
@@ -244,8 +224,8 @@ EffectCandidate contact_candidate(const EffectSpec& effect, const ParticleScale&
   const Stage s = effect.stage;
   const std::string name(effect.name);
   c.add = [s, name](MaterialModel& m) {
-    if (auto* choices = additive_choices(m.contact, s)) choices->push_back(ContactSpec::Choice{name, {}, {}});
-    else *single_choice(m.contact, s) = ContactSpec::Choice{name, {}, {}};
+    if (auto* choices = m.contact.additive(s)) choices->push_back(ContactSpec::Choice{name, {}, {}});
+    else *m.contact.single(s) = ContactSpec::Choice{name, {}, {}};
   };
   return c;
 }

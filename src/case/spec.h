@@ -11,6 +11,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <array>
@@ -84,6 +85,9 @@ struct InteractionSpec {
   SourceLocation location;
 };
 
+/// The stages of a contact (contact/effect.h, kStageTable), declared here without the engine's headers.
+enum class Stage : std::uint8_t;
+
 /// The effects a case switches on, by stage, with their options.
 struct ContactSpec {
   struct Choice {
@@ -94,6 +98,17 @@ struct ContactSpec {
   Choice normal{"hertz", {}, {}}, damping{"restitution", {}, {}}, tangential{"mindlin", {}, {}}, rolling{"none", {}, {}},
       twisting{"none", {}, {}};
   std::vector<Choice> adhesion, extra;
+
+  // A field per stage of kStageTable (contact/effect.h); `single` and `additive` are the one place
+  // that maps a stage to its field, so code that walks the stages loops over kStages.
+  /// The choice of a single stage; nullptr for an additive one (stage_is_additive).
+  const Choice* single(Stage stage) const;
+  Choice* single(Stage stage) { return const_cast<Choice*>(std::as_const(*this).single(stage)); }
+  /// The list of an additive stage; nullptr for a single one.
+  const std::vector<Choice>* additive(Stage stage) const;
+  std::vector<Choice>* additive(Stage stage) { return const_cast<std::vector<Choice>*>(std::as_const(*this).additive(stage)); }
+  /// What the stage holds, in order: its single choice (also "none"), or each entry of its list.
+  std::vector<const Choice*> choices(Stage stage) const;
 };
 
 /// Particle diameters: fixed, or drawn from a truncated distribution.

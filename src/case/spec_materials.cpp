@@ -74,11 +74,69 @@ void check_choice(const ContactSpec::Choice& c, Stage stage, const std::string& 
   std::string list;
   for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
   throw CaseError(fmt::format("{}: {}: '{}' is not a {} model{}; valid: {}", c.location.str(), path, c.model,
-                              kStageKeys[static_cast<int>(stage)],
+                              stage_name(stage),
                               hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
 }
 
+/// `contact.STAGE: MODEL` of a single stage; an absent key keeps the default choice.
+void read_single_stage(MapReader& map, const std::string& file, Stage stage, ContactSpec::Choice& choice) {
+  const std::string key(stage_name(stage));
+  if (!map.has(key)) {
+    map.node(key);
+    return;
+  }
+  choice = read_choice(map.node(key), file, "contact." + key, map, key);
+  check_choice(choice, stage, "contact." + key);
+}
+
+/// `contact.STAGE: [MODEL, ...]` of an additive stage.
+void read_additive_stage(MapReader& map, const std::string& file, Stage stage, std::vector<ContactSpec::Choice>& out) {
+  const std::string key(stage_name(stage));
+  const YAML::Node list = map.node(key);
+  if (!list) return;
+  if (!list.IsSequence()) map.fail(key, "must be a list of models, e.g. [liquid_bridge]");
+  for (size_t k = 0; k < list.size(); ++k) {
+    const std::string path = fmt::format("contact.{}[{}]", key, k);
+    out.push_back(read_choice(list[k], file, path, map, key));
+    check_choice(out.back(), stage, path);
+  }
+}
+
 }  // namespace
+
+const ContactSpec::Choice* ContactSpec::single(Stage stage) const {
+  switch (stage) {
+    case Stage::normal: return &normal;
+    case Stage::damping: return &damping;
+    case Stage::tangential: return &tangential;
+    case Stage::rolling: return &rolling;
+    case Stage::twisting: return &twisting;
+    case Stage::adhesion:
+    case Stage::extra: return nullptr;
+  }
+  return nullptr;
+}
+
+const std::vector<ContactSpec::Choice>* ContactSpec::additive(Stage stage) const {
+  switch (stage) {
+    case Stage::adhesion: return &adhesion;
+    case Stage::extra: return &extra;
+    case Stage::normal:
+    case Stage::damping:
+    case Stage::tangential:
+    case Stage::rolling:
+    case Stage::twisting: return nullptr;
+  }
+  return nullptr;
+}
+
+std::vector<const ContactSpec::Choice*> ContactSpec::choices(Stage stage) const {
+  std::vector<const Choice*> out;
+  if (const Choice* one = single(stage)) out.push_back(one);
+  if (const std::vector<Choice>* list = additive(stage))
+    for (const Choice& c : *list) out.push_back(&c);
+  return out;
+}
 
 namespace spec_reading {
 
@@ -182,31 +240,10 @@ ContactSpec read_contact(const YAML::Node& node, const std::string& file) {
   ContactSpec contact;
   if (!node) return contact;
   MapReader map(node, file, "contact");
-  const std::pair<Stage, ContactSpec::Choice*> single[] = {{Stage::normal, &contact.normal},
-                                                           {Stage::damping, &contact.damping},
-                                                           {Stage::tangential, &contact.tangential},
-                                                           {Stage::rolling, &contact.rolling},
-                                                           {Stage::twisting, &contact.twisting}};
-  for (auto [stage, choice] : single) {
-    const std::string key(kStageKeys[static_cast<int>(stage)]);
-    if (!map.has(key)) {
-      map.node(key);
-      continue;
-    }
-    *choice = read_choice(map.node(key), file, "contact." + key, map, key);
-    check_choice(*choice, stage, "contact." + key);
-  }
-  for (Stage stage : {Stage::adhesion, Stage::extra}) {
-    const std::string key(kStageKeys[static_cast<int>(stage)]);
-    const YAML::Node list = map.node(key);
-    if (!list) continue;
-    if (!list.IsSequence()) map.fail(key, "must be a list of models, e.g. [liquid_bridge]");
-    auto& out = stage == Stage::adhesion ? contact.adhesion : contact.extra;
-    for (size_t k = 0; k < list.size(); ++k) {
-      const std::string path = fmt::format("contact.{}[{}]", key, k);
-      out.push_back(read_choice(list[k], file, path, map, key));
-      check_choice(out.back(), stage, path);
-    }
+  // Single stages, then the lists: of two mistakes, the one reported first stays the same.
+  for (const Stage stage : kStagesSingleFirst) {
+    if (stage_is_additive(stage)) read_additive_stage(map, file, stage, *contact.additive(stage));
+    else read_single_stage(map, file, stage, *contact.single(stage));
   }
   map.finish();
   return contact;

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -30,10 +31,59 @@ namespace dem {
 
 /// Order in which effects run at a contact. Later stages read what earlier ones wrote.
 enum class Stage : std::uint8_t { normal, damping, adhesion, tangential, rolling, twisting, extra };
-inline constexpr std::array<std::string_view, 7> kStageKeys = {
-    "normal", "damping", "adhesion", "tangential", "rolling", "twisting", "extra"};
+
+/// One stage: its key under `contact:` in YAML, and whether it takes any number of effects (a
+/// YAML list, "additive") rather than exactly one or none.
+struct StageRow {
+  Stage stage;
+  std::string_view key;
+  bool additive;
+};
+
+/// Every stage in running order, a row at its enumerator's place. The case reader, compile, the
+/// key reference and materials/ loop over it. A new stage is an enumerator above and a row here,
+/// plus the one thing that cannot derive from them: its field in ContactSpec (src/case/spec.h,
+/// returned by ContactSpec::single or ::additive; test Contact.EveryStageHasItsFieldInContactSpec).
+inline constexpr std::array<StageRow, 7> kStageTable = {{
+    {Stage::normal, "normal", false},
+    {Stage::damping, "damping", false},
+    {Stage::adhesion, "adhesion", true},
+    {Stage::tangential, "tangential", false},
+    {Stage::rolling, "rolling", false},
+    {Stage::twisting, "twisting", false},
+    {Stage::extra, "extra", true},
+}};
+static_assert(
+    [] {
+      for (std::size_t k = 0; k < kStageTable.size(); ++k)
+        if (static_cast<std::size_t>(kStageTable[k].stage) != k) return false;
+      return true;
+    }(),
+    "kStageTable: each stage's row sits at its enumerator's place, in running order");
+
+/// The stages in running order, for `for (Stage stage : kStages)`.
+inline constexpr std::array<Stage, kStageTable.size()> kStages = [] {
+  std::array<Stage, kStageTable.size()> stages{};
+  for (std::size_t k = 0; k < stages.size(); ++k) stages[k] = kStageTable[k].stage;
+  return stages;
+}();
+
+/// The stage's key under `contact:`, e.g. "tangential".
+inline constexpr std::string_view stage_name(Stage s) { return kStageTable[static_cast<std::size_t>(s)].key; }
 /// Stages that take any number of effects (a YAML list); the others take exactly one or none.
-inline constexpr bool stage_is_additive(Stage s) { return s == Stage::adhesion || s == Stage::extra; }
+inline constexpr bool stage_is_additive(Stage s) { return kStageTable[static_cast<std::size_t>(s)].additive; }
+
+/// The single stages, then the additive ones, each in running order: the order a case's
+/// `contact:` is read in (so which of two mistakes is reported first) and materials/ writes a
+/// contact model in (calibrated material files, the keys of stored simulations).
+inline constexpr std::array<Stage, kStages.size()> kStagesSingleFirst = [] {
+  std::array<Stage, kStages.size()> stages{};
+  std::size_t next = 0;
+  for (const bool additive : {false, true})
+    for (const Stage stage : kStages)
+      if (stage_is_additive(stage) == additive) stages[next++] = stage;
+  return stages;
+}();
 
 /// How a per-material parameter combines for a contact between two different materials.
 /// Explicit `interactions:` entries in a case override any rule.

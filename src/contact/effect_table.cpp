@@ -73,7 +73,7 @@ void register_effect(const EffectSpec* effect) {
     throw std::invalid_argument(fmt::format("effect '{}': a normal law must give its contact_time (the time step resolves it)", effect->name));
   if (find_effect(effect->stage, effect->name))
     throw std::invalid_argument(fmt::format("effect '{}': the {} stage already has an effect of that name", effect->name,
-                                            kStageKeys[static_cast<int>(effect->stage)]));
+                                            stage_name(effect->stage)));
   for (const ParamSpec& p : effect->params)
     if (const ParamSpec* known = find_param(p.key); known && !same_param(*known, p))
       throw std::invalid_argument(fmt::format("effect '{}': parameter '{}' is another effect's with a different definition; "

@@ -59,14 +59,14 @@ void add_effect(Model& model, const ContactSpec::Choice& choice, Stage stage, in
       std::string valid = "model";
       for (const auto& o : spec->options) valid += fmt::format(", {}", o.key);
       throw CaseError(fmt::format("{}: contact.{}.{}: unknown option of '{}'; valid: {}", choice.location.str(),
-                                  kStageKeys[static_cast<int>(stage)], key, spec->name, valid));
+                                  stage_name(stage), key, spec->name, valid));
     }
     const auto at = std::find(option->values.begin(), option->values.end(), value);
     if (at == option->values.end()) {
       std::string valid;
       for (const auto& v : option->values) valid += (valid.empty() ? "" : ", ") + std::string(v);
       throw CaseError(fmt::format("{}: contact.{}.{}: '{}' is not valid; valid: {}", choice.location.str(),
-                                  kStageKeys[static_cast<int>(stage)], key, value, valid));
+                                  stage_name(stage), key, value, valid));
     }
     active.options[option - spec->options.begin()] = static_cast<std::uint8_t>(at - option->values.begin());
   }
@@ -97,7 +97,7 @@ void note_unused(Model& model, const std::map<std::string, double>& params,
     std::string effect;
     for (const EffectSpec* e : effect_table())
       for (const ParamSpec& p : e->params)
-        if (p.key == key && effect.empty()) effect = fmt::format("contact.{}: {}", kStageKeys[static_cast<int>(e->stage)], e->name);
+        if (p.key == key && effect.empty()) effect = fmt::format("contact.{}: {}", stage_name(e->stage), e->name);
     model.notes.push_back(fmt::format("{}: {}.{} = {:g} has no effect: it belongs to {}, which this case does not switch on",
                                       where.at(key).str(), owner, key, value, effect));
   }
@@ -206,13 +206,8 @@ void switch_on_effects(const ContactSpec& c, Model& model) {
   int param_cursor = 2;  // columns 0, 1: E*, G*
   if (c.normal.model == "none")
     throw CaseError(fmt::format("{}: contact.normal: a normal force law is required (hertz or linear)", c.normal.location.str()));
-  add_effect(model, c.normal, Stage::normal, param_cursor);
-  add_effect(model, c.damping, Stage::damping, param_cursor);
-  for (const auto& a : c.adhesion) add_effect(model, a, Stage::adhesion, param_cursor);
-  add_effect(model, c.tangential, Stage::tangential, param_cursor);
-  add_effect(model, c.rolling, Stage::rolling, param_cursor);
-  add_effect(model, c.twisting, Stage::twisting, param_cursor);
-  for (const auto& e : c.extra) add_effect(model, e, Stage::extra, param_cursor);
+  for (const Stage stage : kStages)
+    for (const ContactSpec::Choice* choice : c.choices(stage)) add_effect(model, *choice, stage, param_cursor);
   model.pair_stride = param_cursor;
   for (const ActiveEffect& e : model.effects) {
     if (!e.spec->requires_normal.empty() && e.spec->requires_normal != c.normal.model)
@@ -664,7 +659,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
 std::string describe_effects() {
   std::string out;
   for (const EffectSpec* e : effect_table()) {
-    out += fmt::format("contact.{}: {}\n    {}\n    source: {}\n", kStageKeys[static_cast<int>(e->stage)], e->name,
+    out += fmt::format("contact.{}: {}\n    {}\n    source: {}\n", stage_name(e->stage), e->name,
                        e->summary, e->citation);
     for (const ParamSpec& p : e->params)
       out += fmt::format("    {:<26} [{}] default {:g}, range [{:g}, {:g}]{}: {}\n", p.key, p.unit, p.default_value,

@@ -139,7 +139,7 @@ std::string run_info(const Model& model, const RunOptions& options, std::uint64_
       model.hash, model.dt, model.mass_scaling, model.stiffness_scaling,
       model.advice.rayleigh_time, model.advice.contact_time);
   for (const ActiveEffect& e : model.effects)
-    out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", kStageKeys[static_cast<int>(e.spec->stage)],
+    out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", stage_name(e.spec->stage),
                        e.spec->name, e.spec->citation);
   out += "materials:\n";
   for (const Material& m : model.materials)
@@ -330,7 +330,7 @@ void print_setup(const Model& model, const State& state, std::ostream& log) {
              model.outlets.size(), omp_get_max_threads());
   std::string law;
   for (const ActiveEffect& e : model.effects)
-    law += fmt::format("{}{}: {}", law.empty() ? "" : ", ", kStageKeys[static_cast<int>(e.spec->stage)], e.spec->name);
+    law += fmt::format("{}{}: {}", law.empty() ? "" : ", ", stage_name(e.spec->stage), e.spec->name);
   fmt::print(log, "  contact law: {}\n", law);
   for (const ActiveEffect& e : model.effects) fmt::print(log, "    {}: {}\n", e.spec->name, e.spec->citation);
   fmt::print(log, "{}\n", model.advice.report);
