@@ -14,6 +14,7 @@
 #include <random>
 #include <sstream>
 
+#include "chute_liner_case.h"
 #include "case/spec.h"
 #include "core/model.h"
 #include "core/state.h"
@@ -143,24 +144,8 @@ TEST(BeltCapacity, BulkDensityStatedInAMaterialFile) {
 
 // ---- the run report's belts ---------------------------------------------------------------------
 
-// A liner, a gravel inlet of 2 kg/s and one outlet; gravel given inline (solid density 2600
-// kg/m^3, no stated bulk density).
-const char* kCase = R"(title: belt capacity test
-simulation: {duration: 4.0}
-materials:
-  gravel: {density: 2600, youngs_modulus: 5e7, restitution: 0.4, friction: 0.5}
-  steel: {density: 7800, youngs_modulus: 2e11, restitution: 0.4, friction: 0.4}
-contact: {normal: hertz, damping: restitution, tangential: mindlin}
-meshes:
-  - name: chute_liner
-    material: steel
-    vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
-    triangles: [[0, 1, 2], [0, 2, 3]]
-inlets:
-  - {name: feed, material: gravel, diameter: 0.01, mass_rate_kgs: 2.0, region: {min: [0, 0, 0.5], max: [0.5, 0.5, 0.8]}}
-outlets:
-  - {name: bin, region: {min: [-1, -1, -2], max: [2, 2, -0.5]}}
-)";
+// A flat two-triangle liner, an inlet of 2 kg/s and one outlet (tests/chute_liner_case.h).
+const std::string kCase = chute_liner_case("belt capacity test");
 
 /// A run whose outflow rises to 2 kg/s (7.2 t/h) with a load box on the receiving belt, whose
 /// design values give its speed 2.5 m/s, width 0.8 m and troughing 30 deg (no belt mesh: the

@@ -17,6 +17,7 @@
 #include <random>
 #include <sstream>
 
+#include "chute_liner_case.h"
 #include "case/liner_materials.h"
 #include "case/spec.h"
 #include "core/model.h"
@@ -36,23 +37,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A flat two-triangle liner, an inlet of 2 kg/s and one outlet.
-const char* kCase = R"(title: report test chute
-simulation: {duration: 4.0}
-materials:
-  gravel: {density: 2600, youngs_modulus: 5e7, restitution: 0.4, friction: 0.5}
-  steel: {density: 7800, youngs_modulus: 2e11, restitution: 0.4, friction: 0.4}
-contact: {normal: hertz, damping: restitution, tangential: mindlin}
-meshes:
-  - name: chute_liner
-    material: steel
-    vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
-    triangles: [[0, 1, 2], [0, 2, 3]]
-inlets:
-  - {name: feed, material: gravel, diameter: 0.01, mass_rate_kgs: 2.0, region: {min: [0, 0, 0.5], max: [0.5, 0.5, 0.8]}}
-outlets:
-  - {name: bin, region: {min: [-1, -1, -2], max: [2, 2, -0.5]}}
-)";
+// A flat two-triangle liner, an inlet of 2 kg/s and one outlet (tests/chute_liner_case.h).
+const std::string kCase = chute_liner_case("report test chute");
 
 std::string read(const fs::path& path) {
   std::ifstream in(path);
@@ -164,7 +150,7 @@ struct Fixture {
     input.model = &model;
     input.state = &state;
     input.case_path = "cases/report.yaml";
-    input.case_text = std::string(kCase) + "# see https://example.org <b>not bold</b>\n";
+    input.case_text = kCase + "# see https://example.org <b>not bold</b>\n";
     input.version = "test";
     input.wall_seconds = 12.5;
     input.records_from = 1.0;
@@ -316,7 +302,7 @@ particles:
 TEST(LinerLife, BadInputNamesTheKey) {
   const auto error_of = [](const std::string& wear) {
     try {
-      (void)compile(parse_case_text(std::string(kCase) + wear, "wear.yaml"));
+      (void)compile(parse_case_text(kCase + wear, "wear.yaml"));
     } catch (const CaseError& e) {
       return std::string(e.what());
     }
