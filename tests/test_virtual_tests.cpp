@@ -394,6 +394,44 @@ TEST(HopperDischarge, RateWithinBeverloosRangeAndASmallOrificeBlocks) {
   EXPECT_EQ(arch.observables.at("mass_flow_rate"), 0.0);
 }
 
+// A shrunk silo keeps its orifice and leaves on its flat floor no more of its bed than the full
+// silo does: the dead zone's wedge (any angle theta) holds pi tan(theta) integral_r^R 2 x (x - r)
+// dx, integrated here by Simpson's rule and held against the closed form; the shrunk bed's share
+// is at most two thirds of the full one's unless the fill is the full fill already. The lab file
+// of 6 mm beads (120 mm silo filled 100 mm) at size factor 0.5: 100 mm filled 100 mm over the
+// 40 mm orifice, 75 mm filled 64.0 mm over the 30 mm one (the wedge's ratio 0.4267 times 1.5).
+TEST(HopperDischarge, AShrunkSiloLeavesNoMoreOfItsBedOnTheFloor) {
+  const double R = 0.06, r = 0.015;
+  const int n = 2000;
+  double integral = 0;  // of 2 x (x - r) over [r, R], Simpson
+  for (int i = 0; i <= n; ++i) {
+    const double x = r + (R - r) * i / n, w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+    integral += w * 2 * x * (x - r);
+  }
+  integral *= (R - r) / (3.0 * n);
+  EXPECT_NEAR(detail::retained_wedge_per_height(R, r), integral / (R * R), 1e-12);
+
+  const detail::SiloSize wide = detail::shrunk_silo(0.12, 0.04, 0.10, 0.5), narrow = detail::shrunk_silo(0.12, 0.03, 0.10, 0.5);
+  EXPECT_NEAR(wide.diameter, 0.100, 1e-12);
+  EXPECT_NEAR(wide.fill, 0.100, 1e-12);
+  EXPECT_NEAR(narrow.diameter, 0.075, 1e-12);
+  EXPECT_NEAR(narrow.fill, 0.0640, 5e-5);
+  const detail::SiloSize same = detail::shrunk_silo(0.12, 0.03, 0.10, 1.0);
+  EXPECT_EQ(same.diameter, 0.12);
+  EXPECT_EQ(same.fill, 0.10);
+  for (const double scale : {0.3, 0.5, 0.7})
+    for (const double orifice : {0.02, 0.03, 0.04}) {
+      const detail::SiloSize s = detail::shrunk_silo(0.12, orifice, 0.10, scale);
+      const double full_share = detail::retained_wedge_per_height(0.06, 0.5 * orifice) / 0.10;
+      const double shrunk_share = detail::retained_wedge_per_height(0.5 * s.diameter, 0.5 * orifice) / s.fill;
+      EXPECT_GE(s.diameter, std::min(0.12, 2.5 * orifice) - 1e-12);
+      if (s.fill < 0.10) {
+        EXPECT_LE(shrunk_share, 2.0 / 3.0 * full_share * (1 + 1e-12)) << "scale " << scale << ", orifice " << orifice;
+      }
+      EXPECT_LE(shrunk_share, full_share) << "scale " << scale << ", orifice " << orifice;
+    }
+}
+
 // Simulations of a batch on two threads at once (CalibrationOptions::parallel, each simulation on
 // one OpenMP thread): the same outcomes, bit for bit, as one after the other, also for tests with
 // triangle meshes (the drum) and random packings (the cup), with two replicas each.

@@ -296,8 +296,8 @@ void DiagnosisRun::calibrate_as_it_is() {
 }
 
 /// A file whose diagnosis cannot meet the budget at full size, even with every reduction, is
-/// diagnosed on a shrunk apparatus (kShrunkSize: a lab file's 120 mm silo then discharges a fifth
-/// of its mass, a pass costs about a ninth), and so is one whose user asked for a size factor
+/// diagnosed on a shrunk apparatus (kShrunkSize: a lab file of 6 mm beads then holds about a third
+/// of its particles a pass, the silos keeping their orifices), and so is one whose user asked for a size factor
 /// (CalibrationOptions::correct_size), corrected to full size: the same packings of the
 /// model as it is are simulated shrunk, and each observation's shift (full-size mean minus shrunk
 /// mean, with the noise of both) is added to every later simulation at that size. The shift is

@@ -112,9 +112,9 @@ Drum read_drum(const SetupReader& read, const MaterialModel& model, const TestOp
   drum.radius = 0.5 * drum.diameter, drum.d50 = size.d50, drum.spacing = 1.05 * size.largest * size.bounding_factor;
   drum.omega = drum.rpm * 2 * std::numbers::pi / 60, drum.revolution = 60 / drum.rpm;
   // A periodic slice must span three neighbour cells of the engine (2 x largest radius + skin
-  // of half the smallest radius + interaction range, model.cpp's check); with 10 % for a
-  // bridge's or neck's reach. The angle is per unit depth, so a thicker slice changes only the
-  // count: a size factor never makes the drum invalid.
+  // of half the smallest radius + interaction range, model.cpp's check), with 10 % to spare;
+  // a contact law reaching further deepens it again (deepen_for_reach). The angle is per unit
+  // depth, so a thicker slice changes only the count: a size factor never makes the drum invalid.
   const double min_periodic_depth = 3.0 * 1.1 * (size.largest * size.bounding_factor + 0.25 * size.largest);
   drum.depth = drum.periodic ? std::max(drum.depth_asked, min_periodic_depth) : drum.depth_asked;
   if (drum.radius < 3 * drum.spacing)
@@ -148,6 +148,20 @@ CaseSpec drum_case(const MaterialModel& model, const TestOptions& options, const
   spec.simulation.domain_max = Vec3(radius + 0.01, 0.5 * depth + (periodic ? 0.0 : 0.01), radius + 0.01);
   spec.simulation.periodic[1] = periodic;
   return spec;
+}
+
+/// A periodic slice deep enough for the contact law's own reach: three neighbour cells of a trial
+/// compile (2 x largest radius + interaction range + skin, with 1.7 % to spare), as the shear cell
+/// sizes its period. read_drum's figure covers the spheres' contact; a liquid bridge's rupture
+/// distance or a JKR neck reaches further, and without this the drum refused such a candidate.
+void deepen_for_reach(const MaterialModel& model, const TestOptions& options, Drum& drum) {
+  Drum trial = drum;
+  trial.depth = 100 * drum.spacing;
+  CaseSpec spec = drum_case(model, options, trial);
+  const Vec3 corner(drum.spacing, drum.spacing, drum.spacing);
+  spec.particles.push_back(particle_box(model, 1, -corner, corner));
+  const Model probe = compile(spec);
+  drum.depth = std::max(drum.depth, 3.05 * (2 * probe.radius_max + probe.interaction_range + probe.skin));
 }
 
 /// The fill: the lowest sites of a jittered cubic lattice inside the drum, or a packing inlet
@@ -247,8 +261,9 @@ void report_angle(const Drum& drum, const DrumSamples& sum, SimulatedOutcome& ou
 SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
   const Clock clock;
   const SetupReader read(model, setup);
-  const Drum drum = read_drum(read, model, options);
+  Drum drum = read_drum(read, model, options);
   if (options.validate_only) return {};
+  if (drum.periodic) deepen_for_reach(model, options, drum);
 
   CaseSpec spec = drum_case(model, options, drum);
   const Fill fill = add_fill(model, options, drum, spec);

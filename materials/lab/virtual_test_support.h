@@ -128,4 +128,16 @@ SimulatedOutcome run_angle_of_repose_cylinder(const MaterialModel& model, const 
 SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
 SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
 
+/// hopper_discharge's flat floor: a dead zone rising at slope tan(theta) from the orifice's edge
+/// (radius r [m]) to the wall (radius R [m]) holds 2 pi tan(theta) (R^3/3 - r R^2/2 + r^3/6) of
+/// volume; over the bed's volume pi R^2 H this is tan(theta) / H times the figure returned [m],
+/// whatever the angle.
+double retained_wedge_per_height(double R, double r);
+/// The silo a size factor makes of one `silo_diameter` wide filled `fill_height` [m] over an
+/// orifice of `orifice_diameter` [m], which is never shrunk (lab_hopper_discharge.cpp says why).
+struct SiloSize {
+  double diameter = 0, fill = 0;  // [m]
+};
+SiloSize shrunk_silo(double silo_diameter, double orifice_diameter, double fill_height, double scale);
+
 }  // namespace dem::materials::detail
