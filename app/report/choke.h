@@ -7,7 +7,7 @@
 // interval, mean and standard error by batch means), over the mass the section would hold at the
 // material's poured bulk density rho: fill = m / (rho A L), A the section's free area
 // (choke_section_area_m2) and L the box's length along the flow (choke_section_length_m), both
-// design values of the generator (equipment/transfer_chute.cpp). Margin = 1 - fill. The profiles
+// design values of the generator (equipment/transfer_chute_sensors.cpp). Margin = 1 - fill. The profiles
 // come from the run's stream profile sensors (statistics/stream_profile.h), the same numbers as
 // its stream_profiles.csv; a bin's depth is its mean mass over rho, its width and the length.
 #pragma once
