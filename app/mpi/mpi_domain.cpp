@@ -1,14 +1,16 @@
+// The MPI transport of the domain decomposition (mpi_domain.h): the sends, receives, all-to-alls
+// and reductions that carry particles, ghosts, loads and sums between the ranks, around the
+// grid, cuts, owners and ghost sets of the engine (core/decomposition.h).
 #include "mpi/mpi_domain.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "case/spec.h"
+#include "core/decomposition.h"
 
 #ifdef DEMDESIGN_WITH_MPI
 #include <mpi.h>
@@ -18,15 +20,6 @@ namespace dem::app::mpi {
 
 #ifdef DEMDESIGN_WITH_MPI
 namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr int kHistogramBins = 4096;
-constexpr double kImbalance = 1.10;  ///< rebalance when the fullest rank holds 10 % above the mean
-/// ... and when the ranks have waited for the fullest, since the last rebalance, at least this many
-/// steps' worth of the mean rank's work (the sum over the steps of most / mean - 1): what moving
-/// the cuts costs (histograms, all-to-all migration, new ghosts), in steps. Without it a stream
-/// that keeps moving (an inlet feeding one rank) had its cuts moved at nearly every rebuild.
-constexpr double kRebalanceAfterSteps = 20;
 
 void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw std::runtime_error(fmt::format("MPI error in {} (code {})", what, code));
@@ -46,66 +39,6 @@ std::vector<int> offsets_of(const std::vector<int>& counts) {
   return out;
 }
 
-/// The 26 neighbour offsets of a box in the rank grid, in a fixed order (the message tags).
-struct Offset {
-  int d[3];
-  /// Lexicographically positive (z first): this rank receives that neighbour's particles as
-  /// ghosts and lists the pairs across their common faces, edges and corners; the neighbour
-  /// receives none of this rank's. Every pair across ranks is thus listed once.
-  bool upper() const { return d[2] > 0 || (d[2] == 0 && (d[1] > 0 || (d[1] == 0 && d[0] > 0))); }
-};
-std::vector<Offset> all_offsets() {
-  std::vector<Offset> out;
-  for (int z = -1; z <= 1; ++z)
-    for (int y = -1; y <= 1; ++y)
-      for (int x = -1; x <= 1; ++x)
-        if (x || y || z) out.push_back({{x, y, z}});
-  return out;
-}
-int index_of(const int d[3]) {  // into all_offsets()
-  const int k = (d[0] + 1) + 3 * (d[1] + 1) + 9 * (d[2] + 1);
-  return k < 13 ? k : k - 1;
-}
-
-/// Whether every box of the grid `n` is at least `narrowest` [m] wide along each cut axis
-/// (`periodic`: every box; otherwise the outer boxes reach to infinity).
-bool grid_fits(const std::array<int, 3>& n, const double extent[3], const bool periodic[3], double narrowest) {
-  for (int a = 0; a < 3; ++a) {
-    const int needed = periodic[a] ? n[a] : std::max(n[a] - 2, 0);
-    if (n[a] > 1 && extent[a] < needed * narrowest) return false;
-  }
-  return true;
-}
-
-/// A rank grid for `ranks` over boxes of `extent` [m] (per axis, a score: the axis of gravity
-/// counts half), each cut axis at least `narrowest` [m] a box (`periodic`: every box; otherwise
-/// the outer boxes reach to infinity): the factorisation whose busiest box shares the least face
-/// area with its neighbours, and of equal ones the one with fewer cut axes (fewer neighbours,
-/// fewer messages); {0, 0, 0} when none fits.
-std::array<int, 3> choose_grid(int ranks, const double extent[3], const bool periodic[3], double narrowest) {
-  std::array<int, 3> best{0, 0, 0};
-  double least = kInfinity;
-  int fewest = 4;
-  for (int nx = 1; nx <= ranks; ++nx) {
-    if (ranks % nx) continue;
-    for (int ny = 1; ny <= ranks / nx; ++ny) {
-      if ((ranks / nx) % ny) continue;
-      const std::array<int, 3> n{nx, ny, ranks / nx / ny};
-      if (!grid_fits(n, extent, periodic, narrowest)) continue;
-      double box[3], area = 0;
-      int cut = 0;
-      for (int a = 0; a < 3; ++a) box[a] = std::max(extent[a], narrowest) / n[a];
-      for (int a = 0; a < 3; ++a) {
-        if (n[a] == 1) continue;
-        const int faces = periodic[a] || n[a] > 2 ? 2 : 1;  // of an interior box
-        area += faces * box[(a + 1) % 3] * box[(a + 2) % 3], ++cut;
-      }
-      if (area < least * (1 - 1e-9) || (area <= least * (1 + 1e-9) && cut < fewest)) least = area, fewest = cut, best = n;
-    }
-  }
-  return best;
-}
-
 class MpiDomain final : public Domain {
  public:
   MpiDomain(const Model& model, const State& initial, const std::array<int, 3>& requested, bool neighbour_migration, Balance balance)
@@ -114,93 +47,17 @@ class MpiDomain final : public Domain {
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
     if (model.has_attached)
       throw CaseError(fmt::format("{}: the split into subdomains does not take spheres glued to walls (a shear cell)", model.source));
-    // A clump belongs to the rank of its centre; its spheres reach `sticking_out_` beyond it,
-    // so the ghost layer and the boxes are that much deeper.
-    for (size_t p = 0; p < initial.size(); ++p)
-      if (initial.body[p] >= 0)
-        sticking_out_ = std::max(sticking_out_, std::sqrt(initial.offset_x[p] * initial.offset_x[p] + initial.offset_y[p] * initial.offset_y[p] +
-                                                          initial.offset_z[p] * initial.offset_z[p]));
-    for (const Inlet& inlet : model.inlets)
-      if (inlet.clump >= 0)
-        sticking_out_ = std::max(sticking_out_, model.clumps[inlet.clump].bounding_radius * inlet.spec.diameter.largest());
-    double radius_max = model.radius_max;
-    for (double r : initial.radius) radius_max = std::max(radius_max, r);
-    reach_ = 2.0 * radius_max + model.interaction_range + model.skin + sticking_out_;
-    box_min_ = reach_ + sticking_out_;
-    // How far the particles (and the domain box) spread along each axis.
-    double extent[3] = {0, 0, 0}, score[3];
-    bool periodic[3];
-    for (int a = 0; a < 3; ++a) {
-      const std::vector<double>& c = column(initial, a);
-      if (!c.empty()) extent[a] = *std::max_element(c.begin(), c.end()) - *std::min_element(c.begin(), c.end());
-      if (model.has_domain) extent[a] = std::max(extent[a], model.domain_max[a] - model.domain_min[a]);
-      periodic[a] = model.period[a] > 0;
-      if (periodic[a]) extent[a] = model.period[a];
-      score[a] = extent[a];
-    }
-    // Particles travel along gravity (they settle, fall down chutes): cuts across it would see
-    // most particles migrate and the balance shift all the time, so that axis counts half.
-    const double g[3] = {std::abs(model.gravity[0]), std::abs(model.gravity[1]), std::abs(model.gravity[2])};
-    const int down = static_cast<int>(std::max_element(g, g + 3) - g);
-    if (g[down] > 0) score[down] *= 0.5;
-    std::array<int, 3> grid = choose_grid(size_, score, periodic, box_min_);
-    if (requested[0] > 0) {
-      if (requested[0] * requested[1] * requested[2] != size_)
-        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} has {} boxes, not the {} ranks running", model.source, requested[0], requested[1],
-                                    requested[2], requested[0] * requested[1] * requested[2], size_));
-      if (!grid_fits(requested, extent, periodic, box_min_))
-        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} makes boxes narrower than one pair reach ({:.4g} m) in a domain of {:.4g} x "
-                                    "{:.4g} x {:.4g} m",
-                                    model.source, requested[0], requested[1], requested[2], box_min_, extent[0], extent[1], extent[2]));
-      grid = requested;
-    }
-    if (grid[0] == 0)
-      throw CaseError(fmt::format("{}: {} ranks cannot share a domain of {:.4g} x {:.4g} x {:.4g} m (each box at least one pair reach, {:.4g} m, "
-                                  "wide along every axis it is cut across), so fewer ranks would split it",
-                                  model.source, size_, extent[0], extent[1], extent[2], box_min_));
-    int rest = rank_;
-    for (int a = 0; a < 3; ++a) {
-      dims_[a] = grid[a];
-      coord_[a] = rest % dims_[a], rest /= dims_[a];
-      periodic_[a] = periodic[a] && dims_[a] > 1;
-      period_[a] = model.period[a];
-      low_[a] = model.domain_min[a];
-      if (periodic_[a]) local_.period[a] = 0.0;  // the ranks carry the period across their faces
-    }
-    // The neighbours: the offsets whose box exists (an axis not cut has none; a non-periodic
-    // axis none beyond its outer boxes), with the shift a particle sent there takes.
-    for (const Offset& o : all_offsets()) {
-      Neighbour n{o, 0, {0, 0, 0}};
-      int at[3];
-      bool exists = true;
-      for (int a = 0; a < 3 && exists; ++a) {
-        at[a] = coord_[a] + o.d[a];
-        if (o.d[a] != 0 && dims_[a] == 1) exists = false;
-        else if (at[a] < 0 || at[a] >= dims_[a]) {
-          if (!periodic_[a]) exists = false;
-          n.shift[a] = at[a] < 0 ? period_[a] : -period_[a];  // what I send there is seen one period on
-          at[a] = (at[a] + dims_[a]) % dims_[a];
-        }
-      }
-      if (!exists) continue;
-      n.rank = rank_of(at);
-      (o.upper() ? from_ : to_).push_back(n);
-      if (n.rank != rank_) near_.push_back(n.rank);
-    }
-    std::sort(near_.begin(), near_.end());
-    near_.erase(std::unique(near_.begin(), near_.end()), near_.end());
+    const GhostReach depth = ghost_reach(model, initial);
+    reach_ = depth.reach;
+    grid_ = box_grid(grid_for(model, initial, requested, depth.box_min), model, depth.box_min);
+    grid_.place_of(rank_, coord_);
+    clear_cut_periods(grid_, local_);
+    const Neighbourhood around = grid_.neighbourhood(coord_);
+    for (const NeighbourBox& n : around.lower) to_.emplace_back(n);
+    for (const NeighbourBox& n : around.upper) from_.emplace_back(n);
+    near_ = around.near;
     // First cuts from the initial particles (the same on every rank), or evenly over the box.
-    for (int a = 0; a < 3; ++a) {
-      std::vector<double> coords;
-      for (size_t p = 0; p < initial.size(); ++p) coords.push_back(wrapped(owner_coordinate(initial, p, a), a));
-      std::sort(coords.begin(), coords.end());
-      cuts_[a].assign(dims_[a] - 1, 0.0);
-      const double lo = periodic_[a] ? low_[a] : model.has_domain ? model.domain_min[a] : coords.empty() ? 0.0 : coords.front();
-      const double hi = periodic_[a] ? low_[a] + period_[a] : model.has_domain ? model.domain_max[a] : coords.empty() ? 1.0 : coords.back();
-      for (int k = 1; k < dims_[a]; ++k)
-        cuts_[a][k - 1] = coords.size() >= static_cast<size_t>(dims_[a]) ? coords[coords.size() * k / dims_[a]] : lo + (hi - lo) * k / dims_[a];
-      keep_boxes_wide(a);
-    }
+    first_cuts(grid_, model, initial);
   }
 
   const Model& local_model() const override { return local_; }
@@ -235,7 +92,7 @@ class MpiDomain final : public Domain {
 
   bool owns(double x, double y, double z) const override {
     const double at[3] = {x, y, z};
-    return owner(at) == rank_;
+    return grid_.owner(at) == rank_;
   }
 
   std::vector<std::array<double, 4>> particles_in(const State& s, const double lo[3], const double hi[3]) override {
@@ -256,151 +113,24 @@ class MpiDomain final : public Domain {
     Timed timed{rebuild_seconds_};
     pairs.append(pending_pairs_), walls.append(pending_walls_);
     pending_pairs_ = {}, pending_walls_ = {};
-    wrap_periodic_axes(s);
+    wrap_periodic_axes(grid_, s);
     const bool cuts_moved = rebalance(s, pairs, walls);
     const int width = model.history_width;
-    const size_t n = s.size(), record = s.record_size();
-    // Where each body goes (-1: stays), then free spheres and bodies with their spheres.
-    std::vector<int> body_to(s.bodies.size(), -1);
-    for (size_t b = 0; b < s.bodies.size(); ++b) {
-      const double at[3] = {s.bodies.x[b], s.bodies.y[b], s.bodies.z[b]};
-      if (owner(at) != rank_) body_to[b] = owner(at);
-    }
-    std::unordered_map<std::int64_t, int> leaving;  // sphere id -> new owner
-    std::vector<std::uint8_t> keep(n, 1);
-    std::vector<std::vector<double>> spheres(size_), clumps(size_);
-    std::vector<int> spheres_to(size_, 0), bodies_to(size_, 0), pair_rows_to(size_, 0), wall_rows_to(size_, 0);
-    std::vector<std::vector<std::int32_t>> members(s.bodies.size());
-    for (size_t p = 0; p < n; ++p) {
-      const std::int32_t b = s.body[p];
-      const double at[3] = {s.x[p], s.y[p], s.z[p]};
-      const int to = b >= 0 ? body_to[b] : owner(at);
-      if (to < 0 || to == rank_) continue;
-      keep[p] = 0;
-      leaving[s.id[p]] = to;
-      if (b >= 0) {
-        members[b].push_back(static_cast<std::int32_t>(p));
-      } else {
-        s.pack(p, spheres[to]);
-        ++spheres_to[to];
-      }
-    }
-    for (size_t b = 0; b < s.bodies.size(); ++b) {
-      const int to = body_to[b];
-      if (to < 0) continue;
-      s.pack_body(b, clumps[to]);
-      clumps[to].push_back(static_cast<double>(members[b].size()));
-      for (const std::int32_t p : members[b]) s.pack(p, clumps[to]);
-      ++bodies_to[to];
-    }
-    // Every history of a leaving sphere goes with it (the new owner lists the pairs it now
-    // evaluates and ignores the rest).
-    std::vector<std::vector<double>> pair_rows(size_), wall_rows(size_);
-    auto add_rows = [&](const HistoryRows& rows, bool wall_rows_only_a, std::vector<std::vector<double>>& out, std::vector<int>& count) {
-      for (size_t q = 0; q < rows.size() && width > 0; ++q) {
-        auto it = leaving.find(rows.a[q]);
-        if (it == leaving.end() && !wall_rows_only_a) it = leaving.find(rows.b[q]);
-        if (it == leaving.end()) continue;
-        rows.pack(q, width, out[it->second]);
-        ++count[it->second];
-      }
-    };
-    if (!leaving.empty()) {
-      add_rows(pairs, false, pair_rows, pair_rows_to);
-      add_rows(walls, true, wall_rows, wall_rows_to);
-    }
-    // Per destination: free spheres, clumps (body, count, spheres), pair histories, wall
-    // histories, in one message with its counts. A particle that left its box since the last
-    // rebuild is in a neighbour's, so the messages go to the neighbours alone; all to all
-    // (counts, then the doubles) after the cuts moved, or when some rank has a particle bound
-    // beyond its neighbours. Either way the parts arrive in rank order: the same state.
-    constexpr int kCounts = 5;
-    const auto message_to = [&](int r) {
-      std::vector<double> m;
-      for (const auto* part : {&spheres[r], &clumps[r], &pair_rows[r], &wall_rows[r]}) m.insert(m.end(), part->begin(), part->end());
-      return m;
-    };
-    const auto counts_to = [&](int r, size_t doubles) {
-      return std::array<int, kCounts>{spheres_to[r], bodies_to[r], pair_rows_to[r], wall_rows_to[r], static_cast<int>(doubles)};
-    };
+    const size_t record = s.record_size();
+    const Parcels parcels = pack_parcels(s, departures(grid_, s, rank_), pairs, walls, width);
+    // A particle that left its box since the last rebuild is in a neighbour's, so the parcels go
+    // to the neighbours alone; all to all (counts, then the doubles) after the cuts moved, or when
+    // some rank has a particle bound beyond its neighbours. Either way the parts arrive in rank
+    // order: the same state.
     int far = 0;
-    for (const auto& [id, to] : leaving) far = far || !std::binary_search(near_.begin(), near_.end(), to);
+    for (const auto& [id, to] : parcels.leaving) far = far || !std::binary_search(near_.begin(), near_.end(), to);
     int anywhere = far;
     check(MPI_Allreduce(&far, &anywhere, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD), "MPI_Allreduce");
-    std::vector<std::vector<double>> arrived;  // per source, in rank order
-    std::vector<std::array<int, kCounts>> in_counts;
-    size_t sent = 0;
-    if (!neighbour_migration_ || cuts_moved || anywhere) {
-      std::vector<int> counts_out(kCounts * size_), counts_in(kCounts * size_);
-      std::vector<double> send;
-      std::vector<int> send_sizes(size_), receive_sizes(size_);
-      for (int r = 0; r < size_; ++r) {
-        const std::vector<double> m = message_to(r);
-        send.insert(send.end(), m.begin(), m.end());
-        send_sizes[r] = static_cast<int>(m.size());
-        const std::array<int, kCounts> c = counts_to(r, m.size());
-        std::copy(c.begin(), c.end(), counts_out.begin() + kCounts * r);
-      }
-      check(MPI_Alltoall(counts_out.data(), kCounts, MPI_INT, counts_in.data(), kCounts, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
-      for (int r = 0; r < size_; ++r) receive_sizes[r] = counts_in[kCounts * r + 4];
-      const std::vector<int> send_at = offsets_of(send_sizes), receive_at = offsets_of(receive_sizes);
-      std::vector<double> received(static_cast<size_t>(receive_at.back()));
-      check(MPI_Alltoallv(send.data(), send_sizes.data(), send_at.data(), MPI_DOUBLE, received.data(), receive_sizes.data(),
-                          receive_at.data(), MPI_DOUBLE, MPI_COMM_WORLD),
-            "MPI_Alltoallv");
-      for (int r = 0; r < size_; ++r) {
-        arrived.emplace_back(received.begin() + receive_at[r], received.begin() + receive_at[r + 1]);
-        in_counts.emplace_back();
-        std::copy(counts_in.begin() + kCounts * r, counts_in.begin() + kCounts * (r + 1), in_counts.back().begin());
-      }
-      sent = send.size();
-      ++migrations_all_;
-    } else {
-      const size_t m = near_.size();
-      std::vector<std::vector<double>> out(m);
-      std::vector<std::array<int, kCounts>> out_counts(m);
-      arrived.resize(m), in_counts.resize(m);
-      for (size_t k = 0; k < m; ++k) out[k] = message_to(near_[k]), out_counts[k] = counts_to(near_[k], out[k].size()), sent += out[k].size();
-      requests_.clear();
-      for (size_t k = 0; k < m; ++k) {
-        requests_.emplace_back();
-        check(MPI_Irecv(in_counts[k].data(), kCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
-        requests_.emplace_back();
-        check(MPI_Isend(out_counts[k].data(), kCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Isend");
-      }
-      check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
-      requests_.clear();
-      for (size_t k = 0; k < m; ++k) {
-        arrived[k].resize(static_cast<size_t>(in_counts[k][4]));
-        requests_.emplace_back();
-        check(MPI_Irecv(arrived[k].data(), in_counts[k][4], MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
-        requests_.emplace_back();
-        check(MPI_Isend(out[k].data(), static_cast<int>(out[k].size()), MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD,
-                        &requests_.back()),
-              "MPI_Isend");
-      }
-      check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
-      ++migrations_near_;
-    }
-    s.compact(keep);  // also drops the bodies that left with all their spheres
-    for (size_t source = 0; source < arrived.size(); ++source) {
-      const double* in = arrived[source].data();
-      const int* count = in_counts[source].data();
-      for (int k = 0; k < count[0]; ++k, in += record) s.unpack(in);
-      for (int k = 0; k < count[1]; ++k) {
-        const std::int32_t b = static_cast<std::int32_t>(s.unpack_body(in));
-        in += State::kBodyRecord;
-        const int spheres_in_body = static_cast<int>(*in++);
-        for (int q = 0; q < spheres_in_body; ++q, in += record) {
-          s.unpack(in);
-          s.body.back() = b;
-        }
-      }
-      in = pairs.unpack(in, static_cast<size_t>(count[2]), width);
-      walls.unpack(in, static_cast<size_t>(count[3]), width);
-    }
-    migrated_ += static_cast<std::int64_t>(leaving.size());
-    bytes_ += 8.0 * static_cast<double>(sent);
+    const Arrivals arrived = !neighbour_migration_ || cuts_moved || anywhere ? send_all_to_all(parcels) : send_to_neighbours(parcels);
+    s.compact(parcels.keep);  // also drops the bodies that left with all their spheres
+    unpack_arrivals(arrived, record, width, s, pairs, walls);
+    migrated_ += static_cast<std::int64_t>(parcels.leaving.size());
+    bytes_ += 8.0 * static_cast<double>(arrived.sent);
   }
 
   void make_ghosts(const Model&, State& s) override {
@@ -408,20 +138,12 @@ class MpiDomain final : public Domain {
     // To each lower neighbour, the owned particles within one reach of the faces, edges or
     // corner this box shares with it, shifted by a period where the grid wraps.
     double lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) lo[a] = box_low(a), hi[a] = box_high(a);
+    for (int a = 0; a < 3; ++a) lo[a] = grid_.box_low(coord_, a), hi[a] = grid_.box_high(coord_, a);
     const int record = static_cast<int>(s.record_size());
-    const size_t owned = s.owned();
     std::vector<std::vector<double>> out(to_.size());
     for (size_t k = 0; k < to_.size(); ++k) {
       Neighbour& n = to_[k];
-      n.slots.clear();
-      for (size_t p = 0; p < owned; ++p) {
-        const double at[3] = {s.x[p], s.y[p], s.z[p]};
-        bool near = true;
-        for (int a = 0; a < 3 && near; ++a)
-          near = n.offset.d[a] == 0 || (n.offset.d[a] < 0 ? at[a] < lo[a] + reach_ : at[a] > hi[a] - reach_);
-        if (near) n.slots.push_back(static_cast<std::int32_t>(p));
-      }
+      ghost_slots(s, n.offset, lo, hi, reach_, n.slots);
       out[k].reserve(n.slots.size() * record);
       for (const std::int32_t p : n.slots) {
         const size_t at = out[k].size();
@@ -506,10 +228,10 @@ class MpiDomain final : public Domain {
   void distribute(State& s) override {
     const int width = local_.history_width;
     std::vector<std::uint8_t> keep(s.size(), 0);
-    wrap_periodic_axes(s);
+    wrap_periodic_axes(grid_, s);
     for (size_t p = 0; p < s.size(); ++p) {
       const double at[3] = {owner_coordinate(s, p, 0), owner_coordinate(s, p, 1), owner_coordinate(s, p, 2)};
-      keep[p] = owner(at) == rank_;
+      keep[p] = grid_.owner(at) == rank_;
     }
     // Histories of a checkpoint: kept (by ids) for the first rebuild, where a pair with a
     // particle of another rank finds its partner among the ghosts.
@@ -552,136 +274,231 @@ class MpiDomain final : public Domain {
   std::string describe() const {
     std::string cuts;
     for (int a = 0; a < 3; ++a) {
-      if (cuts_[a].empty()) continue;
+      if (grid_.cuts[a].empty()) continue;
       std::string at;
-      for (double c : cuts_[a]) at += fmt::format("{}{:.4g}", at.empty() ? "" : ", ", c);
-      cuts += fmt::format("{}{} at {} m{}", cuts.empty() ? "" : "; ", "xyz"[a], at, periodic_[a] ? " across the period" : "");
+      for (double c : grid_.cuts[a]) at += fmt::format("{}{:.4g}", at.empty() ? "" : ", ", c);
+      cuts += fmt::format("{}{} at {} m{}", cuts.empty() ? "" : "; ", "xyz"[a], at, grid_.periodic[a] ? " across the period" : "");
     }
-    return fmt::format("{} ranks as a {} x {} x {} grid of boxes (cuts: {}), ghost reach {:.3g} m, balanced by {}", size_, dims_[0], dims_[1], dims_[2],
-                       cuts, reach_, balance_ == Balance::time ? "measured time" : "particles and contacts");
+    return fmt::format("{} ranks as a {} x {} x {} grid of boxes (cuts: {}), ghost reach {:.3g} m, balanced by {}", size_, grid_.dims[0], grid_.dims[1],
+                       grid_.dims[2], cuts, reach_, balance_ == Balance::time ? "measured time" : "particles and contacts");
   }
 
  private:
-  /// A box next to this one: its rank, where it lies, the shift [m] of what is sent to it, and
-  /// what is sent (to a lower neighbour: owned slots, in message order) or received (from an
-  /// upper one: the ghost count, the ghosts in the order of from_).
   /// Message kinds of a migration between neighbours (tags 32 x kind; 1-4 are the ghosts').
   static constexpr int kMigrationCounts = 5, kMigrationData = 6;
 
-  struct Neighbour {
-    Offset offset;
-    int rank = MPI_PROC_NULL;
-    double shift[3] = {0, 0, 0};
+  /// A box next to this one (where it lies, its rank, the shift [m] of what is sent to it), and
+  /// what is sent (to a lower neighbour: owned slots, in message order) or received (from an
+  /// upper one: the ghost count, the ghosts in the order of from_).
+  struct Neighbour : NeighbourBox {
+    explicit Neighbour(const NeighbourBox& box) : NeighbourBox(box) {}
     std::vector<std::int32_t> slots;
     int count = 0;
   };
 
-  static std::vector<double>& column(State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
-  static const std::vector<double>& column(const State& s, int a) { return a == 0 ? s.x : a == 1 ? s.y : s.z; }
-  static std::vector<double>& body_column(State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
-  static const std::vector<double>& body_column(const State& s, int a) { return a == 0 ? s.bodies.x : a == 1 ? s.bodies.y : s.bodies.z; }
+  /// What a rank sends each rank at a migration (per destination rank): free spheres, clumps
+  /// (body, sphere count, spheres), pair histories, wall histories, in one message with its
+  /// counts (kParcelCounts: the four, then the message's doubles).
+  static constexpr int kParcelCounts = 5;
+  struct Parcels {
+    Parcels(int destinations, size_t n)
+        : spheres(destinations), clumps(destinations), pair_rows(destinations), wall_rows(destinations), spheres_to(destinations, 0),
+          bodies_to(destinations, 0), pair_rows_to(destinations, 0), wall_rows_to(destinations, 0), keep(n, 1) {}
+    std::vector<std::vector<double>> spheres, clumps, pair_rows, wall_rows;
+    std::vector<int> spheres_to, bodies_to, pair_rows_to, wall_rows_to;
+    std::unordered_map<std::int64_t, int> leaving;  // sphere id -> new owner
+    std::vector<std::uint8_t> keep;                 // (n) 0: the slot leaves
+    std::vector<double> message_to(int r) const {
+      std::vector<double> m;
+      for (const auto* part : {&spheres[r], &clumps[r], &pair_rows[r], &wall_rows[r]}) m.insert(m.end(), part->begin(), part->end());
+      return m;
+    }
+    std::array<int, kParcelCounts> counts_to(int r, size_t doubles) const {
+      return {spheres_to[r], bodies_to[r], pair_rows_to[r], wall_rows_to[r], static_cast<int>(doubles)};
+    }
+  };
+  /// What arrived at a migration, per source (in rank order, or in the order of near_), with its
+  /// counts; and the doubles this rank sent.
+  struct Arrivals {
+    std::vector<std::vector<double>> data;
+    std::vector<std::array<int, kParcelCounts>> counts;
+    size_t sent = 0;
+  };
 
-  int rank_of(const int at[3]) const { return at[0] + dims_[0] * (at[1] + dims_[1] * at[2]); }
-  /// Where a sphere belongs along axis a: its own centre, or its clump's.
-  double owner_coordinate(const State& s, size_t p, int a) const { return s.body[p] >= 0 ? body_column(s, a)[s.body[p]] : column(s, a)[p]; }
-  /// Free spheres and clump centres back into the period along every periodic axis the grid cuts
-  /// (a clump's spheres move with its centre).
-  void wrap_periodic_axes(State& s) const {
-    for (int a = 0; a < 3; ++a) {
-      if (!periodic_[a]) continue;
-      std::vector<double>& c = column(s, a);
-      std::vector<double>& centre = body_column(s, a);
-      std::vector<double> shift(centre.size());
-      for (size_t b = 0; b < centre.size(); ++b) shift[b] = wrapped(centre[b], a) - centre[b], centre[b] += shift[b];
-      for (size_t p = 0; p < s.size(); ++p) c[p] = s.body[p] >= 0 ? c[p] + shift[s.body[p]] : wrapped(c[p], a);
+  /// The particles leaving (`away`) packed per destination: free spheres, then each clump with
+  /// its spheres, then every history of a leaving sphere (the new owner lists the pairs it now
+  /// evaluates and ignores the rest).
+  Parcels pack_parcels(const State& s, const Departures& away, const HistoryRows& pairs, const HistoryRows& walls, int width) const {
+    Parcels out(size_, s.size());
+    std::vector<std::vector<std::int32_t>> members(s.bodies.size());
+    for (size_t p = 0; p < s.size(); ++p) {
+      const int to = away.slot_to[p];
+      if (to < 0) continue;
+      const std::int32_t b = s.body[p];
+      out.keep[p] = 0;
+      out.leaving[s.id[p]] = to;
+      if (b >= 0) {
+        members[b].push_back(static_cast<std::int32_t>(p));
+      } else {
+        s.pack(p, out.spheres[to]);
+        ++out.spheres_to[to];
+      }
+    }
+    for (size_t b = 0; b < s.bodies.size(); ++b) {
+      const int to = away.body_to[b];
+      if (to < 0) continue;
+      s.pack_body(b, out.clumps[to]);
+      out.clumps[to].push_back(static_cast<double>(members[b].size()));
+      for (const std::int32_t p : members[b]) s.pack(p, out.clumps[to]);
+      ++out.bodies_to[to];
+    }
+    if (!out.leaving.empty()) {
+      pack_rows(pairs, false, width, out.leaving, out.pair_rows, out.pair_rows_to);
+      pack_rows(walls, true, width, out.leaving, out.wall_rows, out.wall_rows_to);
+    }
+    return out;
+  }
+  /// The history rows of leaving spheres, to their new owners (`wall_rows`: b is a wall, not a sphere).
+  static void pack_rows(const HistoryRows& rows, bool wall_rows, int width, const std::unordered_map<std::int64_t, int>& leaving,
+                        std::vector<std::vector<double>>& out, std::vector<int>& count) {
+    for (size_t q = 0; q < rows.size() && width > 0; ++q) {
+      auto it = leaving.find(rows.a[q]);
+      if (it == leaving.end() && !wall_rows) it = leaving.find(rows.b[q]);
+      if (it == leaving.end()) continue;
+      rows.pack(q, width, out[it->second]);
+      ++count[it->second];
     }
   }
-  double wrapped(double c, int a) const { return periodic_[a] ? c - period_[a] * std::floor((c - low_[a]) / period_[a]) : c; }
-  int slot_along(double c, int a) const { return static_cast<int>(std::upper_bound(cuts_[a].begin(), cuts_[a].end(), wrapped(c, a)) - cuts_[a].begin()); }
-  int owner(const double at[3]) const {
-    const int slot[3] = {slot_along(at[0], 0), slot_along(at[1], 1), slot_along(at[2], 2)};
-    return rank_of(slot);
-  }
-  double box_low(int a) const { return coord_[a] > 0 ? cuts_[a][coord_[a] - 1] : periodic_[a] ? low_[a] : -kInfinity; }
-  double box_high(int a) const {
-    return coord_[a] < dims_[a] - 1 ? cuts_[a][coord_[a]] : periodic_[a] ? low_[a] + period_[a] : kInfinity;
+
+  /// Every rank's parcel to every rank: the counts all to all, then the doubles (collective).
+  Arrivals send_all_to_all(const Parcels& parcels) {
+    Arrivals in;
+    std::vector<int> counts_out(kParcelCounts * size_), counts_in(kParcelCounts * size_);
+    std::vector<double> send;
+    std::vector<int> send_sizes(size_), receive_sizes(size_);
+    for (int r = 0; r < size_; ++r) {
+      const std::vector<double> m = parcels.message_to(r);
+      send.insert(send.end(), m.begin(), m.end());
+      send_sizes[r] = static_cast<int>(m.size());
+      const std::array<int, kParcelCounts> c = parcels.counts_to(r, m.size());
+      std::copy(c.begin(), c.end(), counts_out.begin() + kParcelCounts * r);
+    }
+    check(MPI_Alltoall(counts_out.data(), kParcelCounts, MPI_INT, counts_in.data(), kParcelCounts, MPI_INT, MPI_COMM_WORLD), "MPI_Alltoall");
+    for (int r = 0; r < size_; ++r) receive_sizes[r] = counts_in[kParcelCounts * r + 4];
+    const std::vector<int> send_at = offsets_of(send_sizes), receive_at = offsets_of(receive_sizes);
+    std::vector<double> received(static_cast<size_t>(receive_at.back()));
+    check(MPI_Alltoallv(send.data(), send_sizes.data(), send_at.data(), MPI_DOUBLE, received.data(), receive_sizes.data(), receive_at.data(),
+                        MPI_DOUBLE, MPI_COMM_WORLD),
+          "MPI_Alltoallv");
+    for (int r = 0; r < size_; ++r) {
+      in.data.emplace_back(received.begin() + receive_at[r], received.begin() + receive_at[r + 1]);
+      in.counts.emplace_back();
+      std::copy(counts_in.begin() + kParcelCounts * r, counts_in.begin() + kParcelCounts * (r + 1), in.counts.back().begin());
+    }
+    in.sent = send.size();
+    ++migrations_all_;
+    return in;
   }
 
-  /// Interior boxes along axis a (all boxes of a periodic axis) at least one reach wide.
-  void keep_boxes_wide(int a) {
-    std::vector<double>& cuts = cuts_[a];
-    const int n = static_cast<int>(cuts.size());
-    if (n == 0) return;
-    if (periodic_[a]) cuts[0] = std::max(cuts[0], low_[a] + box_min_);
-    for (int k = 1; k < n; ++k) cuts[k] = std::max(cuts[k], cuts[k - 1] + box_min_);
-    if (periodic_[a]) cuts[n - 1] = std::min(cuts[n - 1], low_[a] + period_[a] - box_min_);
-    for (int k = n - 2; k >= 0; --k) cuts[k] = std::min(cuts[k], cuts[k + 1] - box_min_);
+  /// Each neighbour's parcel to it and its parcel from it: the counts, then the doubles.
+  Arrivals send_to_neighbours(const Parcels& parcels) {
+    Arrivals in;
+    const size_t m = near_.size();
+    std::vector<std::vector<double>> out(m);
+    std::vector<std::array<int, kParcelCounts>> out_counts(m);
+    in.data.resize(m), in.counts.resize(m);
+    for (size_t k = 0; k < m; ++k) out[k] = parcels.message_to(near_[k]), out_counts[k] = parcels.counts_to(near_[k], out[k].size()), in.sent += out[k].size();
+    requests_.clear();
+    for (size_t k = 0; k < m; ++k) {
+      requests_.emplace_back();
+      check(MPI_Irecv(in.counts[k].data(), kParcelCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
+      requests_.emplace_back();
+      check(MPI_Isend(out_counts[k].data(), kParcelCounts, MPI_INT, near_[k], 32 * kMigrationCounts, MPI_COMM_WORLD, &requests_.back()), "MPI_Isend");
+    }
+    check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+    requests_.clear();
+    for (size_t k = 0; k < m; ++k) {
+      in.data[k].resize(static_cast<size_t>(in.counts[k][4]));
+      requests_.emplace_back();
+      check(MPI_Irecv(in.data[k].data(), in.counts[k][4], MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD, &requests_.back()), "MPI_Irecv");
+      requests_.emplace_back();
+      check(MPI_Isend(out[k].data(), static_cast<int>(out[k].size()), MPI_DOUBLE, near_[k], 32 * kMigrationData, MPI_COMM_WORLD, &requests_.back()),
+            "MPI_Isend");
+    }
+    check(MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+    ++migrations_near_;
+    return in;
   }
 
-  /// New cuts when the most loaded rank carries more than kImbalance times the mean work and the
-  /// waiting for it since the last rebalance adds up to kRebalanceAfterSteps (collective). A particle's work is one plus its contacts (the pairs and wall contacts with a
-  /// history: in a dense bed the contacts, not the particles, cost the time); each cut axis gets
-  /// its cuts at the quantiles of the work along it. Balanced by time (Balance::time), a rank's
-  /// work is the time it computed since the last rebuild (its wall time less the time in
-  /// communication and packing), shared among its particles by their work: what a pair across a
-  /// face, a mesh contact or a slower core costs is then measured, not modelled.
+  /// The arrived particles appended to `s` (a clump's spheres after their body) and their
+  /// histories to `pairs` and `walls`, source after source.
+  static void unpack_arrivals(const Arrivals& arrived, size_t record, int width, State& s, HistoryRows& pairs, HistoryRows& walls) {
+    for (size_t source = 0; source < arrived.data.size(); ++source) {
+      const double* in = arrived.data[source].data();
+      const int* count = arrived.counts[source].data();
+      for (int k = 0; k < count[0]; ++k, in += record) s.unpack(in);
+      for (int k = 0; k < count[1]; ++k) {
+        const std::int32_t b = static_cast<std::int32_t>(s.unpack_body(in));
+        in += State::kBodyRecord;
+        const int spheres_in_body = static_cast<int>(*in++);
+        for (int q = 0; q < spheres_in_body; ++q, in += record) {
+          s.unpack(in);
+          s.body.back() = b;
+        }
+      }
+      in = pairs.unpack(in, static_cast<size_t>(count[2]), width);
+      walls.unpack(in, static_cast<size_t>(count[3]), width);
+    }
+  }
+
+  /// The rank grid: the one asked for, checked, or the one chosen (decomposition.h).
+  std::array<int, 3> grid_for(const Model& model, const State& initial, const std::array<int, 3>& requested, double box_min) const {
+    const GridSpan span = grid_span(model, initial);
+    const double* extent = span.extent;
+    std::array<int, 3> grid = choose_grid(size_, span.score, span.periodic, box_min);
+    if (requested[0] > 0) {
+      if (requested[0] * requested[1] * requested[2] != size_)
+        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} has {} boxes, not the {} ranks running", model.source, requested[0], requested[1],
+                                    requested[2], requested[0] * requested[1] * requested[2], size_));
+      if (!grid_fits(requested, extent, span.periodic, box_min))
+        throw CaseError(fmt::format("{}: a rank grid of {} x {} x {} makes boxes narrower than one pair reach ({:.4g} m) in a domain of {:.4g} x "
+                                    "{:.4g} x {:.4g} m",
+                                    model.source, requested[0], requested[1], requested[2], box_min, extent[0], extent[1], extent[2]));
+      grid = requested;
+    }
+    if (grid[0] == 0)
+      throw CaseError(fmt::format("{}: {} ranks cannot share a domain of {:.4g} x {:.4g} x {:.4g} m (each box at least one pair reach, {:.4g} m, "
+                                  "wide along every axis it is cut across), so fewer ranks would split it",
+                                  model.source, size_, extent[0], extent[1], extent[2], box_min));
+    return grid;
+  }
+
+  /// The rebalancing of decomposition.h over the ranks (collective): each rank's work, the most
+  /// loaded rank's and the sum, and when the cuts move, per cut axis the histogram of the work
+  /// summed over the ranks. Balanced by time (Balance::time), a rank's work is the time it
+  /// computed since the last check (its wall time less its time in communication and packing).
   /// Returns whether the cuts moved (the same on every rank).
   bool rebalance(const State& s, const HistoryRows& pairs, const HistoryRows& walls) {
-    const size_t n = s.size();
-    std::unordered_map<std::int64_t, double> contacts;
-    for (size_t q = 0; q < pairs.size(); ++q) contacts[pairs.a[q]] += 1, contacts[pairs.b[q]] += 1;
-    for (size_t q = 0; q < walls.size(); ++q) contacts[walls.a[q]] += 1;
-    std::vector<double> work(n, 1.0);
-    double mine = 0;
-    for (size_t p = 0; p < n; ++p) {
-      const auto it = contacts.find(s.id[p]);
-      if (it != contacts.end()) work[p] += it->second;
-      mine += work[p];
-    }
+    ParticleWork work = particle_work(s, pairs, walls);
     if (balance_ == Balance::time) {
       const double now = MPI_Wtime(), communicated = step_seconds_ + rebuild_seconds_ + gather_seconds_;
       const double computed = std::max(0.0, (now - balanced_at_) - (communicated - communicated_at_));
       balanced_at_ = now, communicated_at_ = communicated;
-      const double per_work = mine > 0 ? computed / mine : 0.0;
-      for (double& w : work) w *= per_work;
-      mine = computed;
+      share_time(work, computed);
     }
-    double stats[7] = {mine};  // work, then -low and high along each axis
-    for (int a = 0; a < 3; ++a) {
-      double lo = kInfinity, hi = -kInfinity;
-      for (size_t p = 0; p < n; ++p) lo = std::min(lo, wrapped(owner_coordinate(s, p, a), a)), hi = std::max(hi, wrapped(owner_coordinate(s, p, a), a));
-      stats[1 + 2 * a] = -lo, stats[2 + 2 * a] = hi;
-    }
+    double stats[7] = {work.total};  // work, then -low and high along each axis
+    owner_bounds(grid_, s, stats + 1);
     double most[7];
     check(MPI_Allreduce(stats, most, 7, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-    const double total = sum(mine);
-    if (balance_ == Balance::work ? total < size_ : !(total > 0)) return false;
-    // The waiting since the last check, in steps of the mean rank's work: the same on every rank
-    // (from reduced values and step counts), so every rank decides alike, and with Balance::work
-    // reproducibly.
-    const std::int64_t steps = rebuilds_ + refreshes_;
-    waited_steps_ += std::max(0.0, most[0] / (total / size_) - 1.0) * static_cast<double>(steps - checked_at_step_);
-    checked_at_step_ = steps;
-    if (most[0] <= kImbalance * total / size_ || waited_steps_ < kRebalanceAfterSteps) return false;
-    waited_steps_ = 0;
+    const double total = sum(work.total);
+    if (!clock_.due(most[0], total, size_, rebuilds_ + refreshes_, balance_ == Balance::time)) return false;
     for (int a = 0; a < 3; ++a) {
-      if (dims_[a] == 1) continue;
-      const double lo = periodic_[a] ? low_[a] : -most[1 + 2 * a], hi = periodic_[a] ? low_[a] + period_[a] : most[2 + 2 * a];
-      if (!(hi > lo)) continue;
-      std::vector<double> histogram(kHistogramBins, 0.0), all(kHistogramBins);
-      const double width = (hi - lo) / kHistogramBins;
-      for (size_t p = 0; p < n; ++p)
-        histogram[std::clamp(static_cast<int>((wrapped(owner_coordinate(s, p, a), a) - lo) / width), 0, kHistogramBins - 1)] += work[p];
-      check(MPI_Allreduce(histogram.data(), all.data(), kHistogramBins, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
-      double below = 0;
-      int bin = 0;
-      for (int k = 1; k < dims_[a]; ++k) {
-        const double target = total * k / dims_[a];
-        while (bin < kHistogramBins && below + all[bin] < target) below += all[bin++];
-        const double within = bin < kHistogramBins && all[bin] > 0 ? (target - below) / all[bin] : 0.0;
-        cuts_[a][k - 1] = lo + (bin + within) * width;
-      }
-      keep_boxes_wide(a);
+      const AxisSpan span = histogram_span(grid_, a, most + 1);
+      if (span.empty()) continue;
+      const std::vector<double> histogram = work_histogram(grid_, s, work.work, a, span);
+      std::vector<double> all(kWorkHistogramBins);
+      check(MPI_Allreduce(histogram.data(), all.data(), kWorkHistogramBins, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD), "MPI_Allreduce");
+      cuts_from_histogram(grid_, a, all, total, span);
     }
     ++rebalances_;
     return true;
@@ -726,7 +543,7 @@ class MpiDomain final : public Domain {
   /// receiver sees it, so negated).
   static int tag(int kind, const int d[3], bool sending) {
     const int seen[3] = {sending ? d[0] : -d[0], sending ? d[1] : -d[1], sending ? d[2] : -d[2]};
-    return 32 * kind + index_of(seen);
+    return 32 * kind + offset_index(seen);
   }
 
   std::vector<double> all_gather(const std::vector<double>& mine) {
@@ -754,21 +571,16 @@ class MpiDomain final : public Domain {
 
   Model local_;
   int rank_ = 0, size_ = 1;
-  int dims_[3] = {1, 1, 1}, coord_[3] = {0, 0, 0};  // the rank grid and this rank's place in it
-  bool periodic_[3] = {false, false, false};        // periodic and cut by the grid
-  double period_[3] = {0, 0, 0}, low_[3] = {0, 0, 0};  // [m]
-  double reach_ = 0;             // [m] ghost layer depth: a pair's largest listing distance (+ sticking_out_)
-  double sticking_out_ = 0;      // [m] how far a clump's sphere centre lies from the clump's centre
-  double box_min_ = 0;           // [m] narrowest box along a cut axis: reach_ + sticking_out_
-  std::vector<double> cuts_[3];  // [m] between box k and k + 1 along each axis
+  BoxGrid grid_;                  // the rank grid and its cuts
+  int coord_[3] = {0, 0, 0};      // this rank's place in it
+  double reach_ = 0;              // [m] ghost layer depth (GhostReach)
   std::vector<Neighbour> to_, from_;  // lower neighbours (get my ghosts, return their loads), upper ones
   HistoryRows pending_pairs_, pending_walls_;
   std::vector<double> buffer_;
   std::vector<std::vector<double>> out_, in_;
   std::vector<MPI_Request> requests_;
   std::int64_t migrated_ = 0, rebalances_ = 0, rebuilds_ = 0, refreshes_ = 0, ghosts_ = 0;
-  std::int64_t checked_at_step_ = 0;  ///< the step of the last rebalance check
-  double waited_steps_ = 0;           ///< steps' worth of waiting for the fullest rank since the last rebalance
+  RebalanceClock clock_;  ///< when the cuts move
   std::int64_t migrations_near_ = 0, migrations_all_ = 0;  // rebuilds whose migration went to the neighbours, all to all
   bool neighbour_migration_ = true;
   Balance balance_ = Balance::work;

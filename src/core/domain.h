@@ -1,13 +1,14 @@
 // Spatial domain decomposition, the engine's side: what a step asks of the ranks that share one
-// simulation. The engine knows no MPI; app/mpi_domain.* implements this over MPI.
+// simulation. The engine knows no MPI; app/mpi/mpi_domain.* implements this over MPI, with the
+// grid, cuts, owners and ghost sets of decomposition.h.
 //
-// Each rank owns the particles in its box of the domain (the grid of boxes is the
-// implementation's) and holds, after its own particles, ghost copies of the particles of its
-// upper neighbours (the boxes across a face, edge or corner that the implementation ranks above
-// it) that lie within one pair reach (interaction range + skin + the largest diameter) of the
-// faces, edges or corner they share (State::ghosts). A pair across ranks is thus listed on exactly
-// one rank, which evaluates it once and returns the force on the ghost to its owner (Newton's
-// third law holds exactly, as in one process). Ghost-ghost pairs are not listed.
+// Each rank owns the particles in its box of the domain (decomposition.h) and holds, after its
+// own particles, ghost copies of the particles of its upper neighbours (the boxes across a face,
+// edge or corner that lie above it, z first) that lie within one pair reach (interaction range +
+// skin + the largest diameter) of the faces, edges or corner they share (State::ghosts). A pair
+// across ranks is thus listed on exactly one rank, which evaluates it once and returns the force
+// on the ghost to its owner (Newton's third law holds exactly, as in one process). Ghost-ghost
+// pairs are not listed.
 //
 // The step with a domain (step.cpp, neighbors.cpp, forces.cpp):
 //   kick + drift of owned particles
