@@ -104,9 +104,10 @@ dem::TriangleSoup load_mesh(const dem::MeshWallSpec& spec, double particle_diame
 }
 
 dem::Model compile_case(const dem::CaseSpec& spec) {
+  // The meshes are checked against the spheres the run moves: parcels when coarse-grained.
   double diameter = 0;
-  for (const auto& p : spec.particles) diameter = std::max(diameter, p.diameter.largest());
-  for (const auto& in : spec.inlets) diameter = std::max(diameter, in.diameter.largest());
+  for (const auto& p : spec.particles) diameter = std::max(diameter, p.diameter.largest() * p.coarse_grain);
+  for (const auto& in : spec.inlets) diameter = std::max(diameter, in.diameter.largest() * in.coarse_grain);
   return dem::compile(spec, [diameter](const dem::MeshWallSpec& m) { return load_mesh(m, diameter); });
 }
 

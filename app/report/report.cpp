@@ -130,6 +130,12 @@ std::string banners(const Page& page) {
     h += fmt::format("<div class=\"banner warn\">Scaled model: particle density &times; {}, Young&#39;s modulus &times; {}. Forces, "
                      "power and wear scale with these factors.</div>\n",
                      num(model.mass_scaling, 3), num(model.stiffness_scaling, 3));
+  if (model.coarse_grain != 1)
+    h += fmt::format("<div class=\"banner warn\">Coarse-grained model: each particle is a parcel standing for {} real particles, "
+                     "{} &times; their diameter, with the contact parameters scaled to keep the contact stresses (stress "
+                     "similarity). Mass flow, power, pressure and wear are the real material&#39;s, not rescaled; what depends on "
+                     "sizes finer than a parcel (segregation, fines) is not reproduced. Details under Reproducibility.</div>\n",
+                     num(model.coarse_grain * model.coarse_grain * model.coarse_grain, 4), num(model.coarse_grain, 4));
   if (run.steady && !run.blockage.blocked && run.spillage <= 0)
     h += fmt::format("<div class=\"banner good\">Steady state from {} ({} samples); no blockage, no spillage.</div>\n", run.interval_text,
                      run.primary.own.samples);
@@ -799,6 +805,7 @@ std::string reproducibility(const Page& page) {
   h += table_row({"model hash", fmt::format("<code>{:016x}</code>", model.hash)});
   h += table_row({"mass scaling (particle density factor)", num(model.mass_scaling)});
   h += table_row({"stiffness scaling (particle Young's modulus factor)", num(model.stiffness_scaling)});
+  if (model.coarse_grain != 1) h += table_row({"coarse graining (parcel diameter / real diameter, F)", num(model.coarse_grain)});
   h += table_row({"time step [s]", num(model.dt, 4)});
   h += table_row({"Rayleigh time [s]", num(model.advice.rayleigh_time, 4)});
   h += table_row({"time step / Rayleigh time (Rayleigh fraction)",
@@ -810,6 +817,12 @@ std::string reproducibility(const Page& page) {
   h += table_row({"run wall time [s]", num(in.wall_seconds, 4)});
   h += "</table>\n";
   if (!model.advice.report.empty()) h += "<h3>Time-step advice</h3>\n<pre>" + esc(model.advice.report) + "</pre>\n";
+  if (!model.coarse_grain_report.empty()) {
+    // F, the parcels of each set and inlet, the parameters scaled, what the results are, narrow openings.
+    h += "<h3>Coarse graining</h3>\n<ul>\n";
+    for (const std::string& line : model.coarse_grain_report) h += "<li>" + esc(line) + "</li>\n";
+    h += "</ul>\n";
+  }
   h += materials_and_contact_law(model);
   if (!in.design.empty()) {
     h += "<h3>Design values</h3>\n<table>\n" + table_row({"name (with unit)", "value"}, true);

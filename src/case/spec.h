@@ -202,6 +202,10 @@ struct InletSpec {
   /// Name of an equipment port (e.g. "feed_belt") that supplies region and velocity; "" when the
   /// inlet gives its own region.
   std::string port;
+  /// [-] Coarse graining (core/coarse_grain.h): each inserted particle is a parcel standing for
+  /// coarse_grain^3 real ones, coarse_grain times their diameter; mass_rate stays the real one and
+  /// `count` counts real particles. 1: real particles.
+  double coarse_grain = 1.0;
   SourceLocation location;
 };
 
@@ -266,8 +270,16 @@ struct ParticleSetSpec {
   /// Name of a plane wall the spheres are glued to (`attach_to: top`): they move with the wall
   /// and load it with their contact forces (rough plates); "" for free particles.
   std::string attach_to;
+  /// [-] Coarse graining (core/coarse_grain.h): each particle is a parcel standing for
+  /// coarse_grain^3 real ones, coarse_grain times their diameter; `count` counts real particles,
+  /// `positions` lists parcels. 1: real particles.
+  double coarse_grain = 1.0;
   SourceLocation location;
 };
+
+/// The largest coarse_grain a case may give (inlets, particle sets): far beyond any published
+/// use (factors of 2-20), low enough that a mistyped value is an error.
+inline constexpr double kMostCoarseGrain = 1000.0;
 
 /// Fewer steps than this in the shortest contact make a step unsafe (timestep.h).
 inline constexpr double kMinStepsPerContact = 8.0;

@@ -69,6 +69,11 @@ SizeDistributionSpec read_diameter(MapReader& parent, const std::string& file, c
   return d;
 }
 
+/// `coarse_grain: F` of an inlet or a particle set: a finite number in [1, kMostCoarseGrain]; 1
+/// when absent. F < 1 would make parcels smaller than the particles they stand for (refining,
+/// which the scaling law in core/coarse_grain.h does not cover); "inf" is out of range.
+double read_coarse_grain(MapReader& map) { return map.number("coarse_grain", 1.0, 1.0, kMostCoarseGrain); }
+
 /// A box {min: [x,y,z], max: [x,y,z]} under `key` of `map`.
 void read_box(MapReader& map, const std::string& key, const std::string& file, Vec3& lo, Vec3& hi) {
   const YAML::Node node = map.node(key);
@@ -146,6 +151,7 @@ InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t ind
   in.start = map.number("start", 0.0, 0.0, 1e9, "s");
   in.stop = map.number("stop", 1e300, in.start, 1e300, "s");
   in.interval = map.number("interval", 0.0, 0.0, 1e6, "s");
+  in.coarse_grain = read_coarse_grain(map);
   map.finish();
   return in;
 }
@@ -213,6 +219,7 @@ ParticleSetSpec read_particles(const YAML::Node& node, const std::string& file, 
   p.velocity = map.vec3("velocity", p.velocity);
   p.angular_velocity = map.vec3("angular_velocity", p.angular_velocity);
   p.attach_to = map.string("attach_to", "");
+  p.coarse_grain = read_coarse_grain(map);
   const YAML::Node positions = map.node("positions");
   if (positions) {
     if (!positions.IsSequence() || positions.size() == 0) map.fail("positions", "must be a list of [x, y, z] centres");

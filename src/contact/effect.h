@@ -22,6 +22,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string_view>
 
@@ -99,6 +100,12 @@ struct ParamSpec {
   Mixing mixing;
   bool tunable;  ///< calibration may vary it
   std::string_view doc;
+  /// Coarse graining (src/core/coarse_grain.h): a pair of parcels F times the real diameter
+  /// takes this parameter times F^exponent, so that the parcels' contact stresses are the real
+  /// particles' (0: unchanged; 1: a linear stiffness [N/m], a surface energy [J/m^2], a surface
+  /// tension [N/m]). Each row states it with its reason; none (std::nullopt): a case with
+  /// coarse_grain != 1 and this effect is refused rather than scaled by a guess.
+  std::optional<int> coarse_grain_exponent = std::nullopt;
 };
 
 /// A model-wide choice of an effect, given as `stage: {model: NAME, OPTION: VALUE}`.

@@ -10,6 +10,7 @@
 
 #include "bodies/clump_geometry.h"
 #include "case/yaml_check.h"
+#include "core/coarse_grain.h"
 #include "core/model.h"
 #include "core/timestep.h"
 
@@ -252,6 +253,9 @@ void fill_pair_table(const CaseSpec& spec, Model& model) {
     note_unused(model, in.params, in.where, fmt::format("interactions[{}]", k));
   }
   for (const MaterialSpec& m : spec.materials) note_unused(model, m.params, m.where, "materials." + m.name);
+  // Coarse graining scales what the materials and interactions state for real particles; the
+  // derived values then follow from the parcels' parameters.
+  if (model.coarse_grain != 1.0) scale_pair_parameters(model);
   for (int t = 0; t < n * n; ++t)
     for (const ActiveEffect& e : model.effects)
       if (e.spec->derive) e.spec->derive(model.pair_table.data() + static_cast<size_t>(t) * model.pair_stride + e.param_offset);
@@ -364,7 +368,8 @@ void add_particle_sources(const CaseSpec& spec, Model& model) {
     const std::string key = fmt::format("particles[{}]", k);
     ParticleSource source{p, material_or_fail(model, p.material, p.location, key + ".material"),
                           clump_or_fail(model, p.clump, p.location, key + ".clump")};
-    extend_radii(model, p.diameter, source.clump);
+    if (model.coarse_grain != 1.0) make_parcels(source.spec, model.coarse_grain);
+    extend_radii(model, source.spec.diameter, source.clump);
     // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
     if (!p.attach_to.empty()) {
       for (size_t w = 0; w < model.planes.size(); ++w)
@@ -388,16 +393,18 @@ void add_particle_sources(const CaseSpec& spec, Model& model) {
 }
 
 /// Particle counts are bounded before anything is allocated for them: a mistyped `count`
-/// (an extra zero or three) must be an error, not an out-of-memory kill minutes later.
-void check_particle_counts(const CaseSpec& spec) {
+/// (an extra zero or three) must be an error, not an out-of-memory kill minutes later. The
+/// sources' counts and diameters are those of the particles created (parcels, when coarse-grained).
+void check_particle_counts(const Model& model) {
+  const char* what = model.coarse_grain != 1.0 ? "parcels" : "particles";
   std::int64_t total = 0;
-  for (size_t k = 0; k < spec.particles.size(); ++k) {
-    const ParticleSetSpec& p = spec.particles[k];
+  for (size_t k = 0; k < model.sources.size(); ++k) {
+    const ParticleSetSpec& p = model.sources[k].spec;
     total += p.count;
     if (total > kMaxParticles)
-      throw CaseError(fmt::format("{}: particles[{}].count: {} particles in all exceeds the limit of {} (about {:.0f} GB at "
+      throw CaseError(fmt::format("{}: particles[{}].count: {} {} in all exceeds the limit of {} (about {:.0f} GB at "
                                   "~1 kB per particle with its contacts); lower `count`",
-                                  p.location.str(), k, total, kMaxParticles, kMaxParticles * 1e3 / 1e9));
+                                  p.location.str(), k, total, what, kMaxParticles, kMaxParticles * 1e3 / 1e9));
     if (!p.positions.empty()) continue;
     // Random placement without overlap stops near 30-35 % solid: refuse what cannot fit
     // before drawing any diameter.
@@ -406,10 +413,10 @@ void check_particle_counts(const CaseSpec& spec) {
     const double scale = p.clump.empty() ? 1.0 : 0.5;  // a clump's spheres may overlap
     const double solid = static_cast<double>(p.count) * std::numbers::pi / 6.0 * d * d * d * scale;
     if (!(solid <= 0.6 * region))
-      throw CaseError(fmt::format("{}: particles[{}].count: {} particles of at least {:g} m hold {:.3g} m^3 of solid, "
+      throw CaseError(fmt::format("{}: particles[{}].count: {} {} of at least {:g} m hold {:.3g} m^3 of solid, "
                                   "{:.0f} % of the region's {:.3g} m^3; random placement stops near 30-35 %. Enlarge "
                                   "`region` or lower `count`",
-                                  p.location.str(), k, p.count, d, solid, 100.0 * solid / region, region));
+                                  p.location.str(), k, p.count, what, d, solid, 100.0 * solid / region, region));
   }
 }
 
@@ -419,7 +426,8 @@ void add_inlets(const CaseSpec& spec, Model& model) {
     const std::string key = fmt::format("inlets[{}]", k);
     Inlet inlet{in, material_or_fail(model, in.material, in.location, key + ".material"),
                 clump_or_fail(model, in.clump, in.location, key + ".clump"), in.interval};
-    extend_radii(model, in.diameter, inlet.clump);
+    if (model.coarse_grain != 1.0) make_parcels(inlet.spec, model.coarse_grain);
+    extend_radii(model, inlet.spec.diameter, inlet.clump);
     model.inlets.push_back(std::move(inlet));
   }
 }
@@ -613,6 +621,8 @@ std::uint64_t physics_hash(const Model& model) {
     }
     if (w.spin != 0) h = fnv1a(&w.spin, sizeof w.spin, h);
   }
+  // Parcels of another size with the same pair table (a Hertz law without cohesion) are another model.
+  if (model.coarse_grain != 1.0) h = fnv1a(&model.coarse_grain, sizeof model.coarse_grain, h);
   return h;
 }
 
@@ -623,8 +633,9 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   model.source = spec.path;
   model.title = spec.title;
 
-  // Contact law: materials, effects, per-pair parameters.
+  // Contact law: materials, effects, per-pair parameters (scaled for parcels, core/coarse_grain.h).
   add_materials(spec, model);
+  model.coarse_grain = case_coarse_grain(spec);
   switch_on_effects(spec.contact, model);
   fill_pair_table(spec, model);
 
@@ -634,7 +645,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   check_liner_names(spec, model);
   add_clump_templates(spec, model);
   add_particle_sources(spec, model);
-  check_particle_counts(spec);
+  check_particle_counts(model);
   const double g_norm = std::sqrt(spec.simulation.gravity.squaredNorm());  // [m/s^2]
   add_inlets(spec, model);
   add_outlets(spec, model);
@@ -651,6 +662,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   check_inlet_rates(model, g_norm);
   size_servo_walls(spec, model);
   check_periodic_lengths(spec, model);
+  if (model.coarse_grain != 1.0) model.coarse_grain_report = describe_coarse_grain(spec, model);
 
   model.hash = physics_hash(model);
   return model;
@@ -661,9 +673,14 @@ std::string describe_effects() {
   for (const EffectSpec* e : effect_table()) {
     out += fmt::format("contact.{}: {}\n    {}\n    source: {}\n", stage_name(e->stage), e->name,
                        e->summary, e->citation);
-    for (const ParamSpec& p : e->params)
-      out += fmt::format("    {:<26} [{}] default {:g}, range [{:g}, {:g}]{}: {}\n", p.key, p.unit, p.default_value,
-                         p.min_value, p.max_value, p.tunable ? ", tunable" : "", p.doc);
+    for (const ParamSpec& p : e->params) {
+      // How coarse graining scales it (core/coarse_grain.h): said when it changes or is unknown.
+      const std::string parcels = !p.coarse_grain_exponent         ? std::string(", coarse_grain refused (no scaling declared)")
+                                  : *p.coarse_grain_exponent != 0 ? fmt::format(", x F^{} for parcels", *p.coarse_grain_exponent)
+                                                                  : std::string();
+      out += fmt::format("    {:<26} [{}] default {:g}, range [{:g}, {:g}]{}{}: {}\n", p.key, p.unit, p.default_value,
+                         p.min_value, p.max_value, p.tunable ? ", tunable" : "", parcels, p.doc);
+    }
     for (const OptionSpec& o : e->options) {
       std::string values;
       for (const auto& v : o.values) values += (values.empty() ? "" : " | ") + std::string(v);

@@ -194,6 +194,13 @@ struct Model {
   std::array<double, 3> period{};  ///< [m] length of each periodic axis, 0 when not periodic
   double mass_scaling = 1.0;       ///< [-] applied to particle densities (reported, never silent)
   double stiffness_scaling = 1.0;  ///< [-] applied to particle Young's moduli (reported)
+  /// [-] Coarse graining F (core/coarse_grain.h): every particle is a parcel standing for F^3 real
+  /// ones, F times their diameter, with the pair parameters scaled by the law; 1: real particles.
+  /// The sources' and inlets' specs above hold the parcels' diameters and counts.
+  double coarse_grain = 1.0;
+  /// What coarse graining does in this run, in lines (the set-up log and the run report print
+  /// them, with the warnings of narrow openings); empty when coarse_grain is 1.
+  std::vector<std::string> coarse_grain_report;
   bool periodic() const { return period[0] > 0 || period[1] > 0 || period[2] > 0; }
   TimeStepAdvice advice;
   OutputSpec output;

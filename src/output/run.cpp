@@ -141,6 +141,11 @@ std::string run_info(const Model& model, const RunOptions& options, std::uint64_
   for (const ActiveEffect& e : model.effects)
     out += fmt::format("  - {{stage: {}, model: {}, source: \"{}\"}}\n", stage_name(e.spec->stage),
                        e.spec->name, e.spec->citation);
+  // Parcels (core/coarse_grain.h): the factor and what it did, beside the results they belong to.
+  if (model.coarse_grain != 1.0) {
+    out += fmt::format("coarse_grain: {:g}\ncoarse_grain_notes:\n", model.coarse_grain);
+    for (const std::string& line : model.coarse_grain_report) out += fmt::format("  - {}\n", yaml_quoted(line));
+  }
   out += "materials:\n";
   for (const Material& m : model.materials)
     out += fmt::format("  {}: {{density: {:.9g}, youngs_modulus: {:.9g}, poisson_ratio: {:g}}}\n", m.name, m.density,
@@ -179,12 +184,14 @@ std::string foreign_checkpoint(const Model& model, const std::string& out, const
 FrameWriter make_frame_writer(const Model& model, const std::string& directory) {
   std::vector<std::string> names;
   for (const Material& m : model.materials) names.push_back(m.name);
-  return FrameWriter(directory, names,
-                     {{"software", fmt::format("demdesign {}", DEMDESIGN_VERSION)},
-                      {"case", model.source},
-                      {"mass_scaling", fmt::format("{:g}", model.mass_scaling)},
-                      {"stiffness_scaling", fmt::format("{:g}", model.stiffness_scaling)},
-                      {"time_step_s", fmt::format("{:.9g}", model.dt)}});
+  std::vector<std::pair<std::string, std::string>> attributes = {{"software", fmt::format("demdesign {}", DEMDESIGN_VERSION)},
+                                                                  {"case", model.source},
+                                                                  {"mass_scaling", fmt::format("{:g}", model.mass_scaling)},
+                                                                  {"stiffness_scaling", fmt::format("{:g}", model.stiffness_scaling)},
+                                                                  {"time_step_s", fmt::format("{:.9g}", model.dt)}};
+  // Parcels' frames say so: their spheres are F times the real particles (core/coarse_grain.h).
+  if (model.coarse_grain != 1.0) attributes.emplace_back("coarse_grain", fmt::format("{:g}", model.coarse_grain));
+  return FrameWriter(directory, names, std::move(attributes));
 }
 
 /// Fields mean_traction_x_Pa, _y_Pa, _z_Pa of a mesh: the particles' force per area over the
@@ -340,6 +347,8 @@ void print_setup(const Model& model, const State& state, std::ostream& log) {
                model.mass_scaling, model.stiffness_scaling);
   else
     fmt::print(log, "  scaling: none (mass x 1, stiffness x 1)\n");
+  // Coarse graining (core/coarse_grain.h): F, the parcels, the parameters scaled, what the results are.
+  for (const std::string& line : model.coarse_grain_report) fmt::print(log, "  {}\n", line);
   if (model.periodic())
     fmt::print(log, "  periodic: {}{}{} (periods {:g} {:g} {:g} m)\n", model.period[0] > 0 ? "x" : "", model.period[1] > 0 ? "y" : "",
                model.period[2] > 0 ? "z" : "", model.period[0], model.period[1], model.period[2]);

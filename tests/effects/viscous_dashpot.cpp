@@ -8,8 +8,9 @@
 namespace dem::test_effects {
 namespace {
 
+// Coarse graining: c x F^2 (exponent 2): at the real velocities the force c v_n keeps its stress.
 constexpr ParamSpec kParams[] = {
-    {"dashpot_coefficient", "N s/m", 0.0, 0.0, 1.0, Mixing::arithmetic, true, "normal dashpot coefficient c"},
+    {"dashpot_coefficient", "N s/m", 0.0, 0.0, 1.0, Mixing::arithmetic, true, "normal dashpot coefficient c", 2},
 };
 
 DEM_KERNEL void dashpot_kernel(const EffectContext& ctx, ContactBatch& b) {

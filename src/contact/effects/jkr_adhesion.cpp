@@ -19,9 +19,13 @@ namespace dem::effects {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// Coarse graining (core/coarse_grain.h): gamma x F (exponent 1). The pull-off force 3/2 pi W R*
+// then grows as F^2, its stress (force / d^2) is the real one, and with E* unchanged the whole JKR
+// curve is the real one in force / d^2 against delta / d (a ~ F, a^3/R* ~ F^2, sqrt(W E* a^3) ~ F^2),
+// the breaking overlap delta_c ~ F included.
 constexpr ParamSpec kParams[] = {
     {"surface_energy", "J/m^2", 0.0, 0.0, 10.0, Mixing::geometric, true,
-     "surface energy gamma of each surface; work of adhesion W = 2 gamma"},
+     "surface energy gamma of each surface; work of adhesion W = 2 gamma", 1},
 };
 constexpr HistorySpec kHistory[] = {{"jkr_neck", 1}};  // the neck's contact radius a [m]; 0: no neck
 

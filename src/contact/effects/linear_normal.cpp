@@ -15,13 +15,17 @@ namespace {
 
 enum Param { kStiffness, kCharacteristicVelocity, kTangentialRatio };
 
+// Coarse graining (core/coarse_grain.h), the last number of each row: a given stiffness x F, so
+// that the same stress (force / d^2) gives the same overlap / d; a derived one (0 given) already
+// grows as F from the parcel's R* and m* (sqrt(R*) (m*/sqrt(R*))^(1/5) ~ F^(1/2 + 3/5 - 1/10)), and
+// 0 x F stays 0. Velocities are the real ones under the law, and a ratio is a ratio.
 constexpr ParamSpec kParams[] = {
     {"normal_stiffness", "N/m", 0.0, 0.0, 1e12, Mixing::harmonic, true,
-     "contact stiffness; 0 derives it from the Young's modulus and characteristic_velocity"},
+     "contact stiffness; 0 derives it from the Young's modulus and characteristic_velocity", 1},
     {"characteristic_velocity", "m/s", 1.0, 1e-6, 1e3, Mixing::maximum, false,
-     "impact speed at which the derived linear stiffness reproduces the Hertz peak overlap"},
+     "impact speed at which the derived linear stiffness reproduces the Hertz peak overlap", 0},
     {"tangential_stiffness_ratio", "-", 2.0 / 7.0, 0.0, 10.0, Mixing::arithmetic, false,
-     "kt / kn"},
+     "kt / kn", 0},
 };
 
 /// The stiffness [N/m]: given, or derived from the moduli at the characteristic velocity.

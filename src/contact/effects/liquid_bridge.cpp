@@ -22,15 +22,20 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 enum Param { kLiquidContent, kSurfaceTension, kContactAngle, kBridgesPerParticle, kCosAngle, kReachCubed /* derived */ };
 
+// Coarse graining (core/coarse_grain.h), the last number of each row: gamma x F, so that the
+// bridge force 2 pi R gamma cos(theta) ~ F^2 keeps its stress. The liquid content is a volume
+// fraction: unchanged, it makes the bridge volume w (V_i + V_j) / n_b grow as F^3 with the
+// parcels' volume, so S+ = (S/2) sqrt(R/V) at the same S / d and the rupture distance
+// (1 + theta/2) V^(1/3) / d are the real ones. An angle and a count of bridges are unchanged.
 constexpr ParamSpec kParams[] = {
     {"liquid_content", "-", 0.0, 0.0, 0.5, Mixing::arithmetic, true,
-     "liquid volume per solid volume of the particles"},
+     "liquid volume per solid volume of the particles", 0},
     {"surface_tension", "N/m", 0.072, 0.0, 1.0, Mixing::arithmetic, false,
-     "surface tension of the liquid (water: 0.072)"},
+     "surface tension of the liquid (water: 0.072)", 1},
     {"contact_angle_deg", "deg", 0.0, 0.0, 89.0, Mixing::arithmetic, true,
-     "wetting angle of the liquid on the solid"},
+     "wetting angle of the liquid on the solid", 0},
     {"bridges_per_particle", "-", 6.0, 1.0, 14.0, Mixing::arithmetic, false,
-     "bridges that share one particle's liquid"},
+     "bridges that share one particle's liquid", 0},
 };
 constexpr HistorySpec kHistory[] = {{"bridge_formed", 1}};
 

@@ -20,9 +20,11 @@ namespace {
 
 enum Param { kRestitution, kBeta /* derived */ };
 
+// Coarse graining (core/coarse_grain.h): e is dimensionless, unchanged (exponent 0); the damping
+// coefficient it gives, 2 beta sqrt(S m*), grows as F^2 from the parcel's stiffness and mass.
 constexpr ParamSpec kParams[] = {
     {"restitution", "-", 0.5, 1e-4, 1.0, Mixing::arithmetic, true,
-     "coefficient of normal restitution of a binary collision"},
+     "coefficient of normal restitution of a binary collision", 0},
 };
 constexpr std::string_view kEndOfContact[] = {"tension", "clip"};
 constexpr OptionSpec kOptions[] = {

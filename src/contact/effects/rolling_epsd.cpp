@@ -14,10 +14,12 @@ namespace {
 
 enum Param { kRollingFriction, kRollingDamping };
 
+// Coarse graining (core/coarse_grain.h): both unchanged (exponent 0), dimensionless; k_r and the
+// damping follow from the parcel's kn, R* and inertia.
 constexpr ParamSpec kParams[] = {
     kRollingFrictionParam,
     {"rolling_damping", "-", 0.3, 0.0, 2.0, Mixing::arithmetic, false,
-     "viscous damping ratio eta_r of the rolling spring (Ai et al. use 0.3)"},
+     "viscous damping ratio eta_r of the rolling spring (Ai et al. use 0.3)", 0},
 };
 constexpr HistorySpec kHistory[] = {{"rolling_spring_torque", 3, /*odd=*/true}};
 

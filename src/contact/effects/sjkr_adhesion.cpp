@@ -13,9 +13,11 @@
 namespace dem::effects {
 namespace {
 
+// Coarse graining (core/coarse_grain.h): k_c unchanged (exponent 0). It is already a stress (force
+// per contact area), and the parcels' contact area at the same delta / d is F^2 the real one.
 constexpr ParamSpec kParams[] = {
     {"cohesion_energy_density", "J/m^3", 0.0, 0.0, 1e9, Mixing::geometric, true,
-     "cohesion energy density k_c: attractive force per unit contact area"},
+     "cohesion energy density k_c: attractive force per unit contact area", 0},
 };
 
 DEM_KERNEL void sjkr_kernel(const EffectContext& ctx, ContactBatch& b) {
