@@ -1,5 +1,6 @@
 // A calibrated material as a library file: written by calibrate/diagnose, read back by the
-// material library and by a case, refused when edited after its fit, and sampled for design runs.
+// material library and by a case, refused when edited after its fit, and sampled for design runs;
+// the coarse_grain it was fitted at, named to a case that runs it at another.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 
 #include "calibration/calibrated_material.h"
 #include "case/calibration_record.h"
+#include "core/model.h"
 #include "model/library.h"
 #include "model/material_model.h"
 
@@ -79,6 +81,36 @@ TEST(CalibratedMaterial, RoundTripsThroughTheLibraryAndACase) {
   ASSERT_NE(g, spec.materials.end());
   ASSERT_TRUE(g->calibration.has_value());
   EXPECT_NEAR(g->params.at("friction"), 0.537, 1e-12);
+}
+
+// A fit at the parcel size (--coarse-grain 2): the file records the coarse_grain its virtual tests
+// ran at, and a case that runs the material at another coarse_grain (real particles, or 3) is
+// told in its set-up notes, with the comparison that would check it; at 2 nothing is said.
+TEST(CalibratedMaterial, RecordsItsCoarseGrainAndACaseAtAnotherIsTold) {
+  const fs::path dir = scratch();
+  CalibrationResult fit = gravel_fit();
+  fit.fitted.coarse_grain = 2;
+  write_calibrated_material((dir / "gravel_calibrated.yaml").string(), fit, {"calibrate", "lab/gravel.yaml", "2026-12-03", ""});
+  EXPECT_NE(read_text(dir / "gravel_calibrated.yaml").find("\n  coarse_grain: 2\n"), std::string::npos);
+  const MaterialModel back = read_material_model((dir / "gravel_calibrated.yaml").string());
+  ASSERT_TRUE(back.particle.calibration.has_value());
+  EXPECT_DOUBLE_EQ(back.particle.calibration->coarse_grain, 2.0);
+  const auto notes = [&](const std::string& coarse_grain) {
+    const CaseSpec spec = parse_case_text(
+        "simulation: {duration: 0.001}\nmaterials:\n  g: {library: gravel_calibrated}\n  steel: {library: steel}\n"
+        "particles:\n  - {material: g, diameter: 0.01, positions: [[0, 0, 0.05]]" + coarse_grain + "}\n",
+        (dir / "case.yaml").string(), library_lookup());
+    std::string all;
+    for (const std::string& n : compile(spec).notes) all += n + "\n";
+    return all;
+  };
+  const std::string same = notes(", coarse_grain: 2"), real = notes(""), coarser = notes(", coarse_grain: 3");
+  EXPECT_EQ(same.find("was calibrated at coarse_grain"), std::string::npos) << same;
+  EXPECT_NE(real.find("was calibrated at coarse_grain 2 and is used here at coarse_grain 1: the scaling law carries it"), std::string::npos)
+      << real;
+  EXPECT_NE(real.find("compare at 1 to check (demdesign compare"), std::string::npos) << real;
+  EXPECT_NE(real.find("lab/gravel.yaml --coarse-grain 1"), std::string::npos) << real;
+  EXPECT_NE(coarser.find("was calibrated at coarse_grain 2 and is used here at coarse_grain 3"), std::string::npos) << coarser;
 }
 
 TEST(CalibratedMaterial, AFileEditedAfterItsFitOrWithABadCorrelationIsRefused) {

@@ -408,6 +408,10 @@ TEST(RunReport, SelfContainedWithSteadyIntervalMeanAndFiles) {
     else
       EXPECT_EQ(back.values[k].second, metrics.values[k].second) << back.values[k].first;
   }
+  // The standard errors of the means (the third column) come back too, and the throughput has one.
+  EXPECT_EQ(back.std_errors, metrics.std_errors);
+  EXPECT_GT(back.std_error("throughput_t_h"), 0.0) << "the outlet's throughput is a mean with a batch-means standard error";
+  EXPECT_TRUE(std::isnan(back.std_error("spillage_kg"))) << "a total has none";
 }
 
 TEST(RunReport, WritesWithoutGnuplotAndSaysSo) {

@@ -39,7 +39,7 @@ std::string variant(int k) { return (k < 10 ? "v0" : "v") + std::to_string(k); }
 
 double metric(const fs::path& metrics_csv, const std::string& name) {
   for (const auto& row : csv_rows(metrics_csv))
-    if (row.size() == 2 && row[0] == name) return std::atof(row[1].c_str());
+    if (row.size() >= 2 && row[0] == name) return std::atof(row[1].c_str());  // name,value,std_error
   return std::nan("");
 }
 

@@ -2,7 +2,8 @@
 // restitution of a normal and an oblique drop, bulk density of poured spheres against random
 // loose/close packing, the lifted-cylinder angle of repose (no heap without rolling resistance,
 // a heap that steepens with it), the rotating drum's dynamic angle and wall slip, and hopper
-// discharge against Beverloo's law and arching. Apparatus shrunk (size_factor) and particles
+// discharge against Beverloo's law and arching; the cup filled with parcels (coarse_grain 2: an
+// eighth as many, the note, the ledger and the store key). Apparatus shrunk (size_factor) and particles
 // coarse and soft so each simulation takes a few seconds. Also: a diagnosis candidate at its
 // `unchanged` values compiles to the model's own contact law, and every candidate effect's `moves`
 // names a test of the table and one of its observables.
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <numbers>
 #include <numeric>
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include "calibration/calibration.h"
+#include "calibration/simulation_store.h"
 #include "contact/effect.h"
 #include "model/material_model.h"
 #include "lab/measurements.h"
@@ -255,6 +258,62 @@ TEST(BulkDensity, PouredSpheresPackBetweenLooseAndCloseAndDenserWithLessFriction
   EXPECT_LT(rough, 0.64);
   EXPECT_GT(smooth, rough + 0.01);
   EXPECT_LT(smooth, 0.66);
+}
+
+// Calibration at the parcel size (--coarse-grain, MaterialModel::coarse_grain): the real cup of
+// bulk_density (4 cm across, 3 cm high) filled with parcels of twice the diameter. The count is
+// sized by what is simulated: 480 spheres of 5 mm, 60 parcels of 10 mm (an eighth); every sphere
+// of the run is a 10 mm parcel, the model says F = 2, the note says so, the ledger records it,
+// and the simulation store keys it apart from the real particles' (which keep their key: no
+// coarse_grain line is written at F = 1).
+TEST(BulkDensity, AtCoarseGrainTwoTheCupHoldsAnEighthAsManyParcelsOfTwiceTheDiameter) {
+  MaterialModel real = beads(0.5, 0.0, 0.5, 0.005);
+  real.particle.youngs_modulus = 2e5;
+  const TestSetup setup =
+      setup_of("bulk_density", {{"cup_diameter", 0.04}, {"cup_height", 0.03}, {"pour_height", 0.015}}, {{"base", "steel"}});
+  const SimulatedOutcome as_real = run_virtual_test(real, setup, {});
+  print("bulk_density real", as_real);
+  MaterialModel parcels = real;
+  parcels.coarse_grain = 2;
+  TestOptions options;
+  double model_factor = 0, smallest = 1, largest = 0;  // [-], [m], [m]
+  options.on_final = [&](const Model& model, const State& state) {
+    model_factor = model.coarse_grain;
+    for (size_t p = 0; p < state.size(); ++p) smallest = std::min(smallest, state.radius[p]), largest = std::max(largest, state.radius[p]);
+  };
+  const SimulatedOutcome as_parcels = run_virtual_test(parcels, setup, options);
+  print("bulk_density coarse_grain 2", as_parcels);
+  EXPECT_DOUBLE_EQ(model_factor, 2.0);
+  EXPECT_NEAR(smallest, 0.005, 1e-12) << "a parcel of 5 mm beads at F = 2 is 10 mm across";
+  EXPECT_NEAR(largest, 0.005, 1e-12);
+  ASSERT_GT(as_real.particles, 400);
+  EXPECT_NEAR(static_cast<double>(as_parcels.particles) / static_cast<double>(as_real.particles), 0.125, 0.005)
+      << as_real.particles << " spheres, " << as_parcels.particles << " parcels";
+  std::string notes;
+  for (const std::string& n : as_parcels.notes) notes += n + "\n";
+  EXPECT_NE(notes.find(fmt::format("coarse grain 2: {} parcels", as_parcels.particles)), std::string::npos) << notes;
+  for (const std::string& n : as_real.notes) EXPECT_EQ(n.find("coarse grain"), std::string::npos) << n;
+  // Four parcels across the cup: still a packing, looser at the walls than the real one may be.
+  const double solid = as_parcels.observables.at("bulk_density") / 2500;
+  EXPECT_GT(solid, 0.3);
+  EXPECT_LT(solid, 0.68);
+
+  // The ledger says the factor, and reads it back.
+  const LedgerEntry entry = ledger_entry(parcels, Comparison{}, "start", {});
+  EXPECT_DOUBLE_EQ(entry.coarse_grain, 2.0);
+  const std::filesystem::path ledger = std::filesystem::temp_directory_path() / "demdesign_coarse_grain_ledger" / "ledger.yaml";
+  std::filesystem::remove_all(ledger.parent_path());
+  append_ledger(ledger.string(), "beads", {entry, ledger_entry(real, Comparison{}, "real", {})});
+  const std::vector<LedgerEntry> back = read_ledger(ledger.string());
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_DOUBLE_EQ(back[0].coarse_grain, 2.0);
+  EXPECT_DOUBLE_EQ(back[1].coarse_grain, 1.0);
+
+  // The store: parcels and real particles never share a stored simulation.
+  const std::string key_real = simulation_inputs(real, setup, {}), key_parcels = simulation_inputs(parcels, setup, {});
+  EXPECT_NE(key_real, key_parcels);
+  EXPECT_NE(key_parcels.find("coarse_grain: 2\n"), std::string::npos) << key_parcels;
+  EXPECT_EQ(key_real.find("coarse_grain"), std::string::npos) << key_real;
 }
 
 // Lifted cylinder: spheres without rolling resistance on a plate spread into a sheet (no_heap,

@@ -97,6 +97,7 @@ SweepPlan read_sweep(const YAML::Node& root, const std::string& file) {
   SweepPlan plan = read_design_sweep(root, file);
   plan.design_paths = plan.paths.size();
   if (root.IsMap() && root["bias_check"]) add_bias_check(plan, root, file);
+  else if (root.IsMap() && root["coarse_grain_check"]) add_coarse_grain_check(plan, root, file);
   else if (root.IsMap() && root["uncertainty"]) add_uncertainty(plan, root, file);
   return plan;
 }
@@ -173,6 +174,7 @@ YAML::Node variant_case(const YAML::Node& root, const SweepPlan& plan, size_t k)
   copy.remove("sweep");
   copy.remove("uncertainty");
   copy.remove("bias_check");
+  copy.remove("coarse_grain_check");
   for (size_t p = 0; p < plan.paths.size(); ++p) {
     const std::vector<PathStep> steps = split_path(plan.paths[p]);
     // yaml-cpp nodes are handles: walking with operator[] on a non-const node creates missing
@@ -506,15 +508,17 @@ void report_uncertainty(const SweepRank& sweep, report::SweepReportInput& input)
     if (x.probability > 0.5) log << fmt::format("  P({} beats {} on {}) = {:.2f} over {} parameter sets\n", x.a, x.b, x.metric, x.probability, x.pairs);
 }
 
-/// With `bias_check:`: how each KPI moves under the checks, on the page and in the log.
+/// With `bias_check:` or `coarse_grain_check:`: how each KPI moves under the checks, on the page
+/// and in the log.
 void report_bias_check(const SweepRank& sweep, report::SweepReportInput& input) {
   std::ostream& log = sweep.log;
   const BiasSummary summary = summarise_bias_check(sweep.plan, input.variants, sweep.options.out + "/report");
   input.extra_html = summary.html;
-  input.title = fmt::format("What the scalings cost: {}", fs::path(sweep.options.case_path).filename().string());
-  log << "bias check: each KPI as the case runs against the checks\n";
+  input.title = fmt::format("{}: {}", summary.title, fs::path(sweep.options.case_path).filename().string());
+  log << summary.log_heading << "\n";
+  for (const std::string& line : summary.log_lines) log << "  " << line << "\n";
   for (const KpiShift& s : summary.shifts)
-    log << fmt::format("  {}{}{}\n", s.design.empty() ? "" : s.design + ": ", s.sensitive ? "SENSITIVE: " : "", s.words);
+    log << fmt::format("  {}{}{}\n", s.design.empty() ? "" : s.design + ": ", s.sensitive ? summary.flag_word + ": " : "", s.words);
 }
 
 /// Writes the comparison report into OUT/report and tells the ranking.

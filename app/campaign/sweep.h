@@ -47,10 +47,16 @@ struct SweepPlan {
   int samples = 0;
   size_t design_paths = 0;
   std::vector<std::string> held;  ///< calibrated parameters a case cannot vary, held at their fitted values
-  /// With `bias_check:` (app/campaign/bias_check.h): the runs per design variant ("as the case", then the
-  /// checks); variant k is design k / runs at run k % runs. Empty: no bias check.
+  /// With `bias_check:` or `coarse_grain_check:` (app/campaign/bias_check.h): the runs per design
+  /// variant ("as the case", then the checks); variant k is design k / runs at run k % runs.
+  /// Empty: no check.
   std::vector<std::string> bias_runs;
   double bias_tolerance_pct = 5;  ///< [%] a KPI that moves by less is not sensitive to the scaling
+  /// What the check's runs vary: bias_check's stiffness and mass scaling, or coarse_grain_check's
+  /// parcel size (every inlet's and particle set's coarse_grain).
+  enum class Check { scalings, coarse_grain } check = Check::scalings;
+  double coarse_grain = 1, finer_coarse_grain = 1;  ///< coarse_grain_check: the case's F and the check run's F' < F
+  std::vector<std::string> check_kpis;  ///< coarse_grain_check.kpis: the KPIs reported (metrics.csv names); empty: all
   /// The design part of variant k's label ("" without a sweep).
   std::string design_label(size_t k) const;
   /// Short name of variant k: "v02".
@@ -59,8 +65,9 @@ struct SweepPlan {
   std::string label(size_t k) const;
 };
 
-/// Reads the `sweep:` section of a case and its `uncertainty:` section (app/campaign/uncertainty.h) (throws CaseError naming file, line and key); nullopt-like
-/// empty plan (no variants) when the case has none.
+/// Reads the `sweep:` section of a case and its `uncertainty:`, `bias_check:` or
+/// `coarse_grain_check:` section (app/campaign/uncertainty.h, app/campaign/bias_check.h; throws
+/// CaseError naming file, line and key); an empty plan (no variants) when the case has none.
 SweepPlan read_sweep(const YAML::Node& root, const std::string& file);
 /// The `sweep:` section alone.
 SweepPlan read_design_sweep(const YAML::Node& root, const std::string& file);

@@ -87,6 +87,8 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
       ->check(number_in(1e-9, 1e3));
   test_->add_option("--rayleigh-fraction", rayleigh_fraction_, "time step as a fraction of the Rayleigh time (default: the lab tests' rule)")
       ->check(number_in(0.005, 0.4));
+  test_->add_option("--coarse-grain", coarse_grain_, "the apparatus filled with parcels of F x the diameter, F^3 particles each (1: real particles)")
+      ->check(number_in(1, kMostCoarseGrain));
   for (CLI::App** cmd : {&compare_, &calibrate_, &diagnose_}) {
     const char* name = cmd == &compare_ ? "compare" : cmd == &calibrate_ ? "calibrate" : "diagnose";
     const char* what = cmd == &compare_ ? "simulate every experiment of a measurement file and compare (report in --out)"
@@ -108,6 +110,10 @@ CalibrationCommands::CalibrationCommands(CLI::App& app, RenderFinal render) : re
                      "run every simulation again: neither take outcomes from OUT/simulations/ (kept there as each simulation finishes) nor keep new ones");
     (*cmd)->add_option("--stiffness-scaling", stiffness_scaling_, "factor on Young's modulus in the virtual tests (soft particles, longer step)")
         ->check(number_in(1e-9, 1e3));
+    (*cmd)->add_option("--coarse-grain", coarse_grain_,
+                       "the virtual tests with parcels of F x the diameter, F^3 particles each, in the real apparatus: the material at "
+                       "the parcel size a case with coarse_grain F runs (1: real particles)")
+        ->check(number_in(1, kMostCoarseGrain));
     if (cmd != &compare_) {
       (*cmd)->add_option("--params", params_, "parameters to fit, comma separated (default: the material's tunable ranges)");
       (*cmd)->add_option("--rounds", rounds_, "surrogate rounds (2: a quarter-range box around the first optimum)")->check(whole_in(1, 10));
@@ -154,6 +160,7 @@ int CalibrationCommands::run_test() {
   MaterialModel model = read_material_model(material_);
   if (!measurements_.empty()) apply_measured(model, read_measurements(measurements_));
   model.stiffness_scaling = stiffness_scaling_;
+  model.coarse_grain = coarse_grain_;
   TestSetup setup;
   setup.test = test_name_;
   setup.location.file = "--set";
@@ -242,6 +249,7 @@ void CalibrationCommands::read_campaign_inputs(Campaign& campaign) {
     for (const std::string& w : campaign.measured.warnings) std::cout << "warning: " << w << std::endl;
   apply_measured(campaign.model, campaign.measured);
   campaign.model.stiffness_scaling = stiffness_scaling_;
+  campaign.model.coarse_grain = coarse_grain_;  // before the check: what an apparatus holds is counted in parcels
   {  // every experiment's set-up checked before the first simulation
     TestOptions check;
     check.size_factor = size_factor_;
@@ -256,6 +264,17 @@ void CalibrationCommands::read_campaign_inputs(Campaign& campaign) {
                                material_, record->stiffness_scaling, campaign.command, stiffness_scaling_, record->stiffness_scaling)
                 << std::endl;
   }
+  // Nor need parameters fitted with parcels of one size hold for another (core/coarse_grain.h).
+  if (const auto& record = campaign.model.particle.calibration; record && mpi::world().rank == 0 && record->coarse_grain != coarse_grain_)
+    std::cout << fmt::format("note: {} was calibrated at coarse_grain {:g}; this {} runs its virtual tests at coarse_grain {:g} "
+                             "(--coarse-grain {:g} repeats the calibration's)",
+                             material_, record->coarse_grain, campaign.command, coarse_grain_, record->coarse_grain)
+              << std::endl;
+  if (coarse_grain_ != 1.0 && mpi::world().rank == 0)
+    std::cout << fmt::format("coarse graining: the virtual tests run parcels of coarse_grain {:g} ({:g} x the diameter, {:.4g} particles "
+                             "each) in the real apparatus\n",
+                             coarse_grain_, coarse_grain_, coarse_grain_ * coarse_grain_ * coarse_grain_)
+              << std::flush;
 }
 
 /// The calibration's options from the command line.
@@ -295,6 +314,7 @@ void CalibrationCommands::start_campaign_report(Campaign& campaign) {
   input.title = fmt::format("{} {}", campaign.command, campaign.model.name);
   input.material_path = material_, input.measurements_path = measurements_, input.version = "0.1.0";
   input.measured = &campaign.measured;
+  input.coarse_grain = campaign.model.coarse_grain;
   for (const auto& p : (campaign.params.empty() ? fit_parameters(campaign.model) : campaign.params)) campaign.keys.push_back(p.key);
 }
 
@@ -459,6 +479,7 @@ int CalibrationCommands::write_synthetic() {
   const MeasurementSet measured = read_measurements(measurements_);
   apply_measured(truth, measured);
   truth.stiffness_scaling = stiffness_scaling_;
+  truth.coarse_grain = coarse_grain_;
   {
     TestOptions check;
     check.size_factor = size_factor_;
@@ -493,9 +514,10 @@ int CalibrationCommands::write_synthetic() {
   fs::create_directories(out_);
   const std::string path = (fs::path(out_) / "synthetic_measurements.yaml").string();
   std::ofstream file(path);
-  file << fmt::format("# SYNTHETIC: values simulated with {} (seed {}, size factor {:g}, stiffness scaling {:g}) plus Gaussian noise of each sigma "
-                      "(noise seed {}), written by `demdesign compare {} {} --synthetic-from {} ...`\n",
-                      synthetic_from_, seed_, size_factor_, stiffness_scaling_, noise_seed_, material_, measurements_, synthetic_from_);
+  file << fmt::format("# SYNTHETIC: values simulated with {} (seed {}, size factor {:g}, stiffness scaling {:g}, coarse grain {:g}) plus "
+                      "Gaussian noise of each sigma (noise seed {}), written by `demdesign compare {} {} --synthetic-from {} ...`\n",
+                      synthetic_from_, seed_, size_factor_, stiffness_scaling_, coarse_grain_, noise_seed_, material_, measurements_,
+                      synthetic_from_);
   for (const std::string& line : lines) file << line << "\n";
   std::cout << "wrote " << path << "\n";
   return 0;

@@ -3,6 +3,9 @@
 //   demdesign compare MATERIAL.yaml MEASUREMENTS.yaml [--replicas N] [--out DIR]
 //   demdesign calibrate MATERIAL.yaml MEASUREMENTS.yaml [--params friction,rolling_friction] [--out DIR]
 //   demdesign diagnose MATERIAL.yaml MEASUREMENTS.yaml [--out DIR]
+// Each takes --coarse-grain F: the virtual tests in the real apparatus filled with parcels of F
+// times the diameter (core/coarse_grain.h), to calibrate the material at the parcel size a
+// coarse-grained case runs.
 // Wiring in main(): construct before CLI11_PARSE, then inside the try block
 //   if (calibration.parsed()) return calibration.run();
 #pragma once
@@ -57,6 +60,8 @@ class CalibrationCommands {
   std::vector<std::string> set_;
   double size_factor_ = 1.0, rayleigh_fraction_ = 0.0, stiffness_scaling_ = 1.0, design_factor_ = 2.0;
   double stiffness_check_ = 0;  ///< compare --stiffness-check: factor of the second comparison (0: none)
+  /// --coarse-grain: the virtual tests with parcels of this factor (MaterialModel::coarse_grain); 1: real particles
+  double coarse_grain_ = 1.0;
   int replicas_ = 3, threads_ = 0, rounds_ = 2, confirm_ = 2, parallel_ = 0;
   bool no_store_ = false, no_renders_ = false, no_walls_first_ = false;
   long long noise_seed_ = 1;

@@ -266,7 +266,8 @@ std::string ledger_section(const std::vector<materials::LedgerEntry>& ledger, co
     std::string effects, params;
     for (const auto& x : e.effects) effects += (effects.empty() ? "" : ", ") + esc(x);
     for (const auto& [k, v] : e.parameters) params += (params.empty() ? "" : "<br>") + esc(k) + " = " + num(v);
-    std::vector<std::string> cells = {std::to_string(e.version), esc(e.label), effects, params, num(e.chi2_per_n(), 3)};
+    const std::string label = esc(e.label) + (e.coarse_grain != 1.0 ? fmt::format("<br><small>coarse_grain {:g}</small>", e.coarse_grain) : "");
+    std::vector<std::string> cells = {std::to_string(e.version), label, effects, params, num(e.chi2_per_n(), 3)};
     for (const auto& t : terms) cells.push_back(e.residuals.count(t) ? num(e.residuals.at(t), 2) : "&ndash;");
     h += row(cells);
   }
@@ -291,6 +292,14 @@ std::string write_calibration_report(const CalibrationReportInput& in, const std
   std::string h = html::head(in.title);
   h += fmt::format("<h1>{}</h1>\n<p class=\"meta\">material {} &middot; measurements {} &middot; {} &middot; demdesign {} &middot; {:.0f} s</p>\n", esc(in.title),
                    esc(in.material_path), esc(in.measurements_path), esc(html::now_text()), esc(in.version), in.wall_seconds);
+  if (in.coarse_grain != 1.0) {
+    const double f = in.coarse_grain;
+    h += fmt::format("<div class=\"banner warn\">COARSE GRAINING: the virtual tests ran with parcels of coarse_grain {0:g} &mdash; the "
+                     "real apparatus filled with parcels {0:g} &times; the diameter, each standing for {1:.4g} real particles, their "
+                     "contact parameters scaled by stress similarity. What is fitted here is the material at that parcel size: it "
+                     "holds for cases run at coarse_grain {0:g}.</div>\n",
+                     f, f * f * f);
+  }
   if (in.measured && !in.measured->warnings.empty()) {
     h += "<h2>Warnings on the measurement file</h2>\n<ul>";
     for (const std::string& w : in.measured->warnings) h += "<li>" + esc(w) + "</li>";

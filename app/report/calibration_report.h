@@ -21,6 +21,9 @@ struct CalibrationReportInput {
   std::vector<materials::LedgerEntry> ledger;
   std::vector<std::string> images;  ///< renders of final states (PNG paths)
   double wall_seconds = 0;
+  /// [-] The coarse_grain the virtual tests ran at (--coarse-grain; MaterialModel::coarse_grain):
+  /// said beside the title, since a fit with parcels holds for cases run at that parcel size.
+  double coarse_grain = 1.0;
 };
 
 /// Writes dir/calibration_report.html and dir/plots/*; returns the HTML path.

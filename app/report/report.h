@@ -77,10 +77,18 @@ struct RunReportInput {
 /// Key numbers of a run, to rank sweep variants. Names carry their unit ("throughput_t_h").
 struct RunMetrics {
   std::vector<std::pair<std::string, double>> values;
+  /// Metric -> the standard error of its value, for the metrics that are a mean over the run's
+  /// records (batch means: statistics/steady_state.h average_over, and report_analysis.cpp
+  /// weighted_over for a sensor's mass-weighted figures): the noise a check of the same case at
+  /// another modelling choice measures a shift against (app/campaign/bias_check.h). Totals,
+  /// peaks and derived figures have none.
+  std::map<std::string, double> std_errors;
   bool steady = false;
   std::string steady_text;  ///< "steady from 1.2 s to 4 s (outflow)" or why not
   /// The value named `name`; NaN when absent.
   double get(const std::string& name) const;
+  /// The standard error of `metric`'s value [its unit]; NaN when it has none.
+  double std_error(const std::string& metric) const;
   /// The run's own standard deviation of `metric` ("throughput_t_h" -> "throughput_std_t_h",
   /// otherwise METRIC_std); NaN when the report gives none.
   double noise(const std::string& metric) const;
@@ -92,7 +100,9 @@ struct RunMetrics {
 /// when a file cannot be written.
 RunMetrics write_run_report(const RunReportInput& input, const std::string& report_dir);
 
-/// metrics.csv: `name,value` rows, a `steady` row (1/0) and a `# steady_text: ...` line.
+/// metrics.csv: `name,value,std_error` rows (std_error empty where the metric has none), a
+/// `steady` row (1/0) and a `# steady_text: ...` line. Read back, files of `name,value` rows are
+/// accepted too.
 void write_metrics(const RunMetrics& metrics, const std::string& path);
 /// Reads metrics.csv; throws std::runtime_error naming the file when it cannot be read.
 RunMetrics read_metrics(const std::string& path);

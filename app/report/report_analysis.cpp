@@ -565,7 +565,12 @@ void other_series(const AnalysisInput& input, RunAnalysis& run) {
 void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   const Model& model = input.model;
   RunMetrics& metrics = run.metrics;
-  const auto metric = [&metrics](const std::string& name, double value) { metrics.values.emplace_back(key(name), value); };
+  // A metric that is a mean over the run's records carries its batch-means standard error; 0
+  // (a series without samples in the interval, or constant) says nothing of the noise: none.
+  const auto metric = [&metrics](const std::string& name, double value, double std_error = kNaN) {
+    metrics.values.emplace_back(key(name), value);
+    if (std::isfinite(std_error) && std_error > 0) metrics.std_errors[key(name)] = std_error;
+  };
   const Quantity& primary = run.primary;
   const std::vector<Quantity>& plane_sensors = run.plane_sensors;
   const std::vector<Quantity>& power = run.power;
@@ -574,11 +579,11 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
 
   metric("steady_from_s", run.steady ? run.run_t0 : kNaN);
   if (!model.outlets.empty()) {
-    metric("throughput_t_h", primary.at_run.mean);
+    metric("throughput_t_h", primary.at_run.mean, primary.at_run.std_error);
     metric("throughput_std_t_h", primary.at_run.std_dev);
-    for (const Quantity& q : run.outlets) metric(key(q.name) + "_t_h", q.at_run.mean);
+    for (const Quantity& q : run.outlets) metric(key(q.name) + "_t_h", q.at_run.mean, q.at_run.std_error);
   }
-  for (const Quantity& q : plane_sensors) metric(key(q.name) + "_t_h", q.at_run.mean);
+  for (const Quantity& q : plane_sensors) metric(key(q.name) + "_t_h", q.at_run.mean, q.at_run.std_error);
   for (std::size_t j = 0; j < plane_sensors.size(); ++j) {
     const double vx = run.plane_detail[4 * j + 1].at_run.mean, vy = run.plane_detail[4 * j + 2].at_run.mean, vz = run.plane_detail[4 * j + 3].at_run.mean;
     metric(key(plane_sensors[j].name) + "_speed_m_s", std::sqrt(vx * vx + vy * vy + vz * vz));
@@ -590,7 +595,7 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   metric("blockage", run.blockage.blocked ? 1.0 : 0.0);
   double total_power = 0;
   for (std::size_t m = 0; m < power.size(); ++m) {
-    metric("power_" + model.meshes[m].name + "_W", power[m].at_run.mean);
+    metric("power_" + model.meshes[m].name + "_W", power[m].at_run.mean, power[m].at_run.std_error);
     total_power += power[m].at_run.mean;
     // The magnitude of the mean force, not the mean of the magnitude (which noise inflates).
     const double fx = run.mesh_load[6 * m].at_run.mean, fy = run.mesh_load[6 * m + 1].at_run.mean, fz = run.mesh_load[6 * m + 2].at_run.mean;
@@ -598,8 +603,8 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   }
   if (!power.empty()) metric("power_total_W", total_power);
   for (const Drive& d : run.drives) {
-    metric("drive_" + d.name + "_power_W", d.power.at_run.mean);
-    metric("drive_" + d.name + (d.kind == DriveKind::rotating ? "_torque_N_m" : "_pull_N"), d.effort.at_run.mean);
+    metric("drive_" + d.name + "_power_W", d.power.at_run.mean, d.power.at_run.std_error);
+    metric("drive_" + d.name + (d.kind == DriveKind::rotating ? "_torque_N_m" : "_pull_N"), d.effort.at_run.mean, d.effort.at_run.std_error);
   }
   if (!model.meshes.empty() && record_time > 0) {
     double max_shear = 0, max_impact = 0, max_wear = kNaN;
@@ -613,9 +618,10 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
     add_liner_metrics(run, model);
   }
   for (const BoxResult& b : run.boxes) {
-    metric("centring_offset_" + b.name + "_pct", b.width > 0 ? 100 * b.offset.at_run.mean / (1000 * b.width) : kNaN);
+    metric("centring_offset_" + b.name + "_pct", b.width > 0 ? 100 * b.offset.at_run.mean / (1000 * b.width) : kNaN,
+           b.width > 0 ? 100 * b.offset.at_run.std_error / (1000 * b.width) : kNaN);
     metric("vertical_speed_" + b.name + "_m_s", b.vertical);
-    metric("mass_in_" + b.name + "_kg", b.mass.at_run.mean);  // a packing's bulk density times the box's volume
+    metric("mass_in_" + b.name + "_kg", b.mass.at_run.mean, b.mass.at_run.std_error);  // a packing's bulk density times the box's volume
     if (!std::isnan(b.belt_speed) && b.belt_speed != 0) {
       metric("speed_ratio_" + b.name, b.along / b.belt_speed);
       // For ranking: how far the load's speed along the belt is from the belt's (0 is best).
@@ -624,7 +630,7 @@ void add_metrics(const AnalysisInput& input, RunAnalysis& run) {
   }
   add_belt_capacity_metrics(run);
   add_choke_metrics(run);
-  metric("kinetic_energy_J", run.kinetic.at_run.mean);
+  metric("kinetic_energy_J", run.kinetic.at_run.mean, run.kinetic.at_run.std_error);
 }
 
 }  // namespace

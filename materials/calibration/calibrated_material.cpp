@@ -127,6 +127,8 @@ std::string calibrated_material_text(const CalibrationResult& fit, const Calibra
   out += "  correlation:\n" + fmt::format("{}", fmt::join(rows, ""));
   out += fmt::format("  chi2_per_n: {}\n", number(chi2));
   out += fmt::format("  stiffness_scaling: {}\n", number(m.stiffness_scaling));
+  // The parcel size of the virtual tests: a case at another coarse_grain is told (core/coarse_grain.h).
+  out += fmt::format("  coarse_grain: {}\n", number(m.coarse_grain));
   return out;
 }
 

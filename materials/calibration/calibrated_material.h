@@ -2,7 +2,8 @@
 // output folder, so that measurement -> material -> design is one chain of files. The file is a
 // materials/NAME.yaml like the shipped ones (a case names it with `{library: NAME}`) plus a
 // `calibration:` block with the fit it came from (src/case/calibration_record.h): the fitted
-// parameters, their standard deviations and correlation, chi^2/n, the effects and the command.
+// parameters, their standard deviations and correlation, chi^2/n, the effects and the command,
+// and the stiffness scaling and coarse_grain the virtual tests ran at.
 #pragma once
 
 #include <string>

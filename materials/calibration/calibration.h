@@ -516,6 +516,9 @@ struct LedgerEntry {
   /// The diagnosis' verdict on this version, where one was made ("missing: epsd ...",
   /// "improves, not explained: jkr ..."; Verdict): "" for none.
   std::string verdict;
+  /// [-] The coarse_grain the version's virtual tests ran at (MaterialModel::coarse_grain): a
+  /// version fitted with parcels is another fit than one with real particles. 1: real particles.
+  double coarse_grain = 1.0;
   double chi2_per_n() const { return n > 0 ? chi2 / n : 0.0; }
 };
 

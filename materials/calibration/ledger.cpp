@@ -36,6 +36,7 @@ LedgerEntry ledger_entry(const MaterialModel& model, const Comparison& compariso
   std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S", &local);
   e.time = buffer;
   e.effects = model_effects(model);
+  e.coarse_grain = model.coarse_grain;
   for (const std::string& key : parameter_keys) e.parameters[key] = get_parameter(model, key);
   for (const Term& term : comparison.terms) e.residuals[term.name()] = term.residual;
   e.chi2 = comparison.chi2;
@@ -62,6 +63,7 @@ std::vector<LedgerEntry> read_ledger(const std::string& path) {
       e.chi2 = v["chi2"].as<double>(0);
       e.n = v["n"].as<int>(0);
       e.verdict = v["verdict"].as<std::string>("");
+      e.coarse_grain = v["coarse_grain"].as<double>(1.0);
       out.push_back(std::move(e));
     }
   } catch (const YAML::Exception& error) {
@@ -84,6 +86,7 @@ std::vector<LedgerEntry> append_ledger(const std::string& path, const std::strin
     out << YAML::Key << "label" << YAML::Value << e.label;
     out << YAML::Key << "time" << YAML::Value << e.time;
     out << YAML::Key << "effects" << YAML::Value << YAML::Flow << e.effects;
+    out << YAML::Key << "coarse_grain" << YAML::Value << e.coarse_grain;
     out << YAML::Key << "parameters" << YAML::Value << YAML::Flow << YAML::BeginMap;
     for (const auto& [k, v] : e.parameters) out << YAML::Key << k << YAML::Value << v;
     out << YAML::EndMap;

@@ -54,6 +54,10 @@ std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup
                      number(options.rayleigh_fraction > 0 ? options.rayleigh_fraction : kLabRayleighFraction), number(kLabStepsPerContact));
   out += fmt::format("seed: {}\nsize_factor: {}\nmass_scaling: {}\nstiffness_scaling: {}\n", options.seed, number(options.size_factor),
                      number(model.mass_scaling), number(model.stiffness_scaling));
+  // Parcels are another simulation of the same material (core/coarse_grain.h): keyed by their
+  // factor, written only when there are parcels, so the stored simulations of real particles
+  // keep the keys they were stored under.
+  if (model.coarse_grain != 1.0) out += fmt::format("coarse_grain: {}\n", number(model.coarse_grain));
   describe(out, "particle", model.particle);
   const ContactSpec& c = model.contact;
   // Single stages, then the lists: the order the stored simulations are keyed by.

@@ -1,6 +1,6 @@
 // The store of finished simulations of a calibration command (OUT/simulations/): each virtual
 // test run is kept, as it finishes, in a file of its own (written atomically) holding its inputs
-// (set-up, material, seed, size factor, scaling, engine version) and its outcome. A simulation
+// (set-up, material, seed, size factor, scaling, coarse grain, engine version) and its outcome. A simulation
 // whose inputs match a stored one is not run again: across a rerun after an interruption, and
 // across commands that share the folder (the compare before a calibrate, the plain model's pass
 // of a diagnose). Outcomes are stored with 17 significant digits, so a stored outcome is the

@@ -44,7 +44,8 @@ namespace {
 
 constexpr double kTargetInertialNumber = 8e-4;
 
-/// d50 by mass and the mean particle volume, from reproducible draws.
+/// d50 by mass and the mean particle volume, from reproducible draws: of the particles the cell
+/// simulates, parcels of model.coarse_grain (as detail::size_figures gives them to the other tests).
 struct Sizes {
   double d50 = 0, mean_volume = 0, largest = 0;
 };
@@ -64,6 +65,8 @@ Sizes sizes_of(const MaterialModel& model) {
   }
   s.mean_volume = volume / static_cast<double>(d.size());
   s.largest = d.back();
+  const double f = model.coarse_grain;
+  s.d50 *= f, s.largest *= f, s.mean_volume *= f * f * f;
   return s;
 }
 
@@ -129,9 +132,11 @@ CaseSpec shear_case(const MaterialModel& model, const TestOptions& options, cons
   spec.planes.push_back(top);
   for (const auto& [wall, z] : {std::pair<std::string, double>{"bottom", 0.5 * cell.d_glue},
                                 {"top", cell.top_start - 0.5 * cell.d_glue}}) {
+    // Every set stated as a case states it, real diameters with the factor (detail::particle_box).
     ParticleSetSpec glued;
     glued.material = particle.name;
-    glued.diameter.value = cell.d_glue;
+    glued.diameter.value = cell.d_glue / model.coarse_grain;
+    glued.coarse_grain = model.coarse_grain;
     glued.positions = glued_layer(cell, z);
     glued.count = static_cast<std::int64_t>(glued.positions.size());
     glued.attach_to = wall;
@@ -141,7 +146,8 @@ CaseSpec shear_case(const MaterialModel& model, const TestOptions& options, cons
   sample.material = particle.name;
   sample.clump = model.shape.empty() ? "" : "shape";
   sample.diameter = model.diameter;
-  sample.count = cell.count;
+  sample.coarse_grain = model.coarse_grain;
+  sample.count = detail::real_count(cell.count, model.coarse_grain);
   sample.region_min = Vec3(0, 0, cell.fill_low);
   sample.region_max = Vec3(cell.length, cell.width, cell.fill_high);
   spec.particles.push_back(sample);
@@ -471,6 +477,7 @@ SimulatedOutcome run_direct_shear(const MaterialModel& material, const TestSetup
   const double unload_speed = unload(plan, run, out);
   const Peak peak = shear_past_peak(plan, run, unload_speed, out);
   report_shear(plan, run, peak, out);
+  if (material.coarse_grain != 1.0) out.notes.push_back(detail::coarse_grain_note(material.coarse_grain, out.particles));
   out.simulated_seconds = run.state.time;
   out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
   if (options.on_final) options.on_final(run.model, run.state);

@@ -34,7 +34,7 @@ SimulatedOutcome run_drop_rebound(const MaterialModel& model, const TestSetup& s
   const double reach = 0.5 * size.d50 * size.bounding_factor;
   ParticleSetSpec one = particle_box(model, 0, Vec3::Zero(), Vec3::Zero());
   one.diameter = SizeDistributionSpec{};
-  one.diameter.value = size.d50;
+  one.diameter.value = size.d50 / size.coarse_grain;  // stated real, as particle_box states a set: compile makes it the parcel
   one.positions.push_back(Vec3(0, 0, reach + height));
   one.velocity = Vec3(tangential, 0, 0);
   spec.particles.push_back(one);

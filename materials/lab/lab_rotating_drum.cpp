@@ -193,7 +193,9 @@ Fill add_fill(const MaterialModel& model, const TestOptions& options, const Drum
     const double half = inner / std::sqrt(2.0), half_y = 0.5 * depth - (periodic ? 0.0 : 0.5 * spacing);
     InletSpec inlet;
     inlet.name = "fill", inlet.material = set.material, inlet.diameter = set.diameter, inlet.clump = set.clump;
-    inlet.count = count;
+    // Stated as particle_box states a set: real particles and the factor, `count` parcels inserted.
+    inlet.coarse_grain = set.coarse_grain;
+    inlet.count = real_count(count, set.coarse_grain);
     inlet.region_min = Vec3(-half, -half_y, -half), inlet.region_max = Vec3(half, half_y, half);
     spec.inlets.push_back(inlet);
   } else {

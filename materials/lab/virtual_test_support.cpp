@@ -11,6 +11,7 @@
 
 #include "bodies/clump_geometry.h"
 #include "case/yaml_check.h"
+#include "core/coarse_grain.h"
 #include "core/particles.h"
 #include "core/step.h"
 
@@ -24,7 +25,11 @@ constexpr double kPi = std::numbers::pi;
 
 void SetupReader::fail(const std::string& key, const std::string& message) const {
   const std::string experiment = setup_.id.empty() ? "" : fmt::format("experiment '{}': ", setup_.id);
-  throw CaseError(fmt::format("{}: {}{}.setup.{}: {}", setup_.location.str(), experiment, setup_.test, key, message));
+  // A check of what the apparatus holds counts parcels when the tests are coarse-grained.
+  const std::string parcels = model_.coarse_grain == 1.0 ? std::string()
+                                                         : fmt::format(" (the test runs parcels of coarse_grain {:g}: {:g} x the diameter)",
+                                                                       model_.coarse_grain, model_.coarse_grain);
+  throw CaseError(fmt::format("{}: {}{}.setup.{}: {}{}", setup_.location.str(), experiment, setup_.test, key, message, parcels));
 }
 
 void SetupReader::finish() const {
@@ -102,6 +107,10 @@ SizeFigures size_figures(const MaterialModel& model) {
   }
   out.mean_volume = kPi / 6 * sum_cube / static_cast<double>(d.size());
   out.largest = model.diameter.largest();
+  // Parcels: every diameter F times the real one (core/coarse_grain.h parcel_diameters).
+  const double f = model.coarse_grain;
+  out.coarse_grain = f;
+  out.d50 *= f, out.largest *= f, out.mean_volume *= f * f * f;
   if (!model.shape.empty()) {
     const ClumpTemplateSpec& t = model.shape[0];
     std::vector<ClumpSphere> spheres;
@@ -154,12 +163,24 @@ CaseSpec base_case(const MaterialModel& model, const TestOptions& options, const
   return spec;
 }
 
+std::int64_t real_count(std::int64_t simulated, double coarse_grain) {
+  return std::llround(static_cast<double>(simulated) * coarse_grain * coarse_grain * coarse_grain);
+}
+
+std::string coarse_grain_note(double coarse_grain, std::int64_t parcels) {
+  const double f = coarse_grain;
+  return fmt::format("coarse grain {:g}: {} parcels of {:g} x the real diameter standing for about {:.4g} real particles, the real "
+                     "apparatus, the contact parameters scaled by stress similarity (core/coarse_grain.h)",
+                     f, parcels, f, static_cast<double>(parcels) * f * f * f);
+}
+
 ParticleSetSpec particle_box(const MaterialModel& model, std::int64_t count, const Vec3& lo, const Vec3& hi) {
   ParticleSetSpec set;
   set.material = particle_name(model);
   if (!model.shape.empty()) set.clump = model.shape[0].name.empty() ? "shape" : model.shape[0].name;
   set.diameter = model.diameter;
-  set.count = count;
+  set.coarse_grain = model.coarse_grain;
+  set.count = real_count(count, model.coarse_grain);
   set.region_min = lo, set.region_max = hi;
   return set;
 }
@@ -286,6 +307,10 @@ void finish(SimulatedOutcome& out, const Runner& run, const Clock& clock, std::i
   out.wall_seconds = clock.seconds();
   if (run.model.mass_scaling != 1.0) out.notes.push_back(fmt::format("mass scaling {:g}", run.model.mass_scaling));
   if (run.model.stiffness_scaling != 1.0) out.notes.push_back(fmt::format("stiffness scaling {:g}", run.model.stiffness_scaling));
+  if (run.model.coarse_grain != 1.0) {
+    out.notes.push_back(coarse_grain_note(run.model.coarse_grain, particles));
+    for (const std::string& warning : narrow_openings(run.model)) out.notes.push_back("WARNING: " + warning);
+  }
   out.notes.push_back(fmt::format("time step {:.3g} s", run.model.dt));
   if (options.on_final) options.on_final(run.model, run.state);
 }

@@ -48,16 +48,27 @@ class SetupReader {
 /// The particle material's name in the test cases: model.name, or "particle".
 std::string particle_name(const MaterialModel& model);
 
-/// Sizes of the distribution from 4000 reproducible draws: d50 by mass and the mean particle
-/// volume (pi/6 E[d^3]; a clump template is scaled to its volume-equivalent diameter).
+/// Sizes of the particles the test simulates, from 4000 reproducible draws: d50 by mass and the
+/// mean particle volume (pi/6 E[d^3]; a clump template is scaled to its volume-equivalent
+/// diameter). With model.coarse_grain = F these are the parcels' (every diameter x F, volumes x
+/// F^3): a test sizes its fill, lattice, bins and checks by what it simulates, in the real apparatus.
 struct SizeFigures {
   double d50 = 0;              // [m] median by mass
   double mean_volume = 0;      // [m^3]
   double largest = 0;          // [m] largest diameter
   double bounding_factor = 1;  // [-] clump bounding diameter / equivalent diameter (1: spheres)
+  double coarse_grain = 1;     // [-] the factor the figures include (model.coarse_grain)
   double mass_of(double count, double density) const { return count * mean_volume * density; }
 };
 SizeFigures size_figures(const MaterialModel& model);
+
+/// The real particles `simulated` parcels of factor `coarse_grain` stand for, as a case counts
+/// them (a set's or an inlet's `count`): round(simulated F^3), which compile's parcel_count turns
+/// back into `simulated` (|rounding| <= 1/2 before the division by F^3 >= 1).
+std::int64_t real_count(std::int64_t simulated, double coarse_grain);
+
+/// The note every coarse-grained test adds: F, the parcels and the real particles they stand for.
+std::string coarse_grain_note(double coarse_grain, std::int64_t parcels);
 
 /// The case every test starts from: the particle material, the named wall materials, the
 /// contact law, the particle-wall pairs of those walls (a pair side that is not a wall
@@ -65,7 +76,12 @@ SizeFigures size_figures(const MaterialModel& model);
 CaseSpec base_case(const MaterialModel& model, const TestOptions& options, const std::vector<std::string>& walls,
                    const std::string& title);
 
-/// `count` particles of the model placed at random without overlap in the box [lo, hi].
+/// `count` particles of the model placed at random without overlap in the box [lo, hi]. `count`
+/// is what the test simulates (parcels with model.coarse_grain = F); the set is stated as a case
+/// states it, the real size distribution with `coarse_grain: F` and real_count(count, F), which
+/// compile turns into `count` parcels F times the diameter, their contact parameters scaled.
+/// Rejected: the parcel distribution stated as real particles, which would keep the parcels'
+/// sizes but not scale the contact law (a linear spring's stiffness, a surface energy).
 ParticleSetSpec particle_box(const MaterialModel& model, std::int64_t count, const Vec3& lo, const Vec3& hi);
 
 /// Vertices and triangles of an inline mesh under construction.

@@ -59,6 +59,9 @@ SimulatedOutcome run_virtual_test(const MaterialModel& model, const TestSetup& s
   if (!e) throw CaseError(fmt::format("{}: test: unknown test '{}'; valid: {}", setup.location.str(), setup.test, fmt::join(test_names(), ", ")));
   if (!(options.size_factor > 0 && options.size_factor <= 1))
     throw CaseError(fmt::format("size factor {:g} is out of range; valid: above 0, at most 1 (--size-factor)", options.size_factor));
+  if (!(model.coarse_grain >= 1.0 && model.coarse_grain <= kMostCoarseGrain))
+    throw CaseError(fmt::format("coarse grain {:g} is out of range; valid: [1, {:g}] (--coarse-grain; 1: real particles)", model.coarse_grain,
+                                kMostCoarseGrain));
   // `threads` is this thread's OpenMP setting for the test's duration, given back afterwards:
   // the engine's parallel regions read it (omp_get_max_threads), not the compiled model.
   const int before = omp_get_max_threads();

@@ -31,6 +31,13 @@ struct MaterialModel {
   /// again as wall-parameter candidates.
   std::vector<std::string> fitted_first;
   double mass_scaling = 1.0, stiffness_scaling = 1.0;  ///< applied to the virtual tests (reported)
+  /// [-] Coarse graining of the virtual tests (core/coarse_grain.h): the real apparatus filled
+  /// with parcels of coarse_grain x the diameter, each standing for coarse_grain^3 particles, the
+  /// contact parameters scaled by the stress-similarity law (--coarse-grain). 1: real particles.
+  /// A state of the material in the tests, as the scalings are, rather than an option of one
+  /// comparison: every copy a calibration or diagnosis makes of the model (a candidate, the fit)
+  /// keeps it, the store keys its simulations by it and the calibrated file records it.
+  double coarse_grain = 1.0;
 };
 
 /// The set-up of one experiment as the measurement file gives it: numbers (lengths in m,

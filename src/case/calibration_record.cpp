@@ -68,6 +68,7 @@ CalibrationRecord read_calibration_record(const YAML::Node& node, const std::str
     if (!(s >= 0)) map.fail("sigma", "standard deviations must not be negative");
   r.chi2_per_n = map.number("chi2_per_n", 0.0, 0.0, 1e12);
   r.stiffness_scaling = map.number("stiffness_scaling", 1.0, 1e-9, 1e9);
+  r.coarse_grain = map.number("coarse_grain", 1.0, 1.0, kMostCoarseGrain, "-");
   const YAML::Node rows = map.node("correlation");
   if (!rows || !rows.IsSequence() || rows.size() != n) map.fail("correlation", fmt::format("must be a {0} x {0} matrix (a list of {0} rows)", n));
   Eigen::MatrixXd c(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));

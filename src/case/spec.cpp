@@ -326,6 +326,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& file, const Librar
   top.node("sweep");  // read by the sweep runner (app/campaign/sweep.cpp) before the variants are parsed
   top.node("uncertainty");  // likewise (app/campaign/uncertainty.h)
   top.node("bias_check");   // likewise (app/campaign/bias_check.h)
+  top.node("coarse_grain_check");  // likewise (app/campaign/bias_check.h)
   spec.output = read_output(top.node("output"), file, file);
   top.finish();
   return spec;

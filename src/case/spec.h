@@ -55,6 +55,9 @@ struct CalibrationRecord {
   std::vector<std::vector<double>> correlation;  ///< symmetric, unit diagonal, positive semi-definite
   double chi2_per_n = 0;     ///< of the calibrated model against the measurements
   double stiffness_scaling = 1;  ///< factor on Young's modulus the virtual tests used in the fit
+  /// [-] The coarse_grain the virtual tests ran at (parcels of F x the diameter; core/coarse_grain.h):
+  /// a case at another coarse_grain is told so in its set-up log. 1: real particles.
+  double coarse_grain = 1;
   SourceLocation location;
 };
 

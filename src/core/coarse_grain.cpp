@@ -175,6 +175,26 @@ std::vector<std::string> narrow_openings(const Model& model) {
   return warnings;
 }
 
+std::vector<std::string> calibration_coarse_grain_notes(const CaseSpec& spec, double coarse_grain) {
+  std::vector<std::string> notes;
+  for (const MaterialSpec& m : spec.materials) {
+    if (!m.calibration) continue;
+    const auto made_of = [&](const auto& sources) {
+      return std::any_of(sources.begin(), sources.end(), [&](const auto& s) { return s.material == m.name; });
+    };
+    if (!made_of(spec.particles) && !made_of(spec.inlets)) continue;  // a wall material's calibration has no parcels
+    const double calibrated = m.calibration->coarse_grain;
+    if (std::abs(calibrated - coarse_grain) <= 1e-9 * coarse_grain) continue;
+    notes.push_back(fmt::format(
+        "{} ({}) was calibrated at coarse_grain {:g} and is used here at coarse_grain {:g}: the scaling law carries it (stress "
+        "similarity, core/coarse_grain.h), but the fit was made at the other parcel size; compare at {:g} to check "
+        "(demdesign compare {} {} --coarse-grain {:g}), or add `coarse_grain_check:` to see what the parcel size moves",
+        m.name, m.library_file, calibrated, coarse_grain, coarse_grain, m.library_file,
+        m.calibration->measurements.empty() ? std::string("MEASUREMENTS") : m.calibration->measurements, coarse_grain));
+  }
+  return notes;
+}
+
 std::vector<std::string> describe_coarse_grain(const CaseSpec& spec, const Model& model) {
   const double f = model.coarse_grain;
   if (f == 1.0) return {};

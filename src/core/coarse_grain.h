@@ -87,6 +87,13 @@ void scale_pair_parameters(Model& model);
 /// are widths of a passage the bulk flows through. Empty when none is found.
 std::vector<std::string> narrow_openings(const Model& model);
 
+/// Notes for the set-up log on each library material the case's particles are made of whose
+/// calibration ran its virtual tests at another coarse_grain than `coarse_grain`, the case's
+/// (CalibrationRecord::coarse_grain): the law above carries a fit from one parcel size to another
+/// in principle, but only a comparison at the case's F shows it holds. Never silent: a mismatch
+/// of any size is named. Empty when every calibrated material matches.
+std::vector<std::string> calibration_coarse_grain_notes(const CaseSpec& spec, double coarse_grain);
+
 /// What coarse graining does in this run, in lines for the set-up log and the run report: F, each
 /// set's and inlet's parcel diameters and counts, the parameters scaled and by what factor, what
 /// the results are, its limits and the warnings of narrow_openings. Empty when F = 1.

@@ -636,6 +636,7 @@ Model compile(const CaseSpec& spec, const MeshLoader& loader) {
   // Contact law: materials, effects, per-pair parameters (scaled for parcels, core/coarse_grain.h).
   add_materials(spec, model);
   model.coarse_grain = case_coarse_grain(spec);
+  for (std::string& note : calibration_coarse_grain_notes(spec, model.coarse_grain)) model.notes.push_back(std::move(note));
   switch_on_effects(spec.contact, model);
   fill_pair_table(spec, model);
 
