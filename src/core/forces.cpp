@@ -505,20 +505,10 @@ DEM_KERNEL void evaluate_effects(const Model& model, ContactBatch& b) {
   copy_histories<false>(b, model.history_width);
 }
 
-void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
-  ForcePass pass;
-  pass.kick = kick;
-  compute_forces(model, s, work, pass);
-}
+namespace {
 
-void compute_forces(const Model& model, State& s, Workspace& work, const ForcePass& pass) {
-  const double kick = pass.kick;
-  const long n_all = static_cast<long>(s.size());
-  const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
-  const std::int32_t owned = static_cast<std::int32_t>(n);
-  const bool periodic = model.periodic();
-  const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
-  const bool near = work.near.valid && work.near.trusted;
+/// Readies the pair list's scan: the near pairs' margin, age and time, and the pair forces kept.
+inline void prepare_pair_scan(const Model& model, const State& s, Workspace& work, bool near) {
   if (!near && work.near.valid) {
     // A full scan because spheres moved half the margin: the margin follows the motion, so that
     // the near pairs last 4-16 steps (a rebuild's scan leaves it as it is). Its size changes the
@@ -533,13 +523,14 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
   if (!near) work.near.time = work.mesh_time;
   if (work.keep_pair_forces && work.pair_forces.fx.size() != s.pairs.size())  // asked for since the lists were built
     for (auto* c : {&work.pair_forces.fx, &work.pair_forces.fy, &work.pair_forces.fz}) c->assign(s.pairs.size(), 0.0);
-  // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
-  // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
-  const bool finish_in_pass = !ghosts && !work.domain;
-  // The next step's drift tests positions against the lists as they are after this pass.
-  const bool ahead = pass.drift_ahead && kick != 0.0 && finish_in_pass;
-  // The drift ahead brings the spheres to the next step's time.
-  const DriftLimits limits = ahead ? drift_limits(model, s, work, /*near_valid=*/true, s.time + 2.0 * model.dt) : DriftLimits{};
+}
+
+/// The block pass on every thread (with finish_in_pass, also each block's meshes, gravity and kick); returns the drift ahead's Moved flags.
+inline int contact_pass(const Model& model, State& s, Workspace& work, double kick, bool near, bool finish_in_pass, const DriftLimits* ahead) {
+  const long n_all = static_cast<long>(s.size());
+  const long n = static_cast<long>(s.owned());
+  const bool periodic = model.periodic();
+  const bool ghosts = n_all > n;
   if (finish_in_pass) prepare_mesh_contacts(model, s, work);  // else mesh_contact_forces does
   share_blocks(work, n);
   work.records_turn = 0;
@@ -555,57 +546,65 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
     std::optional<MeshContactPass> meshes;
     if (finish_in_pass && !model.meshes.empty()) meshes.emplace(model, s, work);
     int thread_moved = 0;
-    const Finish finish{meshes ? &*meshes : nullptr, kick, ahead ? &limits : nullptr, &thread_moved};
+    const Finish finish{meshes ? &*meshes : nullptr, kick, ahead, &thread_moved};
     (near ? pass_of<Scan::kNear> : pass_of<Scan::kRefresh>)[periodic][ghosts](model, s, work, batch, finish_in_pass ? &finish : nullptr);
     if (meshes) sum_records_in_turn(model, s, work, n);
     moved |= thread_moved;
   }
-  if (finish_in_pass && !model.meshes.empty()) s.mesh_loads.integrate(model.dt);  // else mesh_contact_forces does
-  work.drifted_ahead = ahead ? (moved | untested(limits)) : -1;
-  work.drifts_ahead += ahead;
-  work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
-  work.near_refreshes += !near;
-  if (!finish_in_pass) {
-    if (!work.ghost_owners.empty()) {
-      // Pairs with ghosts (the subdomain's faces shared with its upper neighbours), in parallel
-      // over their owned spheres: each thread takes a run of them in slot order and adds to its
-      // own spheres; the loads on the ghosts, which several threads touch, are kept per contact
-      // and added after in pass order, so every sum is the serial one whatever the threads.
-      const long owners = static_cast<long>(work.ghost_owners.size());
-      const int threads = owners >= work.ghost_pass_parallel_min ? omp_get_max_threads() : 1;
-      work.ghost_loads.resize(static_cast<size_t>(threads));
-#pragma omp parallel num_threads(threads)
-      {
-        std::vector<double>& out = work.ghost_loads[static_cast<size_t>(omp_get_thread_num())];
-        out.clear();
-        Batch batch;
-        batch.ghost_loads = &out;
-        std::int32_t unused = 0;
-#pragma omp for schedule(static)  // contiguous runs in thread order
-        for (long e = 0; e < owners; ++e) {
-          const std::int32_t i = work.ghost_owners[static_cast<size_t>(e)];
-          (periodic ? list_contacts<true, true, Scan::kAll> : list_contacts<false, true, Scan::kAll>)(
-              model, s, work, batch, work.pair_begin[i], work.pair_begin[i + 1], owned, static_cast<std::int32_t>(n_all), unused);
-        }
-        flush(model, batch, s, work);
-      }
-      double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
-      for (int t = 0; t < threads; ++t) {
-        const std::vector<double>& loads = work.ghost_loads[static_cast<size_t>(t)];
-        for (size_t k = 0; k < loads.size(); k += 7) {
-          const size_t j = static_cast<size_t>(loads[k]);
-          fx[j] -= loads[k + 1], fy[j] -= loads[k + 2], fz[j] -= loads[k + 3];
-          tx[j] += loads[k + 4], ty[j] += loads[k + 5], tz[j] += loads[k + 6];
-        }
-      }
-    }
-    mesh_contact_forces(model, s, work);
-    if (work.domain) work.domain->return_ghost_loads(s);
-    // Gravity, and the closing half kick of free spheres.
-#pragma omp parallel if (n >= kParallelMin)
-    for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick, nullptr, model.dt); });
-  }
+  return moved;
+}
 
+/// The pairs with ghosts, after the block pass: loads on owned spheres added as they go, those on ghosts after.
+inline void ghost_pairs(const Model& model, State& s, Workspace& work) {
+  const long n_all = static_cast<long>(s.size());
+  const std::int32_t owned = static_cast<std::int32_t>(s.owned());
+  const bool periodic = model.periodic();
+  // Pairs with ghosts (the subdomain's faces shared with its upper neighbours), in parallel
+  // over their owned spheres: each thread takes a run of them in slot order and adds to its
+  // own spheres; the loads on the ghosts, which several threads touch, are kept per contact
+  // and added after in pass order, so every sum is the serial one whatever the threads.
+  const long owners = static_cast<long>(work.ghost_owners.size());
+  const int threads = owners >= work.ghost_pass_parallel_min ? omp_get_max_threads() : 1;
+  work.ghost_loads.resize(static_cast<size_t>(threads));
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<double>& out = work.ghost_loads[static_cast<size_t>(omp_get_thread_num())];
+    out.clear();
+    Batch batch;
+    batch.ghost_loads = &out;
+    std::int32_t unused = 0;
+#pragma omp for schedule(static)  // contiguous runs in thread order
+    for (long e = 0; e < owners; ++e) {
+      const std::int32_t i = work.ghost_owners[static_cast<size_t>(e)];
+      (periodic ? list_contacts<true, true, Scan::kAll> : list_contacts<false, true, Scan::kAll>)(
+          model, s, work, batch, work.pair_begin[i], work.pair_begin[i + 1], owned, static_cast<std::int32_t>(n_all), unused);
+    }
+    flush(model, batch, s, work);
+  }
+  double *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *tx = s.tx.data(), *ty = s.ty.data(), *tz = s.tz.data();
+  for (int t = 0; t < threads; ++t) {
+    const std::vector<double>& loads = work.ghost_loads[static_cast<size_t>(t)];
+    for (size_t k = 0; k < loads.size(); k += 7) {
+      const size_t j = static_cast<size_t>(loads[k]);
+      fx[j] -= loads[k + 1], fy[j] -= loads[k + 2], fz[j] -= loads[k + 3];
+      tx[j] += loads[k + 4], ty[j] += loads[k + 5], tz[j] += loads[k + 6];
+    }
+  }
+}
+
+/// With ghosts or ranks, what the block pass leaves, each a pass of its own: pairs with ghosts, meshes, gravity and kick.
+inline void finish_apart(const Model& model, State& s, Workspace& work, double kick) {
+  const long n = static_cast<long>(s.owned());
+  if (!work.ghost_owners.empty()) ghost_pairs(model, s, work);
+  mesh_contact_forces(model, s, work);
+  if (work.domain) work.domain->return_ghost_loads(s);
+  // Gravity, and the closing half kick of free spheres.
+#pragma omp parallel if (n >= kParallelMin)
+  for_own_blocks(work, n, [&](long begin, long end) { gravity_kick_range(model.gravity.data(), s, begin, end, kick, nullptr, model.dt); });
+}
+
+/// Each body's force and torque from its spheres plus its weight, then (kick != 0) its closing half kick.
+inline void body_loads(const Model& model, State& s, const Workspace& work, double kick) {
   // Bodies: force and torque about the centre of mass from their spheres, plus weight.
   const double gx = model.gravity[0], gy = model.gravity[1], gz = model.gravity[2];
   Bodies& bodies = s.bodies;
@@ -629,7 +628,11 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
       bodies.lx[b] += kick * tx, bodies.ly[b] += kick * ty, bodies.lz[b] += kick * tz;
     }
   }
+}
 
+/// The force on each wall: the reaction of its contacts, plus the loads of the spheres glued to it.
+inline void wall_loads(const Model& model, State& s, const Workspace& work) {
+  const long n = static_cast<long>(s.owned());
   // Force on each wall (reaction of its contacts), summed in list order.
   const ContactForces& wf = work.wall_forces;
   for (auto* column : {&s.walls.fx, &s.walls.fy, &s.walls.fz}) std::fill(column->begin(), column->end(), 0.0);
@@ -653,6 +656,39 @@ void compute_forces(const Model& model, State& s, Workspace& work, const ForcePa
     if (w < 0) continue;
     s.walls.fx[w] += s.fx[p], s.walls.fy[w] += s.fy[p], s.walls.fz[w] += s.fz[p];
   }
+}
+
+}  // namespace
+
+void compute_forces(const Model& model, State& s, Workspace& work, double kick) {
+  ForcePass pass;
+  pass.kick = kick;
+  compute_forces(model, s, work, pass);
+}
+
+void compute_forces(const Model& model, State& s, Workspace& work, const ForcePass& pass) {
+  const double kick = pass.kick;
+  const long n_all = static_cast<long>(s.size());
+  const long n = static_cast<long>(s.owned());  // ghosts: forces returned to their owners
+  const bool ghosts = n_all > n;  // the block pass skips them: their pairs are evaluated apart
+  const bool near = work.near.valid && work.near.trusted;
+  prepare_pair_scan(model, s, work, near);
+  // Without ghosts the block pass finishes each block's spheres (meshes, gravity, kick) as soon
+  // as their pair contacts are summed, while they are in cache: two passes and their barriers less.
+  const bool finish_in_pass = !ghosts && !work.domain;
+  // The next step's drift tests positions against the lists as they are after this pass.
+  const bool ahead = pass.drift_ahead && kick != 0.0 && finish_in_pass;
+  // The drift ahead brings the spheres to the next step's time.
+  const DriftLimits limits = ahead ? drift_limits(model, s, work, /*near_valid=*/true, s.time + 2.0 * model.dt) : DriftLimits{};
+  const int moved = contact_pass(model, s, work, kick, near, finish_in_pass, ahead ? &limits : nullptr);
+  if (finish_in_pass && !model.meshes.empty()) s.mesh_loads.integrate(model.dt);  // else mesh_contact_forces does
+  work.drifted_ahead = ahead ? (moved | untested(limits)) : -1;
+  work.drifts_ahead += ahead;
+  work.near.valid = true, work.near.trusted = false, work.loads_cleared = false;
+  work.near_refreshes += !near;
+  if (!finish_in_pass) finish_apart(model, s, work, kick);
+  body_loads(model, s, work, kick);
+  wall_loads(model, s, work);
 }
 
 }  // namespace dem

@@ -255,6 +255,174 @@ MeshContactPass::MeshContactPass(const Model& model, State& state, Workspace& wo
 
 MeshContactPass::~MeshContactPass() = default;
 
+namespace {
+
+/// Slot p's contacts of the last step (mesh, point, history into old_history); returns how many.
+inline int load_last_contacts(const MeshContacts& mc, long p, int width, std::int32_t old_mesh[kSlots], double old_point[kSlots][3],
+                              std::vector<double>& old_history) {
+  const int old_count = mc.count[p];
+  for (int k = 0; k < old_count; ++k) {
+    const size_t slot = static_cast<size_t>(p) * kSlots + k;
+    old_mesh[k] = mc.mesh[slot];
+    old_point[k][0] = mc.px[slot], old_point[k][1] = mc.py[slot], old_point[k][2] = mc.pz[slot];
+    if (width) std::memcpy(&old_history[k * width], &mc.history[slot * width], width * sizeof(double));
+  }
+  return old_count;
+}
+
+/// [m] The distance at the build beyond which slot p's candidates cannot touch (infinite: none skipped).
+inline double skip_beyond(const State& s, long p, double radius, double range, const double* gaps, double meshes_moved) {
+  // Candidates farther from the sphere at the build than its reach plus how far it and the
+  // meshes have moved since cannot touch (the distance to a fixed triangle changes by at most
+  // the displacement): skipped unread. The margin of 1e-9 keeps rounding from skipping one
+  // that the exact test would take.
+  double beyond = std::numeric_limits<double>::infinity();
+  if (gaps && std::isfinite(meshes_moved)) {
+    const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
+    beyond = (radius + range + std::sqrt(dx * dx + dy * dy + dz * dz) + meshes_moved) * (1 + 1e-9);
+  }
+  return beyond;
+}
+
+/// Mesh m's candidates from q on into list (closest points within reach of `local`); returns the next mesh's first.
+inline std::int32_t closest_in_reach(const State& s, const TriangleSurface& surface, std::int32_t m, std::int32_t q, std::int32_t last,
+                                     const double local[3], double radius, double range, const double* gaps, double beyond,
+                                     std::vector<Candidate>& list) {
+  list.clear();
+  const double reach2 = (radius + range) * (radius + range);
+  for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
+    if (gaps && gaps[q] > beyond) continue;
+    const std::int32_t t = s.mesh_candidates[q][1];
+    const auto& tri = surface.triangles[t];
+    // The plane's distance bounds the triangle's from below: most candidates of a sphere
+    // moving over a surface are out of reach of its plane, and cost a dot product.
+    const double* v0 = surface.vertices[tri[0]].data();
+    const double* normal = surface.normals[t].data();
+    const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
+    if (above * above >= reach2) continue;
+    const ClosestPoint cp = closest_point_on_triangle(local, v0, surface.vertices[tri[1]].data(), surface.vertices[tri[2]].data());
+    if (cp.distance2 < reach2) list.push_back({t, cp});
+  }
+  return q;
+}
+
+/// The velocity and spin of mesh m's surface at a contact point (world) on its triangle t.
+[[gnu::always_inline]] inline void wall_motion(const Workspace& work, std::int32_t m, const MeshWall& mesh, const TriangleSurface& surface,
+                                               std::int32_t t, const double point[3], double wall_v[3], double wall_w[3]) {
+  const auto& rot = work.mesh_rotation[m];
+  // Wall velocity at the contact: rigid motion plus the surface's own (belts, pulleys).
+  double arm[3] = {point[0] - work.mesh_origin[m][0], point[1] - work.mesh_origin[m][1], point[2] - work.mesh_origin[m][2]};
+  cross(work.mesh_angular[m].data(), arm, wall_v);
+  for (int a = 0; a < 3; ++a) wall_v[a] += work.mesh_linear[m][a];
+  wall_w[0] = work.mesh_angular[m][0], wall_w[1] = work.mesh_angular[m][1], wall_w[2] = work.mesh_angular[m][2];
+  const SurfaceVelocitySpec& sv = mesh.surface_velocity;
+  if (sv.kind == SurfaceVelocitySpec::Kind::linear) {
+    double tri_normal[3];
+    mul(rot, surface.normals[t].data(), tri_normal);
+    const double along = sv.velocity.x() * tri_normal[0] + sv.velocity.y() * tri_normal[1] + sv.velocity.z() * tri_normal[2];
+    for (int a = 0; a < 3; ++a) wall_v[a] += sv.velocity[a] - along * tri_normal[a];
+  } else if (sv.kind == SurfaceVelocitySpec::Kind::rotation) {
+    const double w[3] = {sv.axis.x() * sv.angular_speed, sv.axis.y() * sv.angular_speed, sv.axis.z() * sv.angular_speed};
+    const double r[3] = {point[0] - sv.point.x(), point[1] - sv.point.y(), point[2] - sv.point.z()};
+    double v[3];
+    cross(w, r, v);
+    for (int a = 0; a < 3; ++a) wall_v[a] += v[a], wall_w[a] += w[a];
+  }
+}
+
+/// The unused contact of the last step on mesh m nearest to `point` (mesh frame) within a radius; -1: none.
+[[gnu::always_inline]] inline int continued_contact(int old_count, const std::int32_t old_mesh[kSlots], const double old_point[kSlots][3],
+                                                    const bool old_used[kSlots], std::int32_t m, const double point[3], double radius) {
+  int match = -1;
+  double best = radius * radius;
+  for (int o = 0; o < old_count; ++o) {
+    if (old_used[o] || old_mesh[o] != m) continue;
+    const double dx = old_point[o][0] - point[0], dy = old_point[o][1] - point[1], dz = old_point[o][2] - point[2];
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 < best) best = d2, match = o;
+  }
+  return match;
+}
+
+/// Adds the first `kept` of mesh m's contacts with slot p (list) to the batch and the slot's contacts from `count` on; returns the new count.
+inline int add_contacts(const Model& model, State& s, Workspace& work, MeshBatch& mb, const std::vector<Candidate>& list, int kept, long p,
+                        std::int32_t first, std::int32_t m, const double local[3], double radius, int count, int old_count,
+                        const std::int32_t old_mesh[kSlots], const double old_point[kSlots][3], bool old_used[kSlots],
+                        std::vector<double>& old_history) {
+  const int width = model.history_width;
+  MeshContacts& mc = s.mesh_contacts;
+  MeshSlotResults& slot_results = work.mesh_slots;
+  const MeshWall& mesh = model.meshes[m];
+  const TriangleSurface& surface = *mesh.surface;
+  const auto& rot = work.mesh_rotation[m];
+  for (int k = 0; k < kept && count < kSlots; ++k) {
+    const Candidate& c = list[k];
+    // Separate meshes meeting at an edge (chute parts) give the same contact twice.
+    double world_point[3];
+    mul(rot, c.closest.point, world_point);
+    bool seen = false;
+    for (int e = mb.b.count - count; e < mb.b.count && !seen; ++e) {
+      const double dx = mb.point[e][0] - world_point[0] - work.mesh_translation[m][0];
+      const double dy = mb.point[e][1] - world_point[1] - work.mesh_translation[m][1];
+      const double dz = mb.point[e][2] - world_point[2] - work.mesh_translation[m][2];
+      seen = dx * dx + dy * dy + dz * dz <= 1e-12 * radius * radius;
+    }
+    if (seen) continue;
+    const double dist = std::sqrt(c.closest.distance2);
+    double normal_local[3];
+    if (dist > 1e-12 * radius) {
+      for (int a = 0; a < 3; ++a) normal_local[a] = (local[a] - c.closest.point[a]) / dist;
+    } else {
+      for (int a = 0; a < 3; ++a) normal_local[a] = surface.normals[c.triangle][a];
+    }
+    double normal[3], point[3];
+    mul(rot, normal_local, normal);
+    mul(rot, c.closest.point, point);
+    for (int a = 0; a < 3; ++a) point[a] += work.mesh_translation[m][a];
+    double wall_v[3], wall_w[3];
+    wall_motion(work, m, mesh, surface, c.triangle, point, wall_v, wall_w);
+    // The same contact as last step: same mesh, nearest point within a radius.
+    const size_t slot = static_cast<size_t>(p) * kSlots + count;
+    const int match = continued_contact(old_count, old_mesh, old_point, old_used, m, c.closest.point, radius);
+    if (width) {
+      if (match >= 0) std::memcpy(&mc.history[slot * width], &old_history[match * width], width * sizeof(double));
+      else std::fill_n(&mc.history[slot * width], width, 0.0);
+    }
+    if (match >= 0) old_used[match] = true;
+    mc.mesh[slot] = m, mc.triangle[slot] = c.triangle;
+    mc.px[slot] = c.closest.point[0], mc.py[slot] = c.closest.point[1], mc.pz[slot] = c.closest.point[2];
+    // Geometry and motion for the effects; a wall is flat (infinite radius).
+    ContactBatch& b = mb.b;
+    const int e = b.count++;
+    const double lever = dist;
+    const double vix = s.vx[p] - lever * (s.wy[p] * normal[2] - s.wz[p] * normal[1]);
+    const double viy = s.vy[p] - lever * (s.wz[p] * normal[0] - s.wx[p] * normal[2]);
+    const double viz = s.vz[p] - lever * (s.wx[p] * normal[1] - s.wy[p] * normal[0]);
+    const double rx = vix - wall_v[0], ry = viy - wall_v[1], rz = viz - wall_v[2];
+    const double vn = rx * normal[0] + ry * normal[1] + rz * normal[2];
+    b.nx[e] = normal[0], b.ny[e] = normal[1], b.nz[e] = normal[2];
+    b.vn[e] = vn;
+    b.vtx[e] = rx - vn * normal[0], b.vty[e] = ry - vn * normal[1], b.vtz[e] = rz - vn * normal[2];
+    b.wx[e] = s.wx[p] - wall_w[0], b.wy[e] = s.wy[p] - wall_w[1], b.wz[e] = s.wz[p] - wall_w[2];
+    b.pair_type[e] = model.pair_type(s.material[p], mesh.material);
+    b.overlap[e] = radius - dist;
+    b.radius_i[e] = radius, b.radius_j[e] = 0.0, b.r_eff[e] = radius;
+    b.m_eff[e] = 1.0 / s.inv_mass[p];
+    b.inertia_eff[e] = 1.4 * radius * radius / s.inv_mass[p];
+    b.history[e] = width ? &mc.history[slot * width] : old_history.data();
+    const size_t at = static_cast<size_t>(first) + static_cast<size_t>(count);  // results
+    mb.slot[e] = static_cast<std::int32_t>(slot);
+    mb.result[e] = static_cast<std::int32_t>(at);
+    mb.lever[e] = lever;
+    for (int a = 0; a < 3; ++a) mb.wall_v[e][a] = wall_v[a], mb.point[e][a] = point[a];
+    slot_results.impact_energy[at] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
+    ++count;
+  }
+  return count;
+}
+
+}  // namespace
+
 void MeshContactPass::run(long begin, long end) {
   const Model& model = model_;
   State& s = s_;
@@ -262,7 +430,6 @@ void MeshContactPass::run(long begin, long end) {
   if (model.meshes.empty()) return;
   const int width = model.history_width;
   MeshContacts& mc = s.mesh_contacts;
-  MeshSlotResults& slot_results = work.mesh_slots;
   const double range = model.interaction_range;
   MeshBatch& mb = scratch_->mb;
   std::vector<Candidate>& list = scratch_->list;
@@ -275,141 +442,24 @@ void MeshContactPass::run(long begin, long end) {
     const std::int32_t first = s.candidate_begin[p], last = s.candidate_begin[p + 1];
     if (first == last && mc.count[p] == 0) continue;
     // The contacts of the last step, to carry their history.
-    const int old_count = mc.count[p];
     std::int32_t old_mesh[kSlots];
     double old_point[kSlots][3];
     bool old_used[kSlots] = {};
-    for (int k = 0; k < old_count; ++k) {
-      const size_t slot = static_cast<size_t>(p) * kSlots + k;
-      old_mesh[k] = mc.mesh[slot];
-      old_point[k][0] = mc.px[slot], old_point[k][1] = mc.py[slot], old_point[k][2] = mc.pz[slot];
-      if (width) std::memcpy(&old_history[k * width], &mc.history[slot * width], width * sizeof(double));
-    }
+    const int old_count = load_last_contacts(mc, p, width, old_mesh, old_point, old_history);
     if (mb.b.count + kSlots > kBatch) flush(model, mb, s, work.mesh_forces, work.mesh_slots);
     const double radius = s.radius[p];
-    // Candidates farther from the sphere at the build than its reach plus how far it and the
-    // meshes have moved since cannot touch (the distance to a fixed triangle changes by at most
-    // the displacement): skipped unread. The margin of 1e-9 keeps rounding from skipping one
-    // that the exact test would take.
-    double beyond = std::numeric_limits<double>::infinity();
-    if (gaps && std::isfinite(scratch_->meshes_moved)) {
-      const double dx = s.x[p] - s.x_built[p], dy = s.y[p] - s.y_built[p], dz = s.z[p] - s.z_built[p];
-      beyond = (radius + range + std::sqrt(dx * dx + dy * dy + dz * dz) + scratch_->meshes_moved) * (1 + 1e-9);
-    }
+    const double beyond = skip_beyond(s, p, radius, range, gaps, scratch_->meshes_moved);
     int count = 0;
     for (std::int32_t q = first; q < last;) {
       const std::int32_t m = s.mesh_candidates[q][0];
-      const MeshWall& mesh = model.meshes[m];
-      const TriangleSurface& surface = *mesh.surface;
-      const auto& rot = work.mesh_rotation[m];
+      const TriangleSurface& surface = *model.meshes[m].surface;
       const double d[3] = {s.x[p] - work.mesh_translation[m][0], s.y[p] - work.mesh_translation[m][1], s.z[p] - work.mesh_translation[m][2]};
       double local[3];
-      mul_transposed(rot, d, local);
+      mul_transposed(work.mesh_rotation[m], d, local);
       // Closest points of this mesh's candidate triangles within reach.
-      list.clear();
-      const double reach2 = (radius + range) * (radius + range);
-      for (; q < last && s.mesh_candidates[q][0] == m; ++q) {
-        if (gaps && gaps[q] > beyond) continue;
-        const std::int32_t t = s.mesh_candidates[q][1];
-        const auto& tri = surface.triangles[t];
-        // The plane's distance bounds the triangle's from below: most candidates of a sphere
-        // moving over a surface are out of reach of its plane, and cost a dot product.
-        const double* v0 = surface.vertices[tri[0]].data();
-        const double* normal = surface.normals[t].data();
-        const double above = (local[0] - v0[0]) * normal[0] + (local[1] - v0[1]) * normal[1] + (local[2] - v0[2]) * normal[2];
-        if (above * above >= reach2) continue;
-        const ClosestPoint cp = closest_point_on_triangle(local, v0, surface.vertices[tri[1]].data(), surface.vertices[tri[2]].data());
-        if (cp.distance2 < reach2) list.push_back({t, cp});
-      }
+      q = closest_in_reach(s, surface, m, q, last, local, radius, range, gaps, beyond, list);
       const int kept = resolve_contacts(surface, list, radius);
-      for (int k = 0; k < kept && count < kSlots; ++k) {
-        const Candidate& c = list[k];
-        // Separate meshes meeting at an edge (chute parts) give the same contact twice.
-        double world_point[3];
-        mul(rot, c.closest.point, world_point);
-        bool seen = false;
-        for (int e = mb.b.count - count; e < mb.b.count && !seen; ++e) {
-          const double dx = mb.point[e][0] - world_point[0] - work.mesh_translation[m][0];
-          const double dy = mb.point[e][1] - world_point[1] - work.mesh_translation[m][1];
-          const double dz = mb.point[e][2] - world_point[2] - work.mesh_translation[m][2];
-          seen = dx * dx + dy * dy + dz * dz <= 1e-12 * radius * radius;
-        }
-        if (seen) continue;
-        const double dist = std::sqrt(c.closest.distance2);
-        double normal_local[3];
-        if (dist > 1e-12 * radius) {
-          for (int a = 0; a < 3; ++a) normal_local[a] = (local[a] - c.closest.point[a]) / dist;
-        } else {
-          for (int a = 0; a < 3; ++a) normal_local[a] = surface.normals[c.triangle][a];
-        }
-        double normal[3], point[3];
-        mul(rot, normal_local, normal);
-        mul(rot, c.closest.point, point);
-        for (int a = 0; a < 3; ++a) point[a] += work.mesh_translation[m][a];
-        // Wall velocity at the contact: rigid motion plus the surface's own (belts, pulleys).
-        double arm[3] = {point[0] - work.mesh_origin[m][0], point[1] - work.mesh_origin[m][1], point[2] - work.mesh_origin[m][2]};
-        double wall_v[3];
-        cross(work.mesh_angular[m].data(), arm, wall_v);
-        for (int a = 0; a < 3; ++a) wall_v[a] += work.mesh_linear[m][a];
-        double wall_w[3] = {work.mesh_angular[m][0], work.mesh_angular[m][1], work.mesh_angular[m][2]};
-        const SurfaceVelocitySpec& sv = mesh.surface_velocity;
-        if (sv.kind == SurfaceVelocitySpec::Kind::linear) {
-          double tri_normal[3];
-          mul(rot, surface.normals[c.triangle].data(), tri_normal);
-          const double along = sv.velocity.x() * tri_normal[0] + sv.velocity.y() * tri_normal[1] + sv.velocity.z() * tri_normal[2];
-          for (int a = 0; a < 3; ++a) wall_v[a] += sv.velocity[a] - along * tri_normal[a];
-        } else if (sv.kind == SurfaceVelocitySpec::Kind::rotation) {
-          const double w[3] = {sv.axis.x() * sv.angular_speed, sv.axis.y() * sv.angular_speed, sv.axis.z() * sv.angular_speed};
-          const double r[3] = {point[0] - sv.point.x(), point[1] - sv.point.y(), point[2] - sv.point.z()};
-          double v[3];
-          cross(w, r, v);
-          for (int a = 0; a < 3; ++a) wall_v[a] += v[a], wall_w[a] += w[a];
-        }
-        // The same contact as last step: same mesh, nearest point within a radius.
-        const size_t slot = static_cast<size_t>(p) * kSlots + count;
-        int match = -1;
-        double best = radius * radius;
-        for (int o = 0; o < old_count; ++o) {
-          if (old_used[o] || old_mesh[o] != m) continue;
-          const double dx = old_point[o][0] - c.closest.point[0], dy = old_point[o][1] - c.closest.point[1],
-                       dz = old_point[o][2] - c.closest.point[2];
-          const double d2 = dx * dx + dy * dy + dz * dz;
-          if (d2 < best) best = d2, match = o;
-        }
-        if (width) {
-          if (match >= 0) std::memcpy(&mc.history[slot * width], &old_history[match * width], width * sizeof(double));
-          else std::fill_n(&mc.history[slot * width], width, 0.0);
-        }
-        if (match >= 0) old_used[match] = true;
-        mc.mesh[slot] = m, mc.triangle[slot] = c.triangle;
-        mc.px[slot] = c.closest.point[0], mc.py[slot] = c.closest.point[1], mc.pz[slot] = c.closest.point[2];
-        // Geometry and motion for the effects; a wall is flat (infinite radius).
-        ContactBatch& b = mb.b;
-        const int e = b.count++;
-        const double lever = dist;
-        const double vix = s.vx[p] - lever * (s.wy[p] * normal[2] - s.wz[p] * normal[1]);
-        const double viy = s.vy[p] - lever * (s.wz[p] * normal[0] - s.wx[p] * normal[2]);
-        const double viz = s.vz[p] - lever * (s.wx[p] * normal[1] - s.wy[p] * normal[0]);
-        const double rx = vix - wall_v[0], ry = viy - wall_v[1], rz = viz - wall_v[2];
-        const double vn = rx * normal[0] + ry * normal[1] + rz * normal[2];
-        b.nx[e] = normal[0], b.ny[e] = normal[1], b.nz[e] = normal[2];
-        b.vn[e] = vn;
-        b.vtx[e] = rx - vn * normal[0], b.vty[e] = ry - vn * normal[1], b.vtz[e] = rz - vn * normal[2];
-        b.wx[e] = s.wx[p] - wall_w[0], b.wy[e] = s.wy[p] - wall_w[1], b.wz[e] = s.wz[p] - wall_w[2];
-        b.pair_type[e] = model.pair_type(s.material[p], mesh.material);
-        b.overlap[e] = radius - dist;
-        b.radius_i[e] = radius, b.radius_j[e] = 0.0, b.r_eff[e] = radius;
-        b.m_eff[e] = 1.0 / s.inv_mass[p];
-        b.inertia_eff[e] = 1.4 * radius * radius / s.inv_mass[p];
-        b.history[e] = width ? &mc.history[slot * width] : old_history.data();
-        const size_t at = static_cast<size_t>(first) + static_cast<size_t>(count);  // results
-        mb.slot[e] = static_cast<std::int32_t>(slot);
-        mb.result[e] = static_cast<std::int32_t>(at);
-        mb.lever[e] = lever;
-        for (int a = 0; a < 3; ++a) mb.wall_v[e][a] = wall_v[a], mb.point[e][a] = point[a];
-        slot_results.impact_energy[at] = match >= 0 ? -1.0 : 0.5 / s.inv_mass[p] * vn * vn;
-        ++count;
-      }
+      count = add_contacts(model, s, work, mb, list, kept, p, first, m, local, radius, count, old_count, old_mesh, old_point, old_used, old_history);
     }
     mc.count[p] = static_cast<std::uint8_t>(count);
   }

@@ -411,32 +411,20 @@ bool needs_rebuild(const Model& model, const State& s, const Workspace& work, do
   return !model.meshes.empty() && mesh_displacement_since_build(model, s, work.mesh_time) > 0.5 * model.skin;
 }
 
-void rebuild_contacts(const Model& model, State& s, Workspace& work) {
-  const int width = model.history_width;
-  HistoryRows &old_pairs = work.old_pairs, &old_walls = work.old_walls;
-  histories_by_id(s.pairs, s, width, false, old_pairs);
-  histories_by_id(s.wall_pairs, s, width, true, old_walls);
-  Domain* domain = work.domain;
+namespace {
 
-  drop_ghosts(s);
-  // Migration first: it carries particles across a periodic face the ranks share (the local
-  // model no longer wraps that axis), which find_lost would take for particles that left.
-  if (domain) domain->migrate(model, s, old_pairs, old_walls);
-  // Spheres that left are dropped by the cell sort below, which gathers every column anyway;
-  // with bodies (renumbered) or nothing left, by State::compact.
-  std::vector<std::uint8_t>& keep = work.keep;
+/// Drops the spheres that left (find_lost) by State::compact where the cell sort cannot; returns the slots kept.
+inline size_t drop_lost(const Model& model, State& s, std::vector<std::uint8_t>& keep) {
   if (find_lost(model, s, keep) && (s.bodies.size() > 0 || std::find(keep.begin(), keep.end(), 1) == keep.end())) {
     s.compact(keep);
     keep.assign(s.size(), 1);
   }
-  const size_t kept = static_cast<size_t>(std::count(keep.begin(), keep.end(), 1));
-  double radius_max = model.radius_max;
-  for (size_t p = 0; p < s.size(); ++p) radius_max = std::max(radius_max, s.radius[p]);
-  const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
-  const double cell_size = std::max(2.0 * radius_max + reach, 1e-12);
+  return static_cast<size_t>(std::count(keep.begin(), keep.end(), 1));
+}
 
-  // Sort the owned slots by cell (counting sort); cells are at least one pair reach wide.
-  wrap_into_period(model, s);
+/// Sorts the kept owned slots by cell, dropping the others, with each one's cell in work.cell_of; returns the grid.
+inline std::optional<Grid> sort_slots_by_cell(const Model& model, State& s, Workspace& work, double cell_size, size_t kept) {
+  const std::vector<std::uint8_t>& keep = work.keep;
   std::optional<Grid> sorted_by;
   if (s.size() > 0) {
     sorted_by = make_grid(model, s, cell_size, keep.data());
@@ -459,19 +447,24 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     for (long k = 0; k < nk; ++k) sorted_cells[k] = work.cell_of[work.order[k]];
     work.cell_of.swap(sorted_cells);
   }
-  if (domain) domain->make_ghosts(model, s);
-  const size_t n = s.size(), n_owned = s.owned();
-  if (n == 0) {  // nothing yet (an inlet will bring particles) or everything left
-    s.pairs.clear(), s.wall_pairs.clear();
-    s.candidate_begin.assign(1, 0), s.mesh_candidates.clear();
-    s.x_built.clear(), s.y_built.clear(), s.z_built.clear();
-    index_contacts(model, s, work);
-    ++work.rebuilds;
-    return;
-  }
+  return sorted_by;
+}
+
+/// Empty lists, indexed, when there is no sphere to list.
+inline void clear_lists(const Model& model, State& s, Workspace& work) {
+  s.pairs.clear(), s.wall_pairs.clear();
+  s.candidate_begin.assign(1, 0), s.mesh_candidates.clear();
+  s.x_built.clear(), s.y_built.clear(), s.z_built.clear();
+  index_contacts(model, s, work);
+}
+
+/// The cells of every slot for the pair search (with ghosts, on a grid over all slots); returns the grid.
+inline const Grid& cell_every_slot(const Model& model, const State& s, Workspace& work, double radius_max, double reach,
+                                   std::optional<Grid>& sorted_by) {
   // Cells of every slot. The owned slots are sorted, so a cell's owned spheres are a run of
   // slots (cell_start); ghosts, unsorted after them, need a second grid over all slots with the
   // slots listed by cell (`members`).
+  const size_t n = s.size(), n_owned = s.owned();
   const bool with_ghosts = s.ghosts > 0;
   if (with_ghosts) {
     for (size_t p = n_owned; p < n; ++p) radius_max = std::max(radius_max, s.radius[p]);
@@ -485,7 +478,13 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     work.members.resize(n);
     sort_by_cell(work.cell_of, n, n_cells, work.cell_start, work.members);
   }
+  return grid;
+}
 
+/// The particle pairs (s.pairs, rows work.pair_begin): each owned slot's partners j > i within the reach.
+inline void list_pairs(const Model& model, State& s, Workspace& work, const Grid& grid, double reach) {
+  const size_t n = s.size(), n_owned = s.owned();
+  const bool with_ghosts = s.ghosts > 0;
   // Particle pairs, in one pass (fill_rows). Ghosts list no pairs (ghost-ghost pairs are
   // another rank's).
   const PairFinder finder{model, s, grid, work.cell_of.data(), work.cell_start.data(),
@@ -498,8 +497,12 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
 #pragma omp parallel for schedule(static) if (nl >= kParallelMin)
   for (long i = 0; i < nl; ++i)
     std::fill(s.pairs.i.data() + work.pair_begin[i], s.pairs.i.data() + work.pair_begin[i + 1], static_cast<std::int32_t>(i));
-  const size_t n_pairs = s.pairs.size();
+}
 
+/// The plane-wall pairs (s.wall_pairs, rows work.wall_begin): each owned slot's planes within the reach.
+inline void list_wall_pairs(const Model& model, State& s, Workspace& work, double reach) {
+  const size_t n = s.size();
+  const long nl = static_cast<long>(s.owned());
   // Wall pairs, grouped by particle (ghosts touch no wall: their owners' contacts), in one
   // pass shared by the threads as the pairs' (a plane's distance for every sphere and plane).
   s.wall_pairs.i.clear();
@@ -527,7 +530,13 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
       std::fill(s.wall_pairs.i.data() + work.wall_begin[i], s.wall_pairs.i.data() + work.wall_begin[i + 1], static_cast<std::int32_t>(i));
     work.wall_begin.resize(n + 1, work.wall_begin[nl]);  // ghosts: no walls
   }
+}
 
+/// The new lists' histories: zero, then each old row (work.old_pairs, old_walls) carried to its pair by particle id.
+inline void carry_histories(const Model& model, State& s, const Workspace& work) {
+  const int width = model.history_width;
+  const HistoryRows &old_pairs = work.old_pairs, &old_walls = work.old_walls;
+  const size_t n = s.size(), n_pairs = s.pairs.size();
   // Carry histories to the new lists by particle id: each old row finds its pair in the new
   // list's row of the lower slot (a handful of partners), so the carry needs no index of its own.
   // Each old row has a new row of its own (or none), so the threads share the old rows.
@@ -569,8 +578,11 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
     carry(old_pairs, false, s.pairs, work.pair_begin);
     carry(old_walls, true, s.wall_pairs, work.wall_begin);
   }
+}
 
-  find_mesh_candidates(model, s, work, reach);
+/// Where the spheres and plane walls are as the lists are built, and the drift the lists follow from there.
+inline void record_build_positions(const Model& model, State& s, Workspace& work) {
+  const size_t n = s.size();
   s.lists_drift_velocity = lists_follow_drift(model, work) ? common_velocity(s) : std::array<double, 3>{0.0, 0.0, 0.0};
   for (auto* c : {&s.x_built, &s.y_built, &s.z_built}) resize_discarding(*c, n);
   const long all = static_cast<long>(n);
@@ -578,6 +590,46 @@ void rebuild_contacts(const Model& model, State& s, Workspace& work) {
   for (long p = 0; p < all; ++p) s.x_built[p] = s.x[p], s.y_built[p] = s.y[p], s.z_built[p] = s.z[p];
   work.plane_built.resize(model.planes.size());
   for (size_t w = 0; w < model.planes.size(); ++w) work.plane_built[w] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]};
+}
+
+}  // namespace
+
+void rebuild_contacts(const Model& model, State& s, Workspace& work) {
+  const int width = model.history_width;
+  HistoryRows &old_pairs = work.old_pairs, &old_walls = work.old_walls;
+  histories_by_id(s.pairs, s, width, false, old_pairs);
+  histories_by_id(s.wall_pairs, s, width, true, old_walls);
+  Domain* domain = work.domain;
+
+  drop_ghosts(s);
+  // Migration first: it carries particles across a periodic face the ranks share (the local
+  // model no longer wraps that axis), which find_lost would take for particles that left.
+  if (domain) domain->migrate(model, s, old_pairs, old_walls);
+  // Spheres that left are dropped by the cell sort below, which gathers every column anyway;
+  // with bodies (renumbered) or nothing left, by State::compact.
+  const size_t kept = drop_lost(model, s, work.keep);
+  double radius_max = model.radius_max;
+  for (size_t p = 0; p < s.size(); ++p) radius_max = std::max(radius_max, s.radius[p]);
+  const double reach = model.interaction_range + model.skin;  // [m] gap that still lists a pair
+  const double cell_size = std::max(2.0 * radius_max + reach, 1e-12);
+
+  // Sort the owned slots by cell (counting sort); cells are at least one pair reach wide.
+  wrap_into_period(model, s);
+  std::optional<Grid> sorted_by = sort_slots_by_cell(model, s, work, cell_size, kept);
+  if (domain) domain->make_ghosts(model, s);
+  if (s.size() == 0) {  // nothing yet (an inlet will bring particles) or everything left
+    clear_lists(model, s, work);
+    ++work.rebuilds;
+    return;
+  }
+  const Grid& grid = cell_every_slot(model, s, work, radius_max, reach, sorted_by);
+
+  list_pairs(model, s, work, grid, reach);
+  list_wall_pairs(model, s, work, reach);
+  carry_histories(model, s, work);
+
+  find_mesh_candidates(model, s, work, reach);
+  record_build_positions(model, s, work);
   index_contacts(model, s, work);
   ++work.rebuilds;
 }
