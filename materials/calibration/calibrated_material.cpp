@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "contact/effect.h"
+#include "model/base_properties.h"
 #include "output/run.h"
 
 namespace dem::materials {
@@ -85,9 +86,13 @@ std::string calibrated_material_text(const CalibrationResult& fit, const Calibra
                                                              std::filesystem::path(source.measurements).filename().string(), source.date)));
   out += fmt::format("contact: {}\n", contact_text(m.contact));
   out += "properties:\n";
-  out += fmt::format("  {:<30}# [kg/m^3]\n", "density: " + number(m.particle.density));
-  out += fmt::format("  {:<30}# [Pa]\n", "youngs_modulus: " + number(m.particle.youngs_modulus));
-  out += fmt::format("  poisson_ratio: {}\n", number(m.particle.poisson_ratio));
+  // The material's base properties (the shape's is refused above), each with its unit unless dimensionless.
+  for (const BaseProperty& b : base_properties()) {
+    if (!b.field) continue;
+    const std::string line = fmt::format("{}: {}", b.spec.key, number(m.particle.*b.field));
+    if (b.spec.unit == "-") out += fmt::format("  {}\n", line);
+    else out += fmt::format("  {:<30}# [{}]\n", line, b.spec.unit);
+  }
   for (const auto& [key, value] : m.particle.params) out += fmt::format("  {}: {}\n", key, number(value));
   // Provenance: the fitted values from this fit, the others as the starting material said.
   std::map<std::string, std::string> sources = m.particle.sources;

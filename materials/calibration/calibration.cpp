@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "contact/effect.h"
+#include "model/base_properties.h"
 
 namespace dem::materials {
 
@@ -185,7 +186,8 @@ std::vector<FitParameter> fit_parameters(const MaterialModel& model, const std::
       continue;
     }
     (void)get_parameter(model, key);  // throws for an unknown key
-    const ParamSpec* spec = find_param(key);
+    const BaseProperty* property = find_base_property(key);
+    const ParamSpec* spec = property ? &property->spec : find_param(key);
     if (!spec || !spec->tunable)
       throw std::invalid_argument(fmt::format("'{}' has no calibration range: declare it under `tunable:` in the material file", key));
     out.push_back({key, spec->min_value, spec->max_value});

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "contact/effect.h"
+#include "model/base_properties.h"
 #include "output/run.h"
 
 namespace dem::materials {
@@ -17,9 +18,12 @@ namespace {
 
 std::string number(double v) { return fmt::format("{:.17g}", v); }
 
+/// A material as a line of the inputs that key a stored simulation: its name, its base properties
+/// in table order, its contact parameters.
 void describe(std::string& out, const std::string& key, const MaterialSpec& m) {
-  out += fmt::format("{}: {{name: {}, density: {}, youngs_modulus: {}, poisson_ratio: {}", key, m.name, number(m.density),
-                     number(m.youngs_modulus), number(m.poisson_ratio));
+  out += fmt::format("{}: {{name: {}", key, m.name);
+  for (const BaseProperty& b : base_properties())
+    if (b.field) out += fmt::format(", {}: {}", b.spec.key, number(m.*b.field));
   for (const auto& [k, v] : m.params) out += fmt::format(", {}: {}", k, number(v));
   out += "}\n";
 }

@@ -14,6 +14,7 @@
 
 #include "case/yaml_check.h"
 #include "contact/effect.h"
+#include "model/base_properties.h"
 #include "model/material_model.h"
 
 namespace dem::materials {
@@ -55,16 +56,32 @@ void read_known_params(MapReader& map, const std::vector<std::string>& fixed, co
   map.finish(valid);
 }
 
+/// Base property `key` of `map`, in its range and unit (model/base_properties.h); `fallback`
+/// when absent.
+double read_property(MapReader& map, std::string_view key, double fallback) {
+  const ParamSpec& p = base_property(key).spec;
+  return map.number(std::string(key), fallback, p.min_value, p.max_value, p.unit);
+}
+
+double read_required_property(MapReader& map, std::string_view key) {
+  const ParamSpec& p = base_property(key).spec;
+  return map.required_number(std::string(key), p.min_value, p.max_value, p.unit);
+}
+
 /// Wall materials measured directly: {youngs_modulus, poisson_ratio, density} and the
 /// particle-wall pair's contact parameters (friction, restitution, ...), known as NAME.KEY.
+/// The properties one by one rather than over the table (model/base_properties.h): in this order,
+/// the key reference's, Young's modulus required and the others steel's when absent. Their key
+/// list stays beside them, so that a property the table gains and this reader does not read is
+/// refused as an unknown key rather than ignored.
 MaterialSpec read_wall(const std::string& name, const YAML::Node& node, const std::string& file, std::vector<KnownValue>& known) {
   MapReader map(node, file, "walls." + name);
   MaterialSpec m;
   m.name = name;
   m.location = map.location();
-  m.youngs_modulus = map.required_number("youngs_modulus", 1e3, 1e15, "Pa");
-  m.poisson_ratio = map.number("poisson_ratio", 0.3, -0.99, 0.499, "-");
-  m.density = map.number("density", 7800, 1.0, 1e5, "kg/m^3");
+  m.youngs_modulus = read_required_property(map, "youngs_modulus");
+  m.poisson_ratio = read_property(map, "poisson_ratio", 0.3);
+  m.density = read_property(map, "density", 7800);
   read_known_params(map, {"youngs_modulus", "poisson_ratio", "density"}, name + ".", known);
   return m;
 }
@@ -224,10 +241,17 @@ MeasurementSet parse_measurements(const std::string& text, const std::string& na
     if (const YAML::Node particles = top.node("particles")) {
       MapReader p(particles, name, "particles");
       if (p.has("diameter")) set.diameter = read_size_distribution(p, name), set.has_diameter = true;
-      set.density = p.number("density", 0, 1.0, 1e5, "kg/m^3");
-      if (p.has("youngs_modulus")) set.known.push_back({"youngs_modulus", p.number("youngs_modulus", 0, 1e3, 1e15, "Pa"), "Pa", p.where("youngs_modulus")});
-      if (p.has("poisson_ratio")) set.known.push_back({"poisson_ratio", p.number("poisson_ratio", 0, -0.99, 0.499, "-"), "-", p.where("poisson_ratio")});
-      read_known_params(p, {"diameter", "density", "youngs_modulus", "poisson_ratio"}, "", set.known);
+      // The density is the set's own (MeasurementSet::density, apply_measured); every other
+      // property of a material's `properties:` stated here is a known value, as a contact parameter is.
+      set.density = read_property(p, "density", 0);
+      std::vector<std::string> read_keys = {"diameter"};
+      for (const std::string& key : material_property_keys()) {
+        read_keys.push_back(key);
+        if (key == "density" || !p.has(key)) continue;
+        const std::string_view unit = base_property(key).spec.unit;
+        set.known.push_back({key, read_property(p, key, 0), std::string(unit), p.where(key)});
+      }
+      read_known_params(p, read_keys, "", set.known);
     }
     if (const YAML::Node walls = top.node("walls")) {
       if (!walls.IsMap()) top.fail("walls", "must map wall material names to {youngs_modulus, poisson_ratio, density, friction, ...}");

@@ -16,6 +16,7 @@
 
 #include "case/yaml_check.h"
 #include "contact/effect.h"
+#include "model/base_properties.h"
 #include "model/library.h"
 
 namespace dem::materials {
@@ -24,8 +25,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// Every key get_parameter knows besides the particle-wall pairs': the base properties, then the
+/// effects' parameters.
 std::vector<std::string> parameter_keys() {
-  std::vector<std::string> keys = {"density", "youngs_modulus", "poisson_ratio", "clump_aspect_ratio"};
+  std::vector<std::string> keys;
+  for (const BaseProperty& b : base_properties()) keys.emplace_back(b.spec.key);
   for (const EffectSpec* e : effect_table())
     for (const ParamSpec& p : e->params) keys.emplace_back(p.key);
   return keys;
@@ -49,20 +53,11 @@ double param_value(const std::map<std::string, double>& params, const std::strin
 
 [[noreturn]] void unknown_key(const std::string& key) {
   const std::string hint = nearest_word(key, parameter_keys());
-  throw std::invalid_argument(fmt::format("'{}' is not a material parameter{}; valid: density, youngs_modulus, poisson_ratio, "
-                                          "clump_aspect_ratio, an effect parameter (see `demdesign effects`), or wall.KEY / WALL.KEY for particle-wall pairs",
-                                          key, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint)));
-}
-
-/// Two equal spheres, overlapping; aspect = length / width. The engine scales a template to
-/// the volume-equivalent diameter, so only the shape matters here.
-ClumpTemplateSpec two_sphere_clump(double aspect) {
-  ClumpTemplateSpec c;
-  c.name = "two_sphere";
-  const double r = 0.5, offset = (aspect - 1.0) * r;  // centres at +-offset along x
-  c.centres = {Vec3{-offset, 0, 0}, Vec3{offset, 0, 0}};
-  c.radii = {r, r};
-  return c;
+  std::string properties;  // "density, youngs_modulus, ...": the base properties' keys
+  for (const BaseProperty& b : base_properties()) properties += fmt::format("{}, ", b.spec.key);
+  throw std::invalid_argument(fmt::format("'{}' is not a material parameter{}; valid: {}an effect parameter (see `demdesign effects`), "
+                                          "or wall.KEY / WALL.KEY for particle-wall pairs",
+                                          key, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), properties));
 }
 
 /// Typical (median by number) diameter [m].
@@ -138,15 +133,7 @@ MaterialModel read_material_model(const std::string& path) {
 }
 
 double get_parameter(const MaterialModel& model, const std::string& key) {
-  if (key == "density") return model.particle.density;
-  if (key == "youngs_modulus") return model.particle.youngs_modulus;
-  if (key == "poisson_ratio") return model.particle.poisson_ratio;
-  if (key == "clump_aspect_ratio") {
-    if (model.shape.empty()) return 1.0;
-    const ClumpTemplateSpec& c = model.shape.front();
-    if (c.centres.size() != 2) return std::nan("");
-    return 1.0 + 0.5 * (c.centres[1] - c.centres[0]).norm() / c.radii[0];
-  }
+  if (const BaseProperty* b = find_base_property(key)) return b->get(model);
   const auto dot = key.find('.');
   if (dot != std::string::npos) {
     const std::string wall = key.substr(0, dot), param = key.substr(dot + 1);
@@ -161,12 +148,11 @@ double get_parameter(const MaterialModel& model, const std::string& key) {
 
 void set_parameter(MaterialModel& model, const std::string& key, double value) {
   if (!std::isfinite(value)) throw std::invalid_argument(fmt::format("'{}': value {} is not finite", key, value));
-  if (key == "density") model.particle.density = value;
-  else if (key == "youngs_modulus") model.particle.youngs_modulus = value;
-  else if (key == "poisson_ratio") model.particle.poisson_ratio = value;
-  else if (key == "clump_aspect_ratio") {
-    if (value < 1.0 || value > 3.0) throw std::invalid_argument(fmt::format("clump_aspect_ratio {:g} out of range; valid: [1, 3]", value));
-    model.shape = {two_sphere_clump(value)};
+  if (const BaseProperty* b = find_base_property(key)) {
+    const ParamSpec& p = b->spec;
+    if (b->checked_when_set && (value < p.min_value || value > p.max_value))
+      throw std::invalid_argument(fmt::format("{} {:g} out of range; valid: [{:g}, {:g}]", key, value, p.min_value, p.max_value));
+    b->set(model, value);
   } else if (const auto dot = key.find('.'); dot != std::string::npos) {
     const std::string wall = key.substr(0, dot), param = key.substr(dot + 1);
     const ParamSpec* p = find_param(param);

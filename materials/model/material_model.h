@@ -17,8 +17,9 @@ namespace dem::materials {
 /// themselves come from the measurement file or the library's steel/rubber files).
 MaterialModel read_material_model(const std::string& path);
 
-/// A parameter by key: "friction", "rolling_friction", "restitution", "liquid_content",
-/// "surface_energy", "youngs_modulus", ... Particle-wall pair keys are "wall.friction" etc.
+/// A parameter by key: a base property (model/base_properties.h: "density", "youngs_modulus",
+/// ...) or an effect parameter ("friction", "rolling_friction", "restitution", "liquid_content",
+/// "surface_energy", ...). Particle-wall pair keys are "wall.friction" etc.
 double get_parameter(const MaterialModel& model, const std::string& key);
 void set_parameter(MaterialModel& model, const std::string& key, double value);
 
