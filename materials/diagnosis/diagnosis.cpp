@@ -15,6 +15,7 @@
 
 #include "calibration/calibration.h"
 #include "calibration/calibration_support.h"
+#include "contact/effect.h"
 #include "diagnosis/discrimination.h"
 
 namespace dem::materials {
@@ -49,24 +50,40 @@ std::string verdict_words(Verdict v) {
 
 namespace {
 
-/// Wall parameters the fit leaves out (friction and restitution of each particle-wall pair, the
-/// rolling friction when the model rolls), as candidates: a test that misses because of a wall
-/// points at the wall's parameter, not at missing physics. Measured ones are inputs, and those
-/// fitted first to their own drop tests are settled: neither is offered.
+/// The parameter rows a wall candidate is offered for (ParamSpec::wall_candidate) of the model's
+/// active effects: the friction of its tangential law, the restitution of its damping, the
+/// rolling friction when it rolls. In the order of their keys (friction, restitution,
+/// rolling_friction), which the candidates and so the diagnosis' output follow. Rejected: the
+/// order of the stages, in which damping comes before the tangential stage, and of the table,
+/// in which a registered effect's row would land wherever it was registered.
+std::vector<const ParamSpec*> wall_candidate_params(const ContactSpec& contact) {
+  std::vector<const ParamSpec*> rows;
+  for (const Stage stage : kStages)
+    for (const ContactSpec::Choice* choice : contact.choices(stage))
+      if (const EffectSpec* effect = find_effect(stage, choice->model))  // nullptr: "none", the stage is off
+        for (const ParamSpec& p : effect->params)
+          if (p.wall_candidate) rows.push_back(&p);
+  std::sort(rows.begin(), rows.end(), [](const ParamSpec* a, const ParamSpec* b) { return a->key < b->key; });
+  // A key two active effects share is one parameter (find_param), offered once.
+  rows.erase(std::unique(rows.begin(), rows.end(), [](const ParamSpec* a, const ParamSpec* b) { return a->key == b->key; }), rows.end());
+  return rows;
+}
+
+/// Wall parameters the fit leaves out (wall_candidate_params of each particle-wall pair), as
+/// candidates: a test that misses because of a wall points at the wall's parameter, not at
+/// missing physics. Measured ones are inputs, and those fitted first to their own drop tests are
+/// settled: neither is offered.
 std::vector<EffectCandidate> wall_parameter_candidates(const MaterialModel& model, const std::vector<FitParameter>& fitted) {
   std::vector<EffectCandidate> out;
-  std::vector<std::string> keys = {"friction", "restitution"};
-  if (model.contact.rolling.model != "none") keys.emplace_back("rolling_friction");
+  const std::vector<const ParamSpec*> params = wall_candidate_params(model.contact);
   const auto listed = [](const std::vector<std::string>& list, const std::string& key) { return std::find(list.begin(), list.end(), key) != list.end(); };
   std::vector<std::string> fitted_keys;
   for (const FitParameter& p : fitted) fitted_keys.push_back(p.key);
   for (const InteractionSpec& pair : model.wall_pairs) {
     const std::string wall = pair.material_a == model.name ? pair.material_b : pair.material_a;
-    for (const std::string& key : keys) {
-      const std::string full = wall + "." + key;
+    for (const ParamSpec* p : params) {
+      const std::string key(p->key), full = wall + "." + key;
       if (listed(fitted_keys, full) || listed(fitted_keys, "wall." + key) || listed(model.known, full) || listed(model.fitted_first, full)) continue;
-      const ParamSpec* p = find_param(key);
-      if (!p) continue;
       const double lo = p->min_value, hi = std::min(p->max_value, 1.0);  // friction above 1 is not a wall liner's
       const double now = std::clamp(get_parameter(model, full), lo, hi), step = 0.2 * (hi - lo);
       const double start = now + step <= hi ? now + step : now - step;

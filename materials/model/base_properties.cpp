@@ -1,7 +1,7 @@
 // The table of a material model's base properties (model/base_properties.h), and the two-sphere
 // clump its shape row builds. The ranges are the ones the file readers check (density and Poisson's
-// ratio as src/case/spec_materials.cpp, Young's modulus as lab/measurements.cpp reads a measured
-// one), and clump_aspect_ratio's the span of the two-sphere clumps set_parameter accepts.
+// ratio as src/case/spec_materials.cpp's kMaterialProperties, Young's modulus as lab/measurements.cpp
+// reads a measured one), and clump_aspect_ratio's the span of the two-sphere clumps set_parameter accepts.
 #include "model/base_properties.h"
 
 #include <fmt/format.h>

@@ -23,6 +23,33 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+/// A material's properties besides its effect parameters (MaterialSpec's fields): key, field,
+/// valid range (inclusive), SI unit, and whether a material must state it (otherwise it keeps
+/// MaterialSpec's default). Read in this order, which the key reference lists and which decides
+/// which of two mistakes is reported first. Every reader of them below loops over these rows.
+/// Rejected: the rows of materials/model/base_properties.cpp, which describe the same keys: the
+/// engine does not include materials/ (materials/ builds on the engine), and a case's material
+/// may be rigid (youngs_modulus +inf) where a measured one stops at 1e15 Pa.
+struct MaterialProperty {
+  std::string_view key;
+  double MaterialSpec::*field;
+  double min_value, max_value;
+  std::string_view unit;
+  bool required;
+};
+constexpr MaterialProperty kMaterialProperties[] = {
+    {"density", &MaterialSpec::density, 1.0, 1e5, "kg/m^3", true},
+    {"youngs_modulus", &MaterialSpec::youngs_modulus, 1e3, kInf, "Pa", true},
+    {"poisson_ratio", &MaterialSpec::poisson_ratio, -0.99, 0.499, "-", false},
+};
+
+/// `keys` followed by the material properties' keys: the keys of a material's map that are not
+/// effect parameters.
+std::vector<std::string> with_property_keys(std::vector<std::string> keys) {
+  for (const MaterialProperty& p : kMaterialProperties) keys.emplace_back(p.key);
+  return keys;
+}
+
 std::vector<std::string> all_param_keys() {
   std::vector<std::string> keys;
   for (const EffectSpec* effect : effect_table())
@@ -163,10 +190,12 @@ MaterialSpec read_material(const std::string& name, const YAML::Node& node, cons
   MaterialSpec m;
   m.name = name;
   m.location = map.location();
-  m.density = map.required_number("density", 1.0, 1e5, "kg/m^3");
-  m.youngs_modulus = map.required_number("youngs_modulus", 1e3, kInf, "Pa");
-  m.poisson_ratio = map.number("poisson_ratio", 0.25, -0.99, 0.499, "-");
-  read_effect_params(map, {"density", "youngs_modulus", "poisson_ratio"}, m.params, m.where);
+  for (const MaterialProperty& p : kMaterialProperties) {
+    const std::string key(p.key);
+    m.*p.field = p.required ? map.required_number(key, p.min_value, p.max_value, p.unit)
+                            : map.number(key, m.*p.field, p.min_value, p.max_value, p.unit);
+  }
+  read_effect_params(map, with_property_keys({}), m.params, m.where);
   return m;
 }
 
@@ -224,14 +253,14 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
   // Overrides in the case entry, beside `library:`.
   MaterialSpec& m = lib.material;
   m.location = entry.location();
-  m.density = entry.number("density", m.density, 1.0, 1e5, "kg/m^3");
-  m.youngs_modulus = entry.number("youngs_modulus", m.youngs_modulus, 1e3, kInf, "Pa");
-  m.poisson_ratio = entry.number("poisson_ratio", m.poisson_ratio, -0.99, 0.499, "-");
-  for (const char* key : {"density", "youngs_modulus", "poisson_ratio"})
+  for (const MaterialProperty& p : kMaterialProperties) {
+    const std::string key(p.key);
+    m.*p.field = entry.number(key, m.*p.field, p.min_value, p.max_value, p.unit);
     if (entry.has(key)) m.where[key] = entry.where(key), m.sources[key] = "set in the case";
+  }
   std::map<std::string, double> overrides;
   std::map<std::string, SourceLocation> where;
-  read_effect_params(entry, {"library", "density", "youngs_modulus", "poisson_ratio"}, overrides, where);
+  read_effect_params(entry, with_property_keys({"library"}), overrides, where);
   for (const auto& [key, value] : overrides) m.params[key] = value, m.where[key] = where[key], m.sources[key] = "set in the case";
   return lib;
 }

@@ -106,6 +106,12 @@ struct ParamSpec {
   /// tension [N/m]). Each row states it with its reason; none (std::nullopt): a case with
   /// coarse_grain != 1 and this effect is refused rather than scaled by a guess.
   std::optional<int> coarse_grain_exponent = std::nullopt;
+  /// A parameter of each particle-wall pair (a wall liner's friction, restitution, ...) that a
+  /// diagnosis offers as a candidate when the fit leaves it out: a test that misses on one wall
+  /// only points at that wall's value, not at missing physics. Offered when its effect is active
+  /// in the model. Rejected: a list of keys in the diagnosis, which a new effect's wall parameter
+  /// would not reach and which would go on naming a parameter whose effect the model lacks.
+  bool wall_candidate = false;
 };
 
 /// A model-wide choice of an effect, given as `stage: {model: NAME, OPTION: VALUE}`.
