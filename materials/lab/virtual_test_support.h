@@ -137,12 +137,8 @@ void finish(SimulatedOutcome& out, const Runner& run, const Clock& clock, std::i
 /// Progress line to stdout when options.progress.
 void progress(const TestOptions& options, const std::string& line);
 
-// One function per test, one file each (test_<name>.cpp); registered in virtual_tests.cpp.
-SimulatedOutcome run_drop_rebound(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
-SimulatedOutcome run_bulk_density(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
-SimulatedOutcome run_angle_of_repose_cylinder(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
-SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
-SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+// One function per test, one file each (lab_<name>.cpp), declared and registered in the table of
+// virtual_tests.cpp.
 
 /// hopper_discharge's flat floor: a dead zone rising at slope tan(theta) from the orifice's edge
 /// (radius r [m]) to the wall (radius R [m]) holds 2 pi tan(theta) (R^3/3 - r R^2/2 + r^3/6) of

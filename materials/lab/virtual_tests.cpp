@@ -2,6 +2,10 @@
 // virtual laboratory: lab_drop_rebound.cpp, lab_bulk_density.cpp, lab_angle_of_repose.cpp,
 // lab_rotating_drum.cpp, lab_hopper_discharge.cpp, lab_direct_shear.cpp). Set-ups and extraction rules:
 // each file's header, summarised in docs/materials-and-calibration.md ("The virtual lab tests").
+// A new test is its file (materials/lab/lab_NAME.cpp, which the build finds) and, here, the
+// declaration of its function and its row. Rejected: tests registering themselves from their own
+// files, as the effect table also rejects (a static library's linker drops an object nothing
+// references, and the table's order would follow the link order).
 #include "lab/virtual_tests.h"
 
 #include <fmt/format.h>
@@ -14,6 +18,14 @@
 #include "lab/virtual_test_support.h"
 
 namespace dem::materials {
+
+namespace detail {
+SimulatedOutcome run_drop_rebound(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+SimulatedOutcome run_bulk_density(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+SimulatedOutcome run_angle_of_repose_cylinder(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+SimulatedOutcome run_rotating_drum(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetup& setup, const TestOptions& options);
+}  // namespace detail
 
 namespace {
 
