@@ -307,27 +307,38 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
   EXPECT_EQ(tight.options.rounds, 1);
   // The wall parameters' screen goes only after the design points and the packings (a guessed
-  // wall pair misfits like missing physics): 51 passes fit 1800 s with the walls still screened.
+  // wall pair misfits like missing physics). One round, design factor 1 and signatures with one
+  // packing: 8 + 3 passes for the plain fit, 8 x 2 for the screen, 2 x (8 + 3) for confirmations
+  // that stand beside the plain fit's points (confirmation_design_points): 49 passes fit 1800 s.
   EXPECT_TRUE(tight.options.wall_candidates);
-  EXPECT_EQ(tight.options.replicas, 2);
-  EXPECT_EQ(tight.options.design_factor, 0.5);
-  EXPECT_NEAR(tight.seconds, 51 * 35.0, 1e-9);
-  // What the first comparison took comes off the budget: with 100 s spent, 51 passes (1785 s) no
-  // longer fit the 1700 s left, and the wall screen goes (8 passes).
+  EXPECT_EQ(tight.options.replicas, 3);
+  EXPECT_EQ(tight.options.signature_replicas, 1);
+  EXPECT_EQ(tight.options.design_factor, 1.0);
+  EXPECT_NEAR(tight.seconds, 49 * 35.0, 1e-9);
+  // What the first comparison took comes off the budget: with 100 s spent, 49 passes (1715 s) no
+  // longer fit the 1700 s left, and design factor 0.5 goes (7 + 3 + 16 + 2 x (8 + 3) = 48 passes);
+  // with 300 s spent, two packings (45 passes, 1575 s) are not enough either, and the wall screen
+  // goes (8 passes): 37.
   const BudgetPlan later = plan_within_budget(options, first, 2, 4, 4, 100.0);
-  EXPECT_FALSE(later.options.wall_candidates);
-  EXPECT_NEAR(later.seconds, 43 * 35.0, 1e-9);
+  EXPECT_TRUE(later.options.wall_candidates);
+  EXPECT_EQ(later.options.design_factor, 0.5);
+  EXPECT_NEAR(later.seconds, 48 * 35.0, 1e-9);
+  const BudgetPlan latest = plan_within_budget(options, first, 2, 4, 4, 300.0);
+  EXPECT_EQ(latest.options.replicas, 2);
+  EXPECT_FALSE(latest.options.wall_candidates);
+  EXPECT_NEAR(latest.seconds, 37 * 35.0, 1e-9);
   // After the calibration of the model as it is, the screen and the confirmations are planned
   // again at the cost measured so far, a candidate's simulations counted at what they cost
   // against the plain model's (the screen's at 2, the confirmations' at 1.2): at 35 s a pass,
-  // 2 x 8 candidates x 3 + 1.2 x 2 x (2 x 22 + 3) = 160.8 passes do not fit 2500 s; one round,
-  // design factor 1 (1.2 x 2 x (12 + 3)) and signatures with one packing (2 x 8 x 2): 68 passes.
+  // 2 x 8 candidates x 3 + 1.2 x 2 x (2 x 22 + 3) = 160.8 passes do not fit 2500 s; one round
+  // (1.2 x 2 x (10 + 3)), design factor 1 (1.2 x 2 x (8 + 3)) and signatures with one packing
+  // (2 x 8 x 2): 58.4 passes.
   const BudgetPlan rest = plan_screen_within_budget(CalibrationOptions{}, 35.0, 2, 4, 4, 2500, 2500);
   EXPECT_NEAR(plan_screen_within_budget(CalibrationOptions{}, 35.0, 2, 4, 4, 1e6, 1e6).seconds, 160.8 * 35.0, 1e-9);
   EXPECT_EQ(rest.options.rounds, 1);
   EXPECT_EQ(rest.options.signature_replicas, 1);
   EXPECT_TRUE(rest.options.wall_candidates);
-  EXPECT_NEAR(rest.seconds, 68 * 35.0, 1e-9);
+  EXPECT_NEAR(rest.seconds, 58.4 * 35.0, 1e-9);
   EXPECT_EQ(rest.given_up.size(), 3u);
   options.budget_seconds = 60;
   const BudgetPlan impossible = plan_within_budget(options, first, 2, 4, 4);
@@ -427,6 +438,19 @@ TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
   EXPECT_EQ(detail::design_points_beside_known(3, 1), 8);
   EXPECT_EQ(detail::design_points_beside_known(2, 1), 6);
   EXPECT_EQ(detail::design_points_beside_known(1, 1), 4);
+  // A confirmation's own design: the design factor on the coefficients the plain fit's points
+  // leave open (4 of 10: 2 x 4 + 2 = 10 points at factor 2, against 2 x 10 + 2 = 22 for all of
+  // them), never below the fewest, never above the full rule; a zoom round takes the full rule.
+  CalibrationOptions o;
+  o.rounds = 1, o.design_factor = 2;
+  EXPECT_EQ(detail::design_points(o, 3), 22);
+  EXPECT_EQ(detail::confirmation_design_points(o, 3, 1), 10);
+  EXPECT_EQ(detail::confirmation_passes(o, 2), 10 + std::max(1, o.replicas));
+  o.design_factor = 1;
+  EXPECT_EQ(detail::confirmation_design_points(o, 3, 1), 8);
+  EXPECT_EQ(detail::confirmation_design_points(o, 1, 1), 4);  // the full rule would take 5
+  o.design_factor = 2, o.rounds = 2;
+  EXPECT_EQ(detail::confirmation_design_points(o, 3, 1), 22);
 }
 
 // Progress over the whole command: every line counts one more of the diagnosis' simulations,

@@ -21,7 +21,7 @@ int screen_passes(const CalibrationOptions& o, int effects, int walls) {
 
 double weighted_screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls, double screen, double confirmation) {
   if (effects + walls == 0) return 0.0;
-  return screen * screen_passes(o, effects, walls) + confirmation * o.confirm_candidates * detail::calibration_passes(o, p + 1);
+  return screen * screen_passes(o, effects, walls) + confirmation * o.confirm_candidates * detail::confirmation_passes(o, p);
 }
 
 int screen_and_confirmation_passes(const CalibrationOptions& o, int p, int effects, int walls) {

@@ -305,8 +305,11 @@ struct Fit {
   const CalibrationOptions& options;            ///< as the budget plan left them
   const Targets& targets;
   int p;                                        ///< parameters fitted
-  int points;                                   ///< design points per round
+  int points;                                   ///< design points of the first round
   int rounds;                                   ///< surrogate rounds before any refinement
+  /// Design points of a zoom or refinement round: the full rule where the first round's design
+  /// stood beside known points (confirmation_design_points), which a smaller box mostly leaves out.
+  int later_points;
 };
 
 /// The surrogate rounds' state: the box searched, its optimum, and every point simulated so far.
@@ -349,7 +352,8 @@ WallStage fit_walls_stage(const MaterialModel& given_model, const MeasurementSet
   result.words = stage.first.words;
   // Wall pairs the first stage gave another value: points simulated before (EarlierPoints::known)
   // had the old one and are left out below; a design reduced to stand beside them
-  // (design_points_beside_known) takes the full rule again.
+  // (confirmation_design_points, design_points_beside_known: any count given with known points)
+  // takes the full rule again.
   std::vector<std::string>& moved = stage.moved;
   for (size_t k = 0; k < model.wall_pairs.size() && k < given_model.wall_pairs.size(); ++k)
     for (const auto& [key, value] : model.wall_pairs[k].params)
@@ -357,7 +361,7 @@ WallStage fit_walls_stage(const MaterialModel& given_model, const MeasurementSet
         moved.push_back(fmt::format("{}.{} {:.3g}", model.wall_pairs[k].material_a == model.name ? model.wall_pairs[k].material_b
                                                                                                  : model.wall_pairs[k].material_a,
                                     key, value));
-  if (!moved.empty() && !earlier.known.empty() && options.design_points > 0 && options.design_points <= basis_size(p)) options.design_points = 0;
+  if (!moved.empty() && !earlier.known.empty() && options.design_points > 0) options.design_points = 0;
   return stage;
 }
 
@@ -415,7 +419,7 @@ Targets numeric_targets(const Comparison& first) {
 /// The design's simulations planned, the first box (the parameters' own) and the start as the
 /// last optimum, before any point is simulated.
 Search start_search(const Fit& fit, const std::vector<double>& start, Progress& progress) {
-  for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.rounds * fit.points);
+  for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.points + (fit.rounds - 1) * fit.later_points);
   Search search;
   search.box = fit.parameters;
   search.x_best.resize(fit.p);
@@ -487,10 +491,11 @@ std::vector<Eigen::VectorXd> included_points(const Fit& fit, const EarlierPoints
 /// The round's design points (points x p): a Latin hypercube in the box, and in the first round
 /// the points included from earlier simulations.
 Eigen::MatrixXd round_design(const Fit& fit, const Search& search, int round) {
-  const int own = round == 0 ? fit.points - static_cast<int>(search.included.size()) : fit.points;
-  Eigen::MatrixXd design(fit.points, fit.p);
+  const int points = round == 0 ? fit.points : fit.later_points;
+  const int own = round == 0 ? points - static_cast<int>(search.included.size()) : points;
+  Eigen::MatrixXd design(points, fit.p);
   design.topRows(own) = latin_hypercube(search.box, own, fit.options.seed + 7919u * static_cast<std::uint64_t>(round));
-  for (int k = own; k < fit.points; ++k) design.row(k) = search.included[k - own].transpose();
+  for (int k = own; k < points; ++k) design.row(k) = search.included[k - own].transpose();
   return design;
 }
 
@@ -499,7 +504,7 @@ Eigen::MatrixXd round_design(const Fit& fit, const Search& search, int round) {
 void simulate_design(const Fit& fit, const Eigen::MatrixXd& design, int round, Search& search, Progress& progress, CalibrationResult& result) {
   const CalibrationOptions& options = fit.options;
   const MeasurementSet& measured = fit.measured;
-  const int points = fit.points;
+  const int points = static_cast<int>(design.rows());
   Eigen::MatrixXd values(points, static_cast<Eigen::Index>(fit.targets.names.size()));
   values.setConstant(kNaN);
   std::vector<MaterialModel> models;
@@ -669,8 +674,8 @@ void refine_around_best(const Fit& fit, Search& search, Progress& progress, Cali
     search.box = missed ? zoom(fit.parameters, centre, search.box, 0.5) : zoom(fit.parameters, search.x_best, search.box, 1.0);
     if (options.progress) options.progress(fmt::format("calibrate: {}: one more round around the best point simulated so far", why));
     const int n_experiments = static_cast<int>(fit.measured.experiments.size());
-    for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.points);
-    if (detail::CommandProgress& count = options.context->count; count.active()) count.plan_more(n_experiments * (fit.points + std::max(1, options.replicas)));
+    for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.later_points);
+    if (detail::CommandProgress& count = options.context->count; count.active()) count.plan_more(n_experiments * (fit.later_points + std::max(1, options.replicas)));
     search.x_best = centre;
     design_round(fit, fit.rounds + refine, search, progress, result);
     result.after = confirm_optimum(fit, search, result);
@@ -814,7 +819,10 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   const std::string budget_words = plan_for_budget(given, t0, command, n, p, result.before, options);
   const Targets targets = numeric_targets(result.before);
 
-  const Fit fit{walls.first.model, measured, parameters, options, targets, p, detail::design_points(options, p), std::max(1, options.rounds)};
+  CalibrationOptions full_rule = options;
+  if (!earlier.known.empty()) full_rule.design_points = 0;
+  const Fit fit{walls.first.model, measured, parameters, options, targets, p, detail::design_points(options, p), std::max(1, options.rounds),
+                detail::design_points(full_rule, p)};
   Progress progress{options, "design"};
   Search search = start_search(fit, result.start, progress);
   feed_known_points(fit, earlier, walls.moved, search, result);

@@ -181,9 +181,33 @@ inline int design_points_beside_known(int k, int added) {
   return std::max(k + 2, 2 * (b(k) - b(k - added)));
 }
 
+/// Design points of one round of a confirmation that fits `k` parameters, of which the last
+/// `added` change nothing at the plain fit's points (EarlierPoints::known): the design factor
+/// applied to the coefficients those points leave open, as design_points applies it to all of
+/// them (design factor 2, one parameter added to two fitted: 10 points, against 22 for the whole
+/// quadratic), and never fewer than design_points_beside_known. The known points determine
+/// the rest; where the walls' first stage moves a wall pair and they are left out, the calibration
+/// takes the full rule again (calibration.cpp, fit_walls_stage), and so does a fit with a zoom
+/// round (rounds > 1), whose smaller box holds few of them. Rejected: the full rule everywhere,
+/// which simulates again, with a third parameter beside them, the plane the plain fit has
+/// already mapped.
+inline int confirmation_design_points(const CalibrationOptions& o, int k, int added) {
+  if (o.design_points > 0 || o.rounds > 1) return design_points(o, k);
+  const auto b = [](int q) { return 1 + q + q * (q + 1) / 2; };
+  const int open = b(k) - b(k - added);
+  return std::min(design_points(o, k), std::max(design_points_beside_known(k, added), static_cast<int>(std::ceil(o.design_factor * open)) + 2));
+}
+
 /// Passes over the experiments (a simulation of each) that a calibration of `p` parameters
 /// makes after its first comparison: the design rounds and the confirming comparison.
 inline int calibration_passes(const CalibrationOptions& o, int p) { return std::max(1, o.rounds) * design_points(o, p) + std::max(1, o.replicas); }
+
+/// The passes of a confirmation adding one parameter to `p` fitted, at confirmation_design_points:
+/// what a plan counts for each (a candidate of two parameters, or one whose plain-fit points are
+/// left out, costs more; the plan after the screen counts each one's own).
+inline int confirmation_passes(const CalibrationOptions& o, int p) {
+  return std::max(1, o.rounds) * confirmation_design_points(o, p + 1, 1) + std::max(1, o.replicas);
+}
 
 /// Passes over the experiments that a diagnosis makes after its first comparison, fitting `p`
 /// parameters and screening `effects` effects and `walls` wall parameters (diagnosis.cpp).

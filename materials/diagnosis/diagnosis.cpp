@@ -262,6 +262,7 @@ class DiagnosisRun {
                               const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor, detail::Progress& progress,
                               double& measured_chi2, double& cost);
   void fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of);
+  CalibrationOptions confirmation_options(const CandidateResult& cr) const;
   void confirm(CandidateResult& cr, const CalibrationOptions& options);
   void separate(const CandidateResult& best, const CandidateResult& rival);
   std::vector<std::string> unexplained_by(const CandidateResult& best) const;
@@ -677,7 +678,7 @@ void DiagnosisRun::plan_signatures(SignaturePass& pass) {
     for (const Experiment& e : measured_.experiments) pass.progress.plan(e, pass.replicas + 1);
   if (command_.outermost())
     count_.plan_remaining(experiments_ * static_cast<int>(effects_.size()) * (pass.replicas + 1) +
-                          (fits_ ? 0 : experiments_ * options_.confirm_candidates * detail::calibration_passes(options_, fitted_ + 1)));
+                          (fits_ ? 0 : experiments_ * options_.confirm_candidates * detail::confirmation_passes(options_, fitted_)));
 }
 
 /// The screen's basis, with a progress line when the signatures are screened whole.
@@ -847,17 +848,17 @@ void DiagnosisRun::confirm_leaders() {
   });
   std::map<std::string, int> design_points_of;  // a confirmation's design points, where a budget reduced them
   fit_confirmations_to_budget(confirming, design_points_of);
-  const auto options_for = [&](const std::string& name) {
-    CalibrationOptions o = options_;
-    if (const auto it = design_points_of.find(name); it != design_points_of.end()) o.design_points = it->second;
+  const auto options_for = [&](const CandidateResult& cr) {
+    CalibrationOptions o = confirmation_options(cr);
+    if (const auto it = design_points_of.find(cr.name); it != design_points_of.end()) o.design_points = it->second;
     return o;
   };
   if (command_.outermost()) {
     int passes = 0;
-    for (const size_t rank : confirming) passes += detail::calibration_passes(options_for(d_.candidates[rank].name), d_.candidates[rank].k);
+    for (const size_t rank : confirming) passes += detail::calibration_passes(options_for(d_.candidates[rank]), d_.candidates[rank].k);
     count_.plan_remaining(experiments_ * passes);
   }
-  for (const size_t rank : confirming) confirm(d_.candidates[rank], options_for(d_.candidates[rank].name));
+  for (const size_t rank : confirming) confirm(d_.candidates[rank], options_for(d_.candidates[rank]));
   for (const CandidateResult& c : d_.candidates)
     if (!c.confirmed && c.explained >= 0.05)
       unconfirmed_.push_back(fmt::format("{} ({:.0f} %{})", c.name, 100 * c.explained, c.stable ? "" : ", unstable"));
@@ -876,7 +877,7 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
   std::vector<double> costs;
   std::vector<bool> tied;
   for (const size_t rank : confirming) {
-    costs.push_back(experiments_ * detail::calibration_passes(options_, d_.candidates[rank].k) * per_simulation);
+    costs.push_back(experiments_ * detail::calibration_passes(confirmation_options(d_.candidates[rank]), d_.candidates[rank].k) * per_simulation);
     tied.push_back(std::find(undecided_.begin(), undecided_.end(), d_.candidates[rank].name) != undecided_.end());
   }
   // A candidate whose plain-fit points are points of its own space (EffectCandidate::unchanged)
@@ -888,7 +889,7 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
     const CandidateResult& cr = d_.candidates[confirming[k]];
     CalibrationOptions o = options_;
     o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
-    if (!takes_plain_points(effect_of(cr), cr) || o.design_points >= detail::design_points(options_, cr.k)) continue;
+    if (!takes_plain_points(effect_of(cr), cr) || o.design_points >= detail::design_points(confirmation_options(cr), cr.k)) continue;
     smaller[k] = experiments_ * detail::calibration_passes(o, cr.k) * per_simulation;
     fewer_points[cr.name] = o.design_points;
   }
@@ -921,6 +922,14 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
                   "larger --budget, or with --effects {} (the simulations done are kept in the store).",
                   detail::duration_text(given_.budget_seconds), detail::duration_text(count_.elapsed()), per_simulation, join(dropped, ", "),
                   dropped.size() == 1 ? "was" : "were", detail::duration_text(each), join(dropped, ",")));
+}
+
+/// A candidate's confirmation options: where the plain fit's points are points of its space, its
+/// design covers only what they leave open (confirmation_design_points).
+CalibrationOptions DiagnosisRun::confirmation_options(const CandidateResult& cr) const {
+  CalibrationOptions o = options_;
+  if (takes_plain_points(effect_of(cr), cr)) o.design_points = detail::confirmation_design_points(options_, cr.k, static_cast<int>(cr.adds.size()));
+  return o;
 }
 
 /// One candidate added at its start values and recalibrated with the fitted parameters.
