@@ -56,6 +56,13 @@ TEST(BadInput, UnknownKeySuggestsTheNearest) {
   EXPECT_ERROR(read_case_text(good_case() + "simulaton: {}\n"), "fuzz.yaml:", "simulaton: unknown key", "simulation");
   EXPECT_ERROR(read_case_text(good_case("{material: glass, diametr: 0.01, count: 10, region: {min: [0, 0, 0], max: [0.1, 0.1, 0.1]}}")),
                "particles[0]", "diameter");
+  // Each valid key once, although a material's properties are read and also listed as valid.
+  std::string glassy = good_case();
+  glassy.replace(glassy.find("friction: 0.3}"), 14, "friction: 0.3, frictoin: 0.2}");
+  const std::string message = read_case_text(glassy);
+  EXPECT_ERROR(message, "frictoin: unknown key", "friction");
+  for (const char* key : {"density, density", "friction, friction", "youngs_modulus, youngs_modulus"})
+    EXPECT_EQ(message.find(key), std::string::npos) << key << " in: " << message;
 }
 
 TEST(BadInput, WrongTypeSaysWhatIsValid) {

@@ -287,6 +287,7 @@ void MapReader::finish(const std::vector<std::string>& extra_valid) const {
   std::vector<std::string> valid(used_.begin(), used_.end());
   valid.insert(valid.end(), extra_valid.begin(), extra_valid.end());
   std::sort(valid.begin(), valid.end());
+  valid.erase(std::unique(valid.begin(), valid.end()), valid.end());  // a key read here and also passed as valid is listed once
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
     if (used_.count(key) || std::find(extra_valid.begin(), extra_valid.end(), key) != extra_valid.end()) continue;
