@@ -902,8 +902,7 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
     for (const auto& [name, points] : fewer_points) which.push_back(fmt::format("{} {}", name, points));
     say(fmt::format("To fit the budget of {} with a tie, the confirmations design fewer points ({} a round, against {}): the plain "
                     "fit's points, where each candidate changes nothing, determine the rest of their surrogates.",
-                    detail::duration_text(given_.budget_seconds), join(which),
-                    detail::design_points(confirmation_options(d_.candidates[confirming.front()]), d_.candidates[confirming.front()].k)));
+                    detail::duration_text(given_.budget_seconds), join(which), detail::design_points(options_, d_.candidates[confirming.front()].k)));
   }
   std::vector<size_t> kept;
   std::vector<std::string> dropped, beyond;
