@@ -410,6 +410,21 @@ TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
   EXPECT_EQ(choice.undecided, (std::vector<std::string>{"jkr"}));
   EXPECT_TRUE(choice.nonlinear.empty());
 
+  // More tied than may be confirmed (at most 4): the leader, then the stable signatures of its
+  // band before the unstable ones, whatever their shares within the band. Wall parameters whose
+  // two strengths disagree (their "100 %" a noisy linear recalibration of a few terms) leave the
+  // places to the stable shape and liquid bridges.
+  std::vector<CandidateResult> crowded(6);
+  const char* crowd[] = {"steel.friction", "steel.rolling_friction", "steel.restitution", "clump_shape", "liquid_bridge", "sjkr"};
+  const double shares[] = {1.0, 1.0, 1.0, 0.98, 0.96, 0.86};
+  const double agreements[] = {-0.01, -0.15, 0.05, 0.80, 0.99, 0.96};
+  for (size_t k = 0; k < crowded.size(); ++k)
+    crowded[k].name = crowd[k], crowded[k].explained = shares[k], crowded[k].agreement = agreements[k], crowded[k].stable = agreements[k] >= 0.5;
+  const detail::ConfirmationChoice crowd_choice = detail::choose_confirmations(crowded, CalibrationOptions{});
+  EXPECT_EQ(crowd_choice.confirming, (std::vector<size_t>{0, 1, 3, 4}));
+  EXPECT_EQ(crowd_choice.undecided, (std::vector<std::string>{"steel.rolling_friction", "clump_shape", "liquid_bridge"}));
+  EXPECT_EQ(crowd_choice.nonlinear, std::vector<std::string>{});
+
   // 700 s left, 600 s a confirmation: the leader fits; the second is tied with it (the screen
   // cannot tell them apart) and is confirmed beyond the budget; the third is not tied and waits.
   const detail::ConfirmationPlan plan = detail::fit_confirmations({600, 600, 600}, {false, true, false}, 700);

@@ -45,8 +45,30 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
     if (cr.explained >= 0.05 && cr.agreement < 0.5) return out.nonlinear.push_back(cr.name), true;
     return false;
   };
-  for (size_t rank = 0; rank < ranked.size() && static_cast<int>(out.confirming.size()) < options.confirm_candidates + 2; ++rank)
+  for (size_t rank = 0; rank < ranked.size(); ++rank)
     if (chosen(ranked[rank], static_cast<int>(rank))) out.confirming.push_back(rank);
+  // More chosen than may be confirmed: the leader stays, and the rest go by the screen's band
+  // below the leader's share and, within a band the screen cannot rank, stable signatures before
+  // unstable ones. An unstable candidate's share is the chi^2 of its own few runs after a linear
+  // recalibration, which noise can bring near 0 on a file of few terms; a stable one's rests on
+  // two strengths that agree. Rejected: the cut in rank order, with which three wall parameters
+  // whose signatures were noise (agreement -0.15 to 0.05, "100 %") took the places of the liquid
+  // bridges (96 %, agreement 0.99) that made the data.
+  const auto cap = static_cast<size_t>(std::max(1, options.confirm_candidates + 2));
+  if (out.confirming.size() > cap) {
+    const auto band = [&](size_t rank) { return std::floor((leader - ranked[rank].explained) / std::max(options.screen_margin, 1e-6)); };
+    std::stable_sort(out.confirming.begin() + 1, out.confirming.end(), [&](size_t a, size_t b) {
+      if (band(a) != band(b)) return band(a) < band(b);
+      return ranked[a].stable && !ranked[b].stable;
+    });
+    out.confirming.resize(cap);
+    std::sort(out.confirming.begin(), out.confirming.end());
+    const auto left_out = [&](const std::string& name) {
+      return std::none_of(out.confirming.begin(), out.confirming.end(), [&](size_t rank) { return ranked[rank].name == name; });
+    };
+    std::erase_if(out.undecided, left_out);
+    std::erase_if(out.nonlinear, left_out);
+  }
   return out;
 }
 

@@ -344,7 +344,6 @@ void choose_parameters(const MaterialModel& given_model, std::vector<FitParamete
 /// The walls' first stage, and the wall pairs it moved.
 WallStage fit_walls_stage(const MaterialModel& given_model, const MeasurementSet& measured, const std::vector<FitParameter>& parameters,
                           const EarlierPoints& earlier, CalibrationOptions& options, CalibrationResult& result) {
-  const int p = static_cast<int>(parameters.size());
   // Stage one: the wall pairs' restitution from their drop tests (walls_first.cpp). The design
   // starts from that model; `before` stays the comparison of the model as given.
   WallStage stage{detail::fit_walls_first(given_model, measured, parameters, options), {}};

@@ -231,7 +231,8 @@ constexpr double kScreenCost = 2.0, kConfirmationCost = 1.2;
 /// none, the leading ones anyway); every runner-up the screen cannot tell from the leader (within
 /// screen_margin: `undecided`, whatever its rank, so that a budget does not leave it out); and
 /// one whose signature changes shape between its two strengths (`nonlinear`); at most
-/// confirm_candidates + 2. `confirming` holds indices into `ranked`.
+/// confirm_candidates + 2: beyond that the leader and then, band of screen_margin by band, stable
+/// signatures before unstable ones. `confirming` holds indices into `ranked`.
 struct ConfirmationChoice {
   std::vector<size_t> confirming;
   std::vector<std::string> undecided, nonlinear;
