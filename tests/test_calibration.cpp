@@ -223,6 +223,26 @@ TEST(Measurements, ErrorsNameFileLineKeyAndWhatIsValid) {
   EXPECT_NE(e.find("not valid YAML"), std::string::npos) << e;
 }
 
+TEST(Calibration, AFitOutOfThePlausibleOrAtItsRangesEdgeIsNamed) {
+  // The plausible spans come from the parameter rows (ParamSpec::plausible; Coetzee 2017) for a
+  // particle key and a wall pair's alike; a material file's `plausible:` would replace them.
+  MaterialModel m = read_material_model(kMaterials + "/gravel.yaml");
+  EXPECT_EQ(plausible_range(m, "friction"), (std::pair{0.1, 0.7}));
+  EXPECT_EQ(plausible_range(m, "wall.friction"), (std::pair{0.1, 0.7}));
+  EXPECT_EQ(plausible_range(m, "restitution"), (std::pair{0.1, 0.95}));
+  EXPECT_EQ(plausible_range(m, "rolling_friction"), (std::pair{0.0, 0.4}));
+  EXPECT_FALSE(plausible_range(m, "youngs_modulus").has_value());
+  const std::vector<FitParameter> fitted = {{"friction", 0.1, 0.9}, {"rolling_friction", 0.0, 0.5}, {"restitution", 0.2, 0.9}};
+  std::vector<std::string> words;
+  // friction 0.79 +- 0.02: out by more than twice its error; rolling 0.45 +- 0.1: within two
+  // errors of 0.4, not named; restitution at 0.899, the edge of its tunable range [0.2, 0.9].
+  const std::vector<std::string> keys = implausible_fits(m, fitted, {0.79, 0.45, 0.899}, {0.02, 0.1, 0.01}, words);
+  EXPECT_EQ(keys, (std::vector<std::string>{"friction", "restitution"}));
+  ASSERT_EQ(words.size(), 1u);
+  EXPECT_NE(words[0].find("friction = 0.79, outside 0.1 to 0.7 (what dry bulk solids usually show)"), std::string::npos) << words[0];
+  EXPECT_NE(words[0].find("restitution = 0.899, at the edge of its range [0.2, 0.9]"), std::string::npos) << words[0];
+}
+
 TEST(MaterialModel, ReadsALibraryFile) {
   MaterialModel m = read_material_model(kMaterials + "/gravel.yaml");
   EXPECT_EQ(m.name, "gravel");

@@ -398,6 +398,20 @@ TEST(Budget, AShrunkApparatusIsCorrectedToFullSizeAndTheNamedEffectCheckedThere)
   EXPECT_LT(raw.residual("density", "bulk_density"), -4);
 }
 
+TEST(Budget, AConfirmationIsCountedAtItsOwnCandidatesCost) {
+  // Three candidates screened, 10 simulations each, one core: spheres 5 s, clumps 20 s, cohesion
+  // 8 s a simulation (mean 11 s); the screen took 6 s of wall time a simulation on two cores.
+  std::vector<CandidateResult> screened(3);
+  const double one_core[] = {5, 20, 8};
+  for (size_t k = 0; k < screened.size(); ++k) screened[k].cost = 10 * one_core[k], screened[k].simulations = 10;
+  EXPECT_NEAR(detail::candidate_seconds_per_simulation(screened, screened[0], 6.0), 6.0 * 5 / 11, 1e-12);
+  EXPECT_NEAR(detail::candidate_seconds_per_simulation(screened, screened[1], 6.0), 6.0 * 20 / 11, 1e-12);
+  // Unknown before a screen, or for a candidate without simulations: 0, the caller's fallback.
+  EXPECT_EQ(detail::candidate_seconds_per_simulation(screened, screened[1], 0.0), 0.0);
+  const CandidateResult unscreened;
+  EXPECT_EQ(detail::candidate_seconds_per_simulation(screened, unscreened, 6.0), 0.0);
+}
+
 TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {
   // sjkr 73 %, jkr 69 % (within the 10 % margin: tied, although jkr is also among the two leaders
   // confirmed anyway), liquid bridges 57 % (not tied); the budget below may drop only the last.

@@ -72,6 +72,14 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
   return out;
 }
 
+double candidate_seconds_per_simulation(const std::vector<CandidateResult>& screened, const CandidateResult& cr, double screen_seconds) {
+  double cost = 0;
+  int simulations = 0;
+  for (const CandidateResult& c : screened) cost += c.cost, simulations += c.simulations;
+  if (!(screen_seconds > 0 && cost > 0 && cr.simulations > 0 && cr.cost > 0)) return 0.0;
+  return screen_seconds * (cr.cost / cr.simulations) / (cost / simulations);
+}
+
 ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left, const std::vector<double>& smaller) {
   const auto fit = [&](const std::vector<double>& cost) {
     ConfirmationPlan plan;

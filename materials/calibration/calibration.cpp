@@ -244,18 +244,17 @@ MaterialModel with_values(const MaterialModel& model, const std::vector<FitParam
 }  // namespace
 
 /// Where a fitted value of a dry bulk solid usually lies, when the material file states none
-/// (`plausible:`): sliding friction between particles or against a wall liner 0.1-0.7, restitution
-/// 0.1-0.95, rolling friction (a stand-in for shape) 0-0.4, the span of calibrated values surveyed
-/// by Coetzee (2017, Powder Technology 310:104) for dry granular materials. A value outside, or
-/// one that runs to the edge of its tunable range, is most often the fit absorbing physics the
-/// model lacks (friction raised to 0.8 for missing rolling resistance or cohesion).
+/// (`plausible:`): its parameter row's (ParamSpec::plausible), which gives sliding friction between
+/// particles or against a wall liner 0.1-0.7, restitution 0.1-0.95 and rolling friction (a
+/// stand-in for shape) 0-0.4, the span of calibrated values surveyed by Coetzee (2017, Powder
+/// Technology 310:104) for dry granular materials. A value outside, or one that runs to the edge
+/// of its tunable range, is most often the fit absorbing physics the model lacks (friction raised
+/// to 0.8 for missing rolling resistance or cohesion).
 std::optional<std::pair<double, double>> plausible_range(const MaterialModel& model, const std::string& key) {
   if (const auto it = model.particle.plausible.find(key); it != model.particle.plausible.end()) return it->second;
   const std::string base = key.substr(key.rfind('.') + 1);
   if (const auto it = model.particle.plausible.find(base); it != model.particle.plausible.end()) return it->second;
-  if (base == "friction") return std::pair{0.1, 0.7};
-  if (base == "restitution") return std::pair{0.1, 0.95};
-  if (base == "rolling_friction") return std::pair{0.0, 0.4};
+  if (const ParamSpec* row = find_param(base)) return row->plausible;
   return std::nullopt;
 }
 

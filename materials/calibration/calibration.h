@@ -411,6 +411,7 @@ struct CandidateResult {
   double screen_chi2 = 0;
   double expected_gain = 0;          ///< expected BIC gain: base chi^2 - screen_chi2 - (added parameters) ln n
   double cost = 0;                   ///< [s] what its signature simulations took (wall seconds, one core each)
+  int simulations = 0;               ///< how many signature simulations `cost` is the time of
   std::string ranked_why;            ///< why it stands where it is in the ranking
   bool confirmed = false;
   CalibrationResult fit;             ///< when confirmed

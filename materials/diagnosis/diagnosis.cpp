@@ -226,6 +226,8 @@ class DiagnosisRun {
 
   std::string shrunk_words_;      ///< why and how the apparatus was shrunk (shrink)
   double full_size_reserve_ = 0;  ///< [s] of the budget kept for the full-size check of a shrunk diagnosis
+  double screen_seconds_per_simulation_ = 0;  ///< [s] wall time the screen took a simulation
+  double confirmation_seconds_per_simulation(const CandidateResult& cr) const;
   double cost_mark_seconds_ = 0;  ///< the command's time and simulations when the apparatus was shrunk:
   int cost_mark_done_ = 0;        ///< later costs are measured from there
 
@@ -260,7 +262,7 @@ class DiagnosisRun {
   template <class SignatureOf, class OwnChi2>
   std::string weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
                               const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor, detail::Progress& progress,
-                              double& measured_chi2, double& cost);
+                              double& measured_chi2, CandidateResult& cr);
   void fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of);
   CalibrationOptions confirmation_options(const CandidateResult& cr) const;
   void confirm(CandidateResult& cr, const CalibrationOptions& options);
@@ -578,7 +580,7 @@ void bound_first_round(const EffectCandidate& c, double strength_needed, Candida
 template <class SignatureOf, class OwnChi2>
 std::string DiagnosisRun::weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
                                           const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor,
-                                          detail::Progress& progress, double& measured_chi2, double& cost) {
+                                          detail::Progress& progress, double& measured_chi2, CandidateResult& cr) {
   if (c.parameters.size() != 1 || !(multiple > 0.05 && multiple < 0.9) || measured_chi2 <= rr * (1 - linear)) return "";
   const auto& [key, range] = *c.parameters.begin();
   if (!c.start.count(key)) return "";
@@ -603,7 +605,7 @@ std::string DiagnosisRun::weaker_strength(const EffectCandidate& c, double multi
   } catch (const CaseError&) {
     return "";
   }
-  for (const ExperimentRun& run : runs) cost += run.wall_seconds;
+  for (const ExperimentRun& run : runs) cr.cost += run.wall_seconds, cr.simulations += run.replicas;
   measured_chi2 = std::min(measured_chi2, own_chi2(signature_of(compare_runs(measured_, runs, options_, floor))));
   return fmt::format(" (at its start, the stronger step and {:.3g}, where the linear screen points)", value);
 }
@@ -625,10 +627,20 @@ void DiagnosisRun::screen_signatures() {
   SignaturePass pass{std::max(1, std::min(options_.replicas, options_.signature_replicas)), Progress{options_, "signatures"}};
   plan_signatures(pass);
   const ScreenBasis basis = screen_basis(std::move(residual));
+  const double seconds_before = count_.elapsed();
+  const int done_before = count_.done();
   const std::vector<detail::SignatureRuns> signature_runs =
       detail::simulate_signatures(d_.base.fitted, effects_, parameters_, measured_, options_, pass.replicas, &pass.progress);
   for (size_t index = 0; index < effects_.size(); ++index) screen_candidate(effects_[index], signature_runs[index], basis, pass);
+  if (count_.done() > done_before) screen_seconds_per_simulation_ = (count_.elapsed() - seconds_before) / (count_.done() - done_before);
   rank_by_share();
+}
+
+/// [s] of wall time a confirmation's simulation of `cr` is expected to take
+/// (detail::candidate_seconds_per_simulation), the diagnosis' mean so far before a screen.
+double DiagnosisRun::confirmation_seconds_per_simulation(const CandidateResult& cr) const {
+  const double screened = detail::candidate_seconds_per_simulation(d_.candidates, cr, screen_seconds_per_simulation_);
+  return screened > 0 ? screened : seconds_per_simulation();
 }
 
 /// The calibrated residual and the fitted parameters' surrogate Jacobian, in each term's sigma.
@@ -728,7 +740,7 @@ void DiagnosisRun::measure_strengths(const EffectCandidate& c, const detail::Sig
                                      CandidateScreen& screen) {
   for (int strength = 0; strength < 2; ++strength) {
     const std::vector<ExperimentRun>& runs = strength == 0 ? signature_runs.start : signature_runs.stronger;
-    for (const ExperimentRun& run : runs) cr.cost += run.wall_seconds;
+    for (const ExperimentRun& run : runs) cr.cost += run.wall_seconds, cr.simulations += run.replicas;
     const Comparison changed = compare_runs(measured_, runs, options_, basis.floor);
     const Eigen::VectorXd s = signature_of_runs(basis, changed, screen.flips);
     if (strength == 0) screen.at_start = s;
@@ -783,7 +795,7 @@ void DiagnosisRun::rank_candidate(const EffectCandidate& c, const ScreenBasis& b
   const auto signature_of = [&](const Comparison& changed) { return signature_of_runs(basis, changed, screen.flips); };
   const auto own_chi2 = [&](const Eigen::VectorXd& s) { return own_runs_chi2(basis, screen.reachable, s); };
   const std::string weaker = cr.stable ? std::string() : weaker_strength(c, basis.cancelling(perp[0], screen.at_start), linear, rr, signature_of, own_chi2,
-                                                                        pass.replicas, basis.floor, pass.progress, screen.measured_chi2, cr.cost);
+                                                                        pass.replicas, basis.floor, pass.progress, screen.measured_chi2, cr);
   cr.screen_chi2 = cr.stable ? rr * (1 - linear) : screen.measured_chi2;
   cr.explained = rr > 0 ? std::max(0.0, 1 - cr.screen_chi2 / rr) : 0.0;
   cr.expected_gain = rr - cr.screen_chi2 - static_cast<double>(cr.adds.size()) * ln_n;
@@ -872,12 +884,12 @@ void DiagnosisRun::confirm_leaders() {
 /// says by how much that exceeds the budget.
 void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of) {
   if (!budgeted() || confirming.size() <= 1) return;
-  const double per_simulation = seconds_per_simulation();
   const double left = given_.budget_seconds - count_.elapsed() - full_size_reserve_;
   std::vector<double> costs;
   std::vector<bool> tied;
   for (const size_t rank : confirming) {
-    costs.push_back(experiments_ * detail::calibration_passes(confirmation_options(d_.candidates[rank]), d_.candidates[rank].k) * per_simulation);
+    costs.push_back(experiments_ * detail::calibration_passes(confirmation_options(d_.candidates[rank]), d_.candidates[rank].k) *
+                    confirmation_seconds_per_simulation(d_.candidates[rank]));
     tied.push_back(std::find(undecided_.begin(), undecided_.end(), d_.candidates[rank].name) != undecided_.end());
   }
   // A candidate whose plain-fit points are points of its own space (EffectCandidate::unchanged)
@@ -890,7 +902,7 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
     CalibrationOptions o = options_;
     o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
     if (!takes_plain_points(effect_of(cr), cr) || o.design_points >= detail::design_points(confirmation_options(cr), cr.k)) continue;
-    smaller[k] = experiments_ * detail::calibration_passes(o, cr.k) * per_simulation;
+    smaller[k] = experiments_ * detail::calibration_passes(o, cr.k) * confirmation_seconds_per_simulation(cr);
     fewer_points[cr.name] = o.design_points;
   }
   const detail::ConfirmationPlan plan = detail::fit_confirmations(costs, tied, left, smaller);
@@ -906,10 +918,11 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
   }
   std::vector<size_t> kept;
   std::vector<std::string> dropped, beyond;
-  double each = 0;
+  std::vector<std::string> each;  // the dropped ones with their costs
   for (const size_t k : plan.kept) kept.push_back(confirming[k]);
   for (const size_t k : plan.beyond) beyond.push_back(d_.candidates[confirming[k]].name);
-  for (const size_t k : plan.dropped) dropped.push_back(d_.candidates[confirming[k]].name), each = costs[k];
+  for (const size_t k : plan.dropped)
+    dropped.push_back(d_.candidates[confirming[k]].name), each.push_back(fmt::format("{} about {}", dropped.back(), detail::duration_text(costs[k])));
   if (!beyond.empty())
     say(fmt::format("The budget of {} is exceeded by about {}: the signature screen cannot tell {} from {}, so each is recalibrated.",
                     detail::duration_text(given_.budget_seconds), detail::duration_text(-plan.left), d_.candidates[confirming.front()].name,
@@ -918,10 +931,10 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
   confirming = kept;
   const auto gone = [&](const std::string& name) { return std::find(dropped.begin(), dropped.end(), name) != dropped.end(); };
   std::erase_if(undecided_, gone), std::erase_if(nonlinear_, gone);
-  say(fmt::format("Within the budget of {} ({} spent, at {:.1f} s a simulation), {} {} not recalibrated (about {} each): run again with a "
-                  "larger --budget, or with --effects {} (the simulations done are kept in the store).",
-                  detail::duration_text(given_.budget_seconds), detail::duration_text(count_.elapsed()), per_simulation, join(dropped, ", "),
-                  dropped.size() == 1 ? "was" : "were", detail::duration_text(each), join(dropped, ",")));
+  say(fmt::format("Within the budget of {} ({} spent; each confirmation counted at what its candidate's screen simulations cost), {} {} "
+                  "not recalibrated ({}): run again with a larger --budget, or with --effects {} (the simulations done are kept in the store).",
+                  detail::duration_text(given_.budget_seconds), detail::duration_text(count_.elapsed()), join(dropped, ", "),
+                  dropped.size() == 1 ? "was" : "were", join(each, ", "), join(dropped, ",")));
 }
 
 /// A candidate's confirmation options: where the plain fit's points are points of its space, its

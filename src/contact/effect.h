@@ -25,6 +25,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <utility>
 
 #include "base/parallel.h"
 
@@ -112,6 +113,10 @@ struct ParamSpec {
   /// in the model. Rejected: a list of keys in the diagnosis, which a new effect's wall parameter
   /// would not reach and which would go on naming a parameter whose effect the model lacks.
   bool wall_candidate = false;
+  /// Where a calibrated value of a dry bulk solid usually lies (none: not judged). A fit that
+  /// lands outside, or runs to the edge of its tunable range, is named by the calibration as the
+  /// fit absorbing physics the model lacks; a material file's `plausible:` overrides it.
+  std::optional<std::pair<double, double>> plausible = std::nullopt;
 };
 
 /// A model-wide choice of an effect, given as `stage: {model: NAME, OPTION: VALUE}`.

@@ -46,7 +46,8 @@ namespace {
 bool same_param(const ParamSpec& a, const ParamSpec& b) {
   return a.key == b.key && a.unit == b.unit && a.default_value == b.default_value && a.min_value == b.min_value &&
          a.max_value == b.max_value && a.mixing == b.mixing && a.tunable == b.tunable &&
-         a.coarse_grain_exponent == b.coarse_grain_exponent && a.wall_candidate == b.wall_candidate;
+         a.coarse_grain_exponent == b.coarse_grain_exponent && a.wall_candidate == b.wall_candidate &&
+         a.plausible == b.plausible;
 }
 
 const EffectSpec* find_in(const std::vector<const EffectSpec*>& rows, Stage stage, std::string_view name) {

@@ -14,7 +14,7 @@ namespace dem::effects {
 /// (core/coarse_grain.h): unchanged (exponent 0); the lever mu_r R* grows with the parcel's R*.
 inline constexpr ParamSpec kRollingFrictionParam = {"rolling_friction", "-", 0.0, 0.0, 1.0, Mixing::arithmetic, true,
                                                "rolling friction coefficient mu_r; lever arm of the limiting torque is mu_r R*", 0,
-                                               /*wall_candidate=*/true};
+                                               /*wall_candidate=*/true, /*plausible=*/std::pair{0.0, 0.4}};
 
 // Pieces shared by the kernels with a spring in the contact plane (Mindlin, EPSD), written as
 // selects so the kernels' loops stay vectorised, and always inlined: a call left in a loop stops

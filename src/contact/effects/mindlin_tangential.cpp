@@ -50,7 +50,8 @@ enum Param { kFriction };
 
 // Coarse graining (core/coarse_grain.h): mu unchanged (exponent 0): a ratio of forces, each F^2.
 constexpr ParamSpec kParams[] = {
-    {"friction", "-", 0.5, 0.0, 10.0, Mixing::arithmetic, true, "Coulomb sliding friction coefficient", 0, /*wall_candidate=*/true},
+    {"friction", "-", 0.5, 0.0, 10.0, Mixing::arithmetic, true, "Coulomb sliding friction coefficient", 0, /*wall_candidate=*/true,
+     /*plausible=*/std::pair{0.1, 0.7}},
 };
 constexpr std::string_view kCoulombCap[] = {"total", "spring", "spring_abs_fn"};
 constexpr OptionSpec kOptions[] = {

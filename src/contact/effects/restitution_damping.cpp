@@ -24,7 +24,8 @@ enum Param { kRestitution, kBeta /* derived */ };
 // coefficient it gives, 2 beta sqrt(S m*), grows as F^2 from the parcel's stiffness and mass.
 constexpr ParamSpec kParams[] = {
     {"restitution", "-", 0.5, 1e-4, 1.0, Mixing::arithmetic, true,
-     "coefficient of normal restitution of a binary collision", 0, /*wall_candidate=*/true},
+     "coefficient of normal restitution of a binary collision", 0, /*wall_candidate=*/true,
+     /*plausible=*/std::pair{0.1, 0.95}},
 };
 constexpr std::string_view kEndOfContact[] = {"tension", "clip"};
 constexpr OptionSpec kOptions[] = {
