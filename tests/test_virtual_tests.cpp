@@ -451,6 +451,22 @@ TEST(HopperDischarge, RateWithinBeverloosRangeAndASmallOrificeBlocks) {
   print("hopper_discharge 2.5 d orifice", arch);
   EXPECT_TRUE(flagged(arch, "blocked"));
   EXPECT_EQ(arch.observables.at("mass_flow_rate"), 0.0);
+  const auto says = [](const SimulatedOutcome& o, const std::string& words) {
+    return std::any_of(o.notes.begin(), o.notes.end(), [&](const std::string& n) { return n.find(words) != std::string::npos; });
+  };
+  EXPECT_TRUE(says(arch, "rest over the orifice: an arch"));
+  // A bed 12 mm deep over a 5 d orifice in an 80 mm silo: the flat floor's dead zone (the wedge
+  // from the orifice's edge up at 30 degrees, cut at the bed's top: about 65 % of it) holds more
+  // than 30 %, so the flow stops short of 70 % and the protocol reads `blocked`, with the orifice
+  // clear. Rolling resistance 0.3 holds the dead zone's slope still (without it the spheres go on
+  // trickling down it until the time cap, which the note says as "still flowing").
+  MaterialModel rough = beads(0.5, 0.3, 0.5, 0.005);
+  rough.particle.youngs_modulus = 2e5;
+  const SimulatedOutcome drained = run_virtual_test(
+      rough, setup_of("hopper_discharge", {{"silo_diameter", 0.08}, {"orifice_diameter", orifice}, {"fill_height", 0.012}}, {{"wall", "steel"}}), {});
+  print("hopper_discharge, a shallow bed", drained);
+  EXPECT_TRUE(flagged(drained, "blocked"));
+  EXPECT_TRUE(says(drained, "the orifice is clear: the funnel drained to the floor's dead zone, no arch"));
 }
 
 // A shrunk silo keeps its orifice and leaves on its flat floor no more of its bed than the full
