@@ -399,17 +399,17 @@ TEST(Budget, AShrunkApparatusIsCorrectedToFullSizeAndTheNamedEffectCheckedThere)
 }
 
 TEST(Budget, AConfirmationIsCountedAtItsOwnCandidatesCost) {
-  // Three candidates screened, 10 simulations each, one core: spheres 5 s, clumps 20 s, cohesion
-  // 8 s a simulation (mean 11 s); the screen took 6 s of wall time a simulation on two cores.
-  std::vector<CandidateResult> screened(3);
-  const double one_core[] = {5, 20, 8};
-  for (size_t k = 0; k < screened.size(); ++k) screened[k].cost = 10 * one_core[k], screened[k].simulations = 10;
-  EXPECT_NEAR(detail::candidate_seconds_per_simulation(screened, screened[0], 6.0), 6.0 * 5 / 11, 1e-12);
-  EXPECT_NEAR(detail::candidate_seconds_per_simulation(screened, screened[1], 6.0), 6.0 * 20 / 11, 1e-12);
-  // Unknown before a screen, or for a candidate without simulations: 0, the caller's fallback.
-  EXPECT_EQ(detail::candidate_seconds_per_simulation(screened, screened[1], 0.0), 0.0);
+  // Signature simulations of 20 s of one core each (a drum of clumps) against 5 s (spheres):
+  // their confirmations, two simulations at once, are counted at 10 s and 2.5 s of wall time.
+  CandidateResult clumps, spheres;
+  clumps.cost = 10 * 20.0, clumps.simulations = 10;
+  spheres.cost = 10 * 5.0, spheres.simulations = 10;
+  EXPECT_DOUBLE_EQ(detail::candidate_seconds_per_simulation(clumps, 2), 10.0);
+  EXPECT_DOUBLE_EQ(detail::candidate_seconds_per_simulation(spheres, 2), 2.5);
+  EXPECT_DOUBLE_EQ(detail::candidate_seconds_per_simulation(spheres, 0), 5.0);
+  // A candidate without signature simulations: 0, the caller's fallback.
   const CandidateResult unscreened;
-  EXPECT_EQ(detail::candidate_seconds_per_simulation(screened, unscreened, 6.0), 0.0);
+  EXPECT_EQ(detail::candidate_seconds_per_simulation(unscreened, 2), 0.0);
 }
 
 TEST(Budget, CandidatesTheScreenCannotTellApartAreAllConfirmed) {

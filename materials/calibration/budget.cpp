@@ -57,7 +57,8 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
   const auto cap = static_cast<size_t>(std::max(1, options.confirm_candidates + 2));
   if (out.confirming.size() > cap) {
     const auto band = [&](size_t rank) { return std::floor((leader - ranked[rank].explained) / std::max(options.screen_margin, 1e-6)); };
-    std::stable_sort(out.confirming.begin() + 1, out.confirming.end(), [&](size_t a, size_t b) {
+    const auto after_leader = out.confirming.begin() + (out.confirming.front() == 0 ? 1 : 0);
+    std::stable_sort(after_leader, out.confirming.end(), [&](size_t a, size_t b) {
       if (band(a) != band(b)) return band(a) < band(b);
       return ranked[a].stable && !ranked[b].stable;
     });
@@ -72,12 +73,8 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
   return out;
 }
 
-double candidate_seconds_per_simulation(const std::vector<CandidateResult>& screened, const CandidateResult& cr, double screen_seconds) {
-  double cost = 0;
-  int simulations = 0;
-  for (const CandidateResult& c : screened) cost += c.cost, simulations += c.simulations;
-  if (!(screen_seconds > 0 && cost > 0 && cr.simulations > 0 && cr.cost > 0)) return 0.0;
-  return screen_seconds * (cr.cost / cr.simulations) / (cost / simulations);
+double candidate_seconds_per_simulation(const CandidateResult& cr, int parallel) {
+  return cr.simulations > 0 && cr.cost > 0 ? cr.cost / cr.simulations / std::max(1, parallel) : 0.0;
 }
 
 ConfirmationPlan fit_confirmations(const std::vector<double>& costs, const std::vector<bool>& tied, double left, const std::vector<double>& smaller) {

@@ -370,7 +370,8 @@ struct EarlierPoints {
 };
 
 /// Where a fitted value of `key` plausibly lies for this material: its file's `plausible:` range,
-/// else that of dry bulk solids for friction, restitution and rolling friction; none otherwise.
+/// else its parameter row's (ParamSpec::plausible: dry bulk solids' friction, restitution and
+/// rolling friction); none otherwise.
 std::optional<std::pair<double, double>> plausible_range(const MaterialModel& model, const std::string& key);
 /// Keys of the values out of their plausible range by more than twice their standard error
 /// (`sigma`, same order; empty: none known) or at the edge of their tunable range, with the words

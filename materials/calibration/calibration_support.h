@@ -240,14 +240,14 @@ struct ConfirmationChoice {
 };
 ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options);
 
-/// [s] of wall time a simulation of candidate `cr` is expected to take in its confirmation: the
-/// screen's wall time a simulation (`screen_seconds`), in the proportion of the candidate's own
-/// signature simulations (CandidateResult::cost over simulations, one core each) to the mean of
-/// all `screened`; 0 when either is unknown. A clump's simulations cost several times a sphere's,
-/// a cohesive silo's more than a dry one's: in lab_rolling.yaml's diagnosis (2026-12-07, one
-/// core each) a drum of clumps took 21.5 s against the plain model's 4.6 s, a silo with liquid
-/// bridges 24.4 s against 18.1 s.
-double candidate_seconds_per_simulation(const std::vector<CandidateResult>& screened, const CandidateResult& cr, double screen_seconds);
+/// [s] of wall time a simulation of candidate `cr` is expected to take in its confirmation, with
+/// `parallel` simulations at once: what its own signature simulations took, one core each
+/// (CandidateResult::cost over simulations; a simulation taken from the store counts what it took
+/// when it ran), so that a rerun from the store does not make the confirmations look free. 0
+/// when it has none. A clump's simulations cost several times a sphere's, a cohesive silo's more
+/// than a dry one's: in lab_rolling.yaml's diagnosis (2026-12-07, one core each) a drum of clumps
+/// took 21.5 s against the plain model's 4.6 s, a silo with liquid bridges 24.4 s against 18.1 s.
+double candidate_seconds_per_simulation(const CandidateResult& cr, int parallel);
 
 /// Which candidate confirmations fit what is left of a budget [s], each at its cost [s], in rank
 /// order: the first always; a later one when it fits, or when it is tied (the signature screen

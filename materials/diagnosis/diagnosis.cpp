@@ -226,8 +226,6 @@ class DiagnosisRun {
 
   std::string shrunk_words_;      ///< why and how the apparatus was shrunk (shrink)
   double full_size_reserve_ = 0;  ///< [s] of the budget kept for the full-size check of a shrunk diagnosis
-  double screen_seconds_per_simulation_ = 0;  ///< [s] wall time the screen took a simulation
-  double confirmation_seconds_per_simulation(const CandidateResult& cr) const;
   double cost_mark_seconds_ = 0;  ///< the command's time and simulations when the apparatus was shrunk:
   int cost_mark_done_ = 0;        ///< later costs are measured from there
 
@@ -237,6 +235,7 @@ class DiagnosisRun {
     const int done = count_.done() - cost_mark_done_;
     return done > 0 ? (count_.elapsed() - cost_mark_seconds_) / done : count_.elapsed() / std::max(1, count_.done());
   }
+  double confirmation_seconds_per_simulation(const CandidateResult& cr) const;
   bool shrink(Comparison& first, double size, const std::string& why);
   void unshrink();
   const EffectCandidate& effect_of(const CandidateResult& cr) const {
@@ -627,19 +626,16 @@ void DiagnosisRun::screen_signatures() {
   SignaturePass pass{std::max(1, std::min(options_.replicas, options_.signature_replicas)), Progress{options_, "signatures"}};
   plan_signatures(pass);
   const ScreenBasis basis = screen_basis(std::move(residual));
-  const double seconds_before = count_.elapsed();
-  const int done_before = count_.done();
   const std::vector<detail::SignatureRuns> signature_runs =
       detail::simulate_signatures(d_.base.fitted, effects_, parameters_, measured_, options_, pass.replicas, &pass.progress);
   for (size_t index = 0; index < effects_.size(); ++index) screen_candidate(effects_[index], signature_runs[index], basis, pass);
-  if (count_.done() > done_before) screen_seconds_per_simulation_ = (count_.elapsed() - seconds_before) / (count_.done() - done_before);
   rank_by_share();
 }
 
 /// [s] of wall time a confirmation's simulation of `cr` is expected to take
-/// (detail::candidate_seconds_per_simulation), the diagnosis' mean so far before a screen.
+/// (detail::candidate_seconds_per_simulation), the diagnosis' mean so far where its screen ran none.
 double DiagnosisRun::confirmation_seconds_per_simulation(const CandidateResult& cr) const {
-  const double screened = detail::candidate_seconds_per_simulation(d_.candidates, cr, screen_seconds_per_simulation_);
+  const double screened = detail::candidate_seconds_per_simulation(cr, options_.parallel);
   return screened > 0 ? screened : seconds_per_simulation();
 }
 
@@ -876,9 +872,10 @@ void DiagnosisRun::confirm_leaders() {
       unconfirmed_.push_back(fmt::format("{} ({:.0f} %{})", c.name, 100 * c.explained, c.stable ? "" : ", unstable"));
 }
 
-/// With a budget, the confirmations are fitted into what is left of it, at the cost per
-/// simulation this diagnosis has measured so far: a candidate's simulations (cohesion, a wetter
-/// bed) may cost several times the first comparison's, on which the plan was made. The first is
+/// With a budget, the confirmations are fitted into what is left of it, each at what its own
+/// candidate's screen simulations cost (confirmation_seconds_per_simulation): a candidate's
+/// simulations (clumps, cohesion, a wetter bed) may cost several times the first comparison's,
+/// on which the plan was made. The first is
 /// always confirmed, and so is every candidate the screen cannot tell from the leader:
 /// confirming one of two the screen cannot separate would name it on a coin toss. The result
 /// says by how much that exceeds the budget.

