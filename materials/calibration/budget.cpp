@@ -33,6 +33,10 @@ int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls)
   return detail::calibration_passes(o, p) + screen_and_confirmation_passes(o, p, effects, walls);
 }
 
+int screen_band(double leader, const CandidateResult& c, const CalibrationOptions& options) {
+  return static_cast<int>(std::floor((leader - c.explained) / std::max(options.screen_margin, 1e-6)));
+}
+
 ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options) {
   ConfirmationChoice out;
   out.screen_silent = std::none_of(ranked.begin(), ranked.end(), [](const CandidateResult& c) { return c.explained >= 0.05; });
@@ -56,7 +60,7 @@ ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& rank
   // bridges (96 %, agreement 0.99) that made the data.
   const auto cap = static_cast<size_t>(std::max(1, options.confirm_candidates + 2));
   if (out.confirming.size() > cap) {
-    const auto band = [&](size_t rank) { return std::floor((leader - ranked[rank].explained) / std::max(options.screen_margin, 1e-6)); };
+    const auto band = [&](size_t rank) { return screen_band(leader, ranked[rank], options); };
     const auto after_leader = out.confirming.begin() + (out.confirming.front() == 0 ? 1 : 0);
     std::stable_sort(after_leader, out.confirming.end(), [&](size_t a, size_t b) {
       if (band(a) != band(b)) return band(a) < band(b);

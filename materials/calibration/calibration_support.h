@@ -239,6 +239,9 @@ struct ConfirmationChoice {
   bool screen_silent = false;
 };
 ConfirmationChoice choose_confirmations(const std::vector<CandidateResult>& ranked, const CalibrationOptions& options);
+/// The band of options.screen_margin below the leader's share (`leader`) that a candidate's share
+/// lies in: 0 for those the screen cannot tell from the leader's share, 1 for the next margin, ...
+int screen_band(double leader, const CandidateResult& c, const CalibrationOptions& options);
 
 /// [s] of wall time a simulation of candidate `cr` is expected to take in its confirmation, with
 /// `parallel` simulations at once: what its own signature simulations took, one core each

@@ -845,9 +845,7 @@ void DiagnosisRun::confirm_leaders() {
   // recalibrated sjkr (stable, 17 %) and not the rolling resistance its own runs put first (68 %)
   // on lab_rolling.yaml.
   const double leader = d_.candidates.empty() ? 0.0 : d_.candidates.front().explained;
-  const auto band = [&](const CandidateResult& c) {
-    return static_cast<int>(std::floor((leader - c.explained) / std::max(options_.screen_margin, 1e-6)));
-  };
+  const auto band = [&](const CandidateResult& c) { return detail::screen_band(leader, c, options_); };
   std::stable_sort(confirming.begin(), confirming.end(), [&](size_t a, size_t b) {
     const CandidateResult &x = d_.candidates[a], &y = d_.candidates[b];
     if (band(x) != band(y)) return band(x) < band(y);
@@ -882,11 +880,14 @@ void DiagnosisRun::confirm_leaders() {
 void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of) {
   if (!budgeted() || confirming.size() <= 1) return;
   const double left = given_.budget_seconds - count_.elapsed() - full_size_reserve_;
-  std::vector<double> costs;
+  std::vector<double> costs, per_simulation;
+  std::vector<int> points;  // each confirmation's design points a round
   std::vector<bool> tied;
   for (const size_t rank : confirming) {
-    costs.push_back(experiments_ * detail::calibration_passes(confirmation_options(d_.candidates[rank]), d_.candidates[rank].k) *
-                    confirmation_seconds_per_simulation(d_.candidates[rank]));
+    const CalibrationOptions o = confirmation_options(d_.candidates[rank]);
+    per_simulation.push_back(confirmation_seconds_per_simulation(d_.candidates[rank]));
+    points.push_back(detail::design_points(o, d_.candidates[rank].k));
+    costs.push_back(experiments_ * detail::calibration_passes(o, d_.candidates[rank].k) * per_simulation.back());
     tied.push_back(std::find(undecided_.begin(), undecided_.end(), d_.candidates[rank].name) != undecided_.end());
   }
   // A candidate whose plain-fit points are points of its own space (EffectCandidate::unchanged)
@@ -898,8 +899,8 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
     const CandidateResult& cr = d_.candidates[confirming[k]];
     CalibrationOptions o = options_;
     o.design_points = detail::design_points_beside_known(cr.k, static_cast<int>(cr.adds.size()));
-    if (!takes_plain_points(effect_of(cr), cr) || o.design_points >= detail::design_points(confirmation_options(cr), cr.k)) continue;
-    smaller[k] = experiments_ * detail::calibration_passes(o, cr.k) * confirmation_seconds_per_simulation(cr);
+    if (!takes_plain_points(effect_of(cr), cr) || o.design_points >= points[k]) continue;
+    smaller[k] = experiments_ * detail::calibration_passes(o, cr.k) * per_simulation[k];
     fewer_points[cr.name] = o.design_points;
   }
   const detail::ConfirmationPlan plan = detail::fit_confirmations(costs, tied, left, smaller);
