@@ -83,6 +83,55 @@ TEST(CalibratedMaterial, RoundTripsThroughTheLibraryAndACase) {
   EXPECT_NEAR(g->params.at("friction"), 0.537, 1e-12);
 }
 
+// A material of sphere clumps: the file keeps the fitted shape under `shape:`, the material
+// library reads it back as the model's shape, and a case's particle set and inlet of the material
+// are its clumps (a template named after the material) unless they name a clump of their own.
+TEST(CalibratedMaterial, AShapeOfClumpsRoundTripsAndACaseUsesIt) {
+  const fs::path dir = scratch();
+  CalibrationResult fit = gravel_fit();
+  ClumpTemplateSpec three;
+  three.centres = {Vec3(0, 0, 0), Vec3(0.7, 0, 0), Vec3(0.35, 0.6, 0)};
+  three.radii = {0.5, 0.5, 0.4};
+  fit.fitted.shape = {three};
+  write_calibrated_material((dir / "ore.yaml").string(), fit, {"calibrate", "lab/ore.yaml", "2026-12-07", ""});
+  const MaterialModel back = read_material_model((dir / "ore.yaml").string());
+  ASSERT_EQ(back.shape.size(), 1u);
+  ASSERT_EQ(back.shape[0].radii.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(back.shape[0].radii[k], three.radii[k], 1e-12);
+    EXPECT_NEAR((back.shape[0].centres[k] - three.centres[k]).norm(), 0.0, 1e-12);
+  }
+  EXPECT_FALSE(back.particle.shape.has_value());  // the model's, not the material's
+  const CaseSpec spec = parse_case_text(
+      "simulation: {duration: 0.001}\nmaterials:\n  rock: {library: ore}\n  steel: {library: steel}\n"
+      "clumps:\n  pair: {spheres: [{centre: [0, 0, 0], diameter: 1}, {centre: [0.5, 0, 0], diameter: 1}]}\n"
+      "particles:\n  - {material: rock, diameter: 0.01, positions: [[0, 0, 0.05]]}\n"
+      "  - {material: rock, clump: pair, diameter: 0.01, positions: [[0.05, 0, 0.05]]}\n"
+      "  - {material: steel, diameter: 0.01, positions: [[0.1, 0, 0.05]]}\n"
+      "inlets:\n  - {material: rock, diameter: 0.01, mass_rate_kgs: 1, region: {min: [0, 0, 0.2], max: [0.1, 0.1, 0.3]}}\n",
+      (dir / "case.yaml").string(), library_lookup());
+  const Model model = compile(spec);
+  ASSERT_EQ(model.clumps.size(), 2u);
+  ASSERT_EQ(model.sources.size(), 3u);
+  EXPECT_EQ(model.clumps[model.sources[0].clump].name, "rock");
+  EXPECT_EQ(model.clumps[model.sources[0].clump].radii.size(), 3u);
+  EXPECT_EQ(model.clumps[model.sources[1].clump].name, "pair");
+  EXPECT_EQ(model.sources[2].clump, -1);
+  ASSERT_EQ(model.inlets.size(), 1u);
+  EXPECT_EQ(model.clumps[model.inlets[0].clump].name, "rock");
+  // A case template of the material's name would be ambiguous.
+  try {
+    (void)compile(parse_case_text(
+        "simulation: {duration: 0.001}\nmaterials:\n  rock: {library: ore}\n"
+        "clumps:\n  rock: {spheres: [{centre: [0, 0, 0], diameter: 1}]}\n"
+        "particles:\n  - {material: rock, diameter: 0.01, positions: [[0, 0, 0.05]]}\n",
+        (dir / "case.yaml").string(), library_lookup()));
+    FAIL() << "a template named as a shaped material was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("clumps.rock: the material 'rock' gives its particles' shape"), std::string::npos) << e.what();
+  }
+}
+
 // A fit at the parcel size (--coarse-grain 2): the file records the coarse_grain its virtual tests
 // ran at, and a case that runs the material at another coarse_grain (real particles, or 3) is
 // told in its set-up notes, with the comparison that would check it; at 2 nothing is said.

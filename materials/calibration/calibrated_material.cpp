@@ -72,8 +72,6 @@ std::string size_text(const SizeDistributionSpec& d) {
 
 std::string calibrated_material_text(const CalibrationResult& fit, const CalibratedMaterialSource& source) {
   const MaterialModel& m = fit.fitted;
-  if (!m.shape.empty())
-    throw std::invalid_argument("a library material holds spheres only: particle shape as clumps is given in the case's particle set");
   const size_t n = fit.parameters.size();
   const double chi2 = fit.after.chi2_per_n();
   std::string out = fmt::format("# Calibrated by demdesign {} on {} ({}): chi^2/n = {:.3g}{}.\n", source.command, source.measurements, source.date,
@@ -86,7 +84,7 @@ std::string calibrated_material_text(const CalibrationResult& fit, const Calibra
                                                              std::filesystem::path(source.measurements).filename().string(), source.date)));
   out += fmt::format("contact: {}\n", contact_text(m.contact));
   out += "properties:\n";
-  // The material's base properties (the shape's is refused above), each with its unit unless dimensionless.
+  // The material's base properties (the shape's is its own block below), each with its unit unless dimensionless.
   for (const BaseProperty& b : base_properties()) {
     if (!b.field) continue;
     const std::string line = fmt::format("{}: {}", b.spec.key, number(m.particle.*b.field));
@@ -104,6 +102,14 @@ std::string calibrated_material_text(const CalibrationResult& fit, const Calibra
     for (const auto& [key, words] : sources) out += fmt::format("  {}: {}\n", key, quoted(words));
   }
   out += fmt::format("size: {}\n", size_text(m.diameter));
+  if (!m.shape.empty()) {
+    // The template as the fit simulated it; `size` is each clump's volume-equivalent diameter.
+    out += "shape:  # sphere clumps in the clump's own frame (any unit: the size scales them)\n  spheres:\n";
+    const ClumpTemplateSpec& c = m.shape.front();
+    for (size_t k = 0; k < c.radii.size(); ++k)
+      out += fmt::format("    - {{centre: [{}, {}, {}], diameter: {}}}\n", number(c.centres[k].x()), number(c.centres[k].y()),
+                         number(c.centres[k].z()), number(2 * c.radii[k]));
+  }
   std::vector<std::string> walls;
   for (const InteractionSpec& pair : m.wall_pairs) {
     const std::string wall = pair.material_a == m.name ? pair.material_b : pair.material_a;

@@ -107,6 +107,9 @@ MaterialModel read_material_model(const std::string& path) {
   // The wall library files stand for the wall material's elasticity only; their own
   // friction/restitution are placeholders for the pairs.
   for (MaterialSpec& w : model.walls) w.tunable.clear();
+  // The shape (`shape:` of the file) is the model's, not the particle material's: the virtual
+  // tests give it to their particle sets themselves.
+  if (model.particle.shape) model.shape = {*model.particle.shape}, model.particle.shape.reset();
   model.contact = spec.contact;
   model.wall_pairs = spec.interactions;
   model.tunable = model.particle.tunable;

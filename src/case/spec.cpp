@@ -215,7 +215,10 @@ void read_parts(MapReader& top, const std::string& file, CaseSpec& spec) {
   }
   if (const YAML::Node clumps = top.node("clumps")) {
     if (!clumps.IsMap()) top.fail("clumps", "must be a map of template names to {spheres: [...]}");
-    for (const auto& kv : clumps) spec.clumps.push_back(read_clump(kv.first.as<std::string>(), kv.second, file));
+    for (const auto& kv : clumps) {
+      const std::string name = kv.first.as<std::string>();
+      spec.clumps.push_back(read_clump(name, kv.second, file, "clumps." + name));
+    }
   }
   if (const YAML::Node inlets = top.node("inlets")) {
     if (!inlets.IsSequence()) top.fail("inlets", "must be a list of inlets");

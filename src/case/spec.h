@@ -61,6 +61,14 @@ struct CalibrationRecord {
   SourceLocation location;
 };
 
+/// A rigid particle made of overlapping spheres (the source paper's sphere conglomerates).
+struct ClumpTemplateSpec {
+  std::string name;
+  std::vector<Vec3> centres;    // [m] in the template's frame
+  std::vector<double> radii;    // [m]
+  SourceLocation location;
+};
+
 struct MaterialSpec {
   std::string name;
   double density = 2500.0;        // [kg/m^3]
@@ -78,6 +86,10 @@ struct MaterialSpec {
   /// source under `sources:`); a calibration names a value outside as a sign of missing physics.
   std::map<std::string, std::pair<double, double>> plausible;
   std::optional<CalibrationRecord> calibration;  ///< when the library file is a calibrated material
+  /// The particles' shape a library file gives (`shape: {spheres: [...]}`): the case gains it as a
+  /// clump template named after the material, which the material's particle sets and inlets use
+  /// unless they name a `clump:` of their own. Empty: spheres.
+  std::optional<ClumpTemplateSpec> shape;
 };
 
 /// Parameters for one unlike pair that replace the mixing rule.
@@ -178,14 +190,6 @@ struct MeshWallSpec {
   Motion motion;                          ///< rigid motion of the whole mesh
   SurfaceVelocitySpec surface;
   double active_from = 0;                 // [s] a wall from then on; before, particles pass through it
-  SourceLocation location;
-};
-
-/// A rigid particle made of overlapping spheres (the source paper's sphere conglomerates).
-struct ClumpTemplateSpec {
-  std::string name;
-  std::vector<Vec3> centres;    // [m] in the template's frame
-  std::vector<double> radii;    // [m]
   SourceLocation location;
 };
 

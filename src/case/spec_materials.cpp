@@ -235,6 +235,7 @@ LibraryMaterial read_library_material(const std::string& name, MapReader& entry,
     if (!walls.IsMap()) file_map.fail("walls", "must map wall material names to pair parameters {friction: ..., ...}");
     for (const auto& kv : walls) lib.walls.emplace_back(kv.first.as<std::string>(), kv.second);
   }
+  if (const YAML::Node shape = file_map.node("shape")) lib.material.shape = read_clump(name, shape, lib.file, "shape");
   lib.contact = file_map.node("contact");
   file_map.node("size");  // a typical size, for the calibration tests
   if (const YAML::Node fit = file_map.node("calibration")) {

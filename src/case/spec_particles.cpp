@@ -110,8 +110,8 @@ void read_profile_bins(MapReader& box, SensorSpec& s) {
 
 namespace spec_reading {
 
-ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, const std::string& file) {
-  MapReader map(node, file, "clumps." + name);
+ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, const std::string& file, const std::string& path) {
+  MapReader map(node, file, path);
   ClumpTemplateSpec c;
   c.name = name;
   c.location = map.location();
@@ -119,7 +119,7 @@ ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, co
   if (!spheres || !spheres.IsSequence() || spheres.size() == 0)
     map.fail("spheres", "must be a list of {centre: [x,y,z], diameter: D} in the clump's own frame [m]");
   for (size_t k = 0; k < spheres.size(); ++k) {
-    MapReader sphere(spheres[k], file, fmt::format("clumps.{}.spheres[{}]", name, k));
+    MapReader sphere(spheres[k], file, fmt::format("{}.spheres[{}]", path, k));
     c.centres.push_back(sphere.vec3("centre", Vec3::Zero()));
     c.radii.push_back(0.5 * sphere.required_number("diameter", 1e-7, 10, "m"));
     sphere.finish();

@@ -40,7 +40,9 @@ MeshWallSpec read_mesh(const YAML::Node& node, const std::string& file, size_t i
 PlaneWallSpec read_wall(const YAML::Node& node, const std::string& file, size_t index);
 
 // Particles, inlets, outlets and sensors (spec_particles.cpp).
-ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, const std::string& file);
+/// A clump template `{spheres: [{centre, diameter}, ...]}`; `path` names it in errors
+/// ("clumps.NAME" in a case, "shape" in a material file).
+ClumpTemplateSpec read_clump(const std::string& name, const YAML::Node& node, const std::string& file, const std::string& path);
 InletSpec read_inlet(const YAML::Node& node, const std::string& file, size_t index);
 OutletSpec read_outlet(const YAML::Node& node, const std::string& file, size_t index);
 SensorSpec read_sensor(const YAML::Node& node, const std::string& file, size_t index);

@@ -337,9 +337,36 @@ void check_liner_names(const CaseSpec& spec, const Model& model) {
   }
 }
 
+/// The clump templates of a case: its own under `clumps:`, then the shape each library material
+/// gives (MaterialSpec::shape), named after the material; a name given twice is refused.
+std::vector<ClumpTemplateSpec> clump_templates(const CaseSpec& spec) {
+  std::vector<ClumpTemplateSpec> out = spec.clumps;
+  for (const MaterialSpec& m : spec.materials) {
+    if (!m.shape) continue;
+    for (const ClumpTemplateSpec& c : spec.clumps)
+      if (c.name == m.name)
+        throw CaseError(fmt::format("{}: clumps.{}: the material '{}' gives its particles' shape under that name ({}, `shape:`); "
+                                    "rename this template",
+                                    c.location.str(), c.name, m.name, m.library_file));
+    out.push_back(*m.shape);
+    out.back().name = m.name;
+  }
+  return out;
+}
+
+/// The clump a particle set or an inlet uses: the one it names, else its material's shape (a
+/// library material's `shape:`), else none (-1, spheres). `clump` is set to the template's name.
+int clump_for(const CaseSpec& spec, const Model& model, std::string& clump, const std::string& material, const SourceLocation& where,
+              const std::string& key) {
+  if (clump.empty())
+    for (const MaterialSpec& m : spec.materials)
+      if (m.name == material && m.shape) clump = m.name;
+  return clump_or_fail(model, clump, where, key);
+}
+
 /// Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
 void add_clump_templates(const CaseSpec& spec, Model& model) {
-  for (const ClumpTemplateSpec& clump : spec.clumps) {
+  for (const ClumpTemplateSpec& clump : clump_templates(spec)) {
     std::vector<ClumpSphere> spheres;
     for (size_t k = 0; k < clump.radii.size(); ++k) spheres.push_back({clump.centres[k], clump.radii[k]});
     const ClumpMassProperties props = clump_mass_properties(spheres, 1.0);
@@ -366,8 +393,8 @@ void add_particle_sources(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.particles.size(); ++k) {
     const ParticleSetSpec& p = spec.particles[k];
     const std::string key = fmt::format("particles[{}]", k);
-    ParticleSource source{p, material_or_fail(model, p.material, p.location, key + ".material"),
-                          clump_or_fail(model, p.clump, p.location, key + ".clump")};
+    ParticleSource source{p, material_or_fail(model, p.material, p.location, key + ".material"), -1};
+    source.clump = clump_for(spec, model, source.spec.clump, p.material, p.location, key + ".clump");
     if (model.coarse_grain != 1.0) make_parcels(source.spec, model.coarse_grain);
     extend_radii(model, source.spec.diameter, source.clump);
     // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
@@ -424,8 +451,8 @@ void add_inlets(const CaseSpec& spec, Model& model) {
   for (size_t k = 0; k < spec.inlets.size(); ++k) {
     const InletSpec& in = spec.inlets[k];
     const std::string key = fmt::format("inlets[{}]", k);
-    Inlet inlet{in, material_or_fail(model, in.material, in.location, key + ".material"),
-                clump_or_fail(model, in.clump, in.location, key + ".clump"), in.interval};
+    Inlet inlet{in, material_or_fail(model, in.material, in.location, key + ".material"), -1, in.interval};
+    inlet.clump = clump_for(spec, model, inlet.spec.clump, in.material, in.location, key + ".clump");
     if (model.coarse_grain != 1.0) make_parcels(inlet.spec, model.coarse_grain);
     extend_radii(model, inlet.spec.diameter, inlet.clump);
     model.inlets.push_back(std::move(inlet));
