@@ -28,32 +28,34 @@ Generated silo(MapReader& reader, const EquipmentSpec& spec) {
   // cells). A lab silo that keeps no wear map takes one cell from orifice to wall and one up it:
   // fewer triangles near each particle, so fewer closest-point tests a step.
   const double cell = reader.number("cell", std::min(kCell, kPi * diameter / around), 1e-4, 100.0, "m");
-  // The wall as an exact cylinder instead of triangles: one contact per sphere against it instead
-  // of the facets near it, and no wear map or liner pressure of the wall (the lab silo's choice).
+  // The wall and floor as exact surfaces instead of triangles (a cylinder, and a disc with the
+  // orifice as its hole): one contact per sphere against each instead of the facets near it, the
+  // orifice's rim a true circle, and no wear map or liner pressure of either (the lab silo's choice).
   const bool exact_wall = reader.boolean("exact_wall", false);
   const SourceLocation& where = spec.location;
   const double radius = 0.5 * diameter, hole = 0.5 * orifice;
 
   Generated out;
   out.camera = "side";
-  {
+  if (!exact_wall) {
     MeshBuilder silo;
     silo.grid([&](double u, double w) {  // floor annulus, normal +z
       const double r = hole + u * (radius - hole), angle = 2 * kPi * w;
       return Vec3(r * std::cos(angle), r * std::sin(angle), 0);
     }, segments(radius - hole, cell), around);
-    if (!exact_wall)
-      silo.grid([&](double u, double w) {  // wall, normal inward
-        const double angle = 2 * kPi * w;
-        return Vec3(radius * std::cos(angle), radius * std::sin(angle), u * height);
-      }, segments(height, std::max(cell, 2 * kPi * radius / around)), around);
+    silo.grid([&](double u, double w) {  // wall, normal inward
+      const double angle = 2 * kPi * w;
+      return Vec3(radius * std::cos(angle), radius * std::sin(angle), u * height);
+    }, segments(height, std::max(cell, 2 * kPi * radius / around)), around);
     out.meshes.push_back(silo.wall("silo", materials.liner, where));
-  }
-  if (exact_wall) {
+  } else {
     PlaneWallSpec wall;
     wall.name = "silo_wall", wall.material = materials.liner, wall.location = where;
     wall.shape = PlaneWallSpec::Shape::cylinder, wall.radius = radius, wall.point = Vec3::Zero(), wall.normal = Vec3(0, 0, 1);
     out.planes.push_back(wall);
+    PlaneWallSpec floor = wall;
+    floor.name = "silo_floor", floor.shape = PlaneWallSpec::Shape::disc, floor.hole_radius = hole;
+    out.planes.push_back(floor);
   }
   if (shut) {
     MeshBuilder gate;
