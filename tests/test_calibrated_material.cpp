@@ -119,6 +119,11 @@ TEST(CalibratedMaterial, AShapeOfClumpsRoundTripsAndACaseUsesIt) {
   EXPECT_EQ(model.sources[2].clump, -1);
   ASSERT_EQ(model.inlets.size(), 1u);
   EXPECT_EQ(model.clumps[model.inlets[0].clump].name, "rock");
+  std::string notes;
+  for (const std::string& n : model.notes) notes += n + "\n";
+  EXPECT_NE(notes.find("particles[0]: clumps of 3 spheres, the shape material 'rock' gives"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("inlets[0]: clumps of 3 spheres"), std::string::npos) << notes;
+  EXPECT_EQ(notes.find("particles[1]: clumps"), std::string::npos) << notes;
   // A case template of the material's name would be ambiguous.
   try {
     (void)compile(parse_case_text(

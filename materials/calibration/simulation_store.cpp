@@ -49,9 +49,10 @@ std::string file_of(const std::string& folder, const std::string& test, const st
 std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup, const TestOptions& options) {
   // `meaning` counts changes of what the same inputs simulate within one version, so a stored
   // simulation of an older meaning is run again. 2: a wall that does not state a contact
-  // parameter leaves it to the particles (before: mixed with the parameter's default). The
-  // lab tests' time-step rule is written out, so a change of it runs them again.
-  std::string out = fmt::format("engine: demdesign {}\nmeaning: 2\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
+  // parameter leaves it to the particles (before: mixed with the parameter's default). 3: the
+  // silo's floor an exact disc (before: facets). The lab tests' time-step rule is written out, so
+  // a change of it runs them again.
+  std::string out = fmt::format("engine: demdesign {}\nmeaning: 3\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
   for (const auto& [k, v] : setup.numbers) out += fmt::format("setup.{}: {}\n", k, number(v));
   for (const auto& [k, v] : setup.words) out += fmt::format("setup.{}: {}\n", k, v);
   out += fmt::format("time_step: {{rayleigh_fraction: {}, steps_per_contact: {}}}\n",

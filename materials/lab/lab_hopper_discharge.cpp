@@ -7,8 +7,9 @@
 // rest over the orifice (an arch) or the orifice is clear (the funnel drained to the flat floor's
 // dead zone, which the rule also reads as blocked).
 //
-// Set-up decisions: the silo is the `silo` equipment generator (equipment/silo.cpp: floor, an
-// exact cylinder wall, a slide-gate shutter under the orifice); discharged mass is what its
+// Set-up decisions: the silo is the `silo` equipment generator (equipment/silo.cpp) with
+// `exact_wall`: an exact disc for the floor with the orifice as its hole, an exact cylinder wall,
+// a triangulated slide-gate shutter under the orifice; discharged mass is what its
 // `discharge` outlet has removed plus anything lost from the domain since the opening. The pour is
 // a column of particles placed at random (about 25 % solid) in the square inscribed in the silo,
 // as many as fill `fill_height` at a solid fraction of 0.6. One run in two phases: the settle runs
@@ -96,7 +97,6 @@ SimulatedOutcome run_hopper_discharge(const MaterialModel& model, const TestSetu
     params["open_at"] = open_at;
     params["liner_material"] = wall_material;
     params["segments"] = std::clamp(segments_around(radius, 0.5 * d50), 48, 360);
-    params["cell"] = height;  // no wear map: one cell from the orifice to the wall, one up it
     params["exact_wall"] = true;  // the wall an exact cylinder: one contact a sphere, not the facets near it
     EquipmentSpec equipment;
     equipment.type = "silo";

@@ -355,13 +355,18 @@ std::vector<ClumpTemplateSpec> clump_templates(const CaseSpec& spec) {
 }
 
 /// The clump a particle set or an inlet uses: the one it names, else its material's shape (a
-/// library material's `shape:`), else none (-1, spheres). `clump` is set to the template's name.
-int clump_for(const CaseSpec& spec, const Model& model, std::string& clump, const std::string& material, const SourceLocation& where,
+/// library material's `shape:`, said in the set-up notes), else none (-1, spheres). `clump` is
+/// set to the template's name.
+int clump_for(const CaseSpec& spec, Model& model, std::string& clump, const std::string& material, const SourceLocation& where,
               const std::string& key) {
   if (clump.empty())
     for (const MaterialSpec& m : spec.materials)
-      if (m.name == material && m.shape) clump = m.name;
-  return clump_or_fail(model, clump, where, key);
+      if (m.name == material && m.shape) {
+        clump = m.name;
+        model.notes.push_back(fmt::format("{}: clumps of {} spheres, the shape material '{}' gives ({}); `clump:` names another",
+                                          key, m.shape->radii.size(), m.name, m.library_file));
+      }
+  return clump_or_fail(model, clump, where, key + ".clump");
 }
 
 /// Clump templates: principal frame, centre of mass at the origin, unit equivalent diameter.
@@ -394,7 +399,7 @@ void add_particle_sources(const CaseSpec& spec, Model& model) {
     const ParticleSetSpec& p = spec.particles[k];
     const std::string key = fmt::format("particles[{}]", k);
     ParticleSource source{p, material_or_fail(model, p.material, p.location, key + ".material"), -1};
-    source.clump = clump_for(spec, model, source.spec.clump, p.material, p.location, key + ".clump");
+    source.clump = clump_for(spec, model, source.spec.clump, p.material, p.location, key);
     if (model.coarse_grain != 1.0) make_parcels(source.spec, model.coarse_grain);
     extend_radii(model, source.spec.diameter, source.clump);
     // Glued particles: spheres on a plane wall (a rough plate), not clumps, not a cylinder.
@@ -452,7 +457,7 @@ void add_inlets(const CaseSpec& spec, Model& model) {
     const InletSpec& in = spec.inlets[k];
     const std::string key = fmt::format("inlets[{}]", k);
     Inlet inlet{in, material_or_fail(model, in.material, in.location, key + ".material"), -1, in.interval};
-    inlet.clump = clump_for(spec, model, inlet.spec.clump, in.material, in.location, key + ".clump");
+    inlet.clump = clump_for(spec, model, inlet.spec.clump, in.material, in.location, key);
     if (model.coarse_grain != 1.0) make_parcels(inlet.spec, model.coarse_grain);
     extend_radii(model, inlet.spec.diameter, inlet.clump);
     model.inlets.push_back(std::move(inlet));
