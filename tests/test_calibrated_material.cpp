@@ -124,6 +124,18 @@ TEST(CalibratedMaterial, AShapeOfClumpsRoundTripsAndACaseUsesIt) {
   EXPECT_NE(notes.find("particles[0]: clumps of 3 spheres, the shape material 'rock' gives"), std::string::npos) << notes;
   EXPECT_NE(notes.find("inlets[0]: clumps of 3 spheres"), std::string::npos) << notes;
   EXPECT_EQ(notes.find("particles[1]: clumps"), std::string::npos) << notes;
+  // Glued particles are spheres: a set of the shaped material cannot be glued, and is told why.
+  try {
+    (void)compile(parse_case_text(
+        "simulation: {duration: 0.001}\nmaterials:\n  rock: {library: ore}\n  steel: {library: steel}\n"
+        "walls:\n  - {name: plate, plane: {point: [0, 0, 0], normal: [0, 0, 1]}, material: steel}\n"
+        "particles:\n  - {material: rock, diameter: 0.01, positions: [[0, 0, 0.005]], attach_to: plate}\n",
+        (dir / "case.yaml").string(), library_lookup()));
+    FAIL() << "glued clumps were accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("material 'rock' gives clumps: glue spheres of a material without a `shape:`"), std::string::npos)
+        << e.what();
+  }
   // A case template of the material's name would be ambiguous.
   try {
     (void)compile(parse_case_text(

@@ -417,7 +417,9 @@ void add_particle_sources(const CaseSpec& spec, Model& model) {
         throw CaseError(fmt::format("{}: {}.attach_to: '{}' is not a plane; particles glue only to plane walls",
                                     p.location.str(), key, p.attach_to));
       if (source.clump >= 0)
-        throw CaseError(fmt::format("{}: {}.attach_to: glued particles must be spheres (drop `clump`)", p.location.str(), key));
+        throw CaseError(fmt::format("{}: {}.attach_to: glued particles must be spheres ({})", p.location.str(), key,
+                                    p.clump.empty() ? fmt::format("material '{}' gives clumps: glue spheres of a material without a `shape:`", p.material)
+                                                    : std::string("drop `clump`")));
       model.has_attached = true;
     }
     model.sources.push_back(std::move(source));
