@@ -210,7 +210,7 @@ inline int confirmation_passes(const CalibrationOptions& o, int p) {
 }
 
 /// Passes over the experiments that a diagnosis makes after its first comparison, fitting `p`
-/// parameters and screening `effects` effects and `walls` wall parameters (diagnosis.cpp).
+/// parameters and screening `effects` effects and `walls` wall parameters (diagnosis/diagnosis_run.h).
 int diagnosis_passes(const CalibrationOptions& o, int p, int effects, int walls);
 /// The part of diagnosis_passes after the calibration of the model as it is: the signature screen
 /// and the confirmations.
