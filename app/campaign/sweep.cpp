@@ -1,6 +1,7 @@
 #include "campaign/sweep.h"
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <fcntl.h>
@@ -9,11 +10,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <regex>
 #include <thread>
 
@@ -216,6 +219,7 @@ struct SweepRank {
   int threads;      ///< per variant
   int parallel;     ///< variants at once on this rank
   std::string who;  ///< "rank 1: " under MPI, "" otherwise
+  std::vector<double> durations;  ///< [s] per variant, the simulated time it runs to (0: not known)
 };
 
 /// What a variant's child process is started with: this program, and this process's environment
@@ -247,6 +251,42 @@ struct VariantResults {
   std::vector<std::string> metrics_text, messages, images;  ///< per variant
 };
 
+/// [s] the simulated time each variant runs to (--duration, else its case's simulation.duration,
+/// which a check may set); 0 where the case cannot be read again (the time left is then the mean
+/// of the variants done).
+std::vector<double> variant_durations(const SweepPlan& plan, const SweepOptions& options) {
+  std::vector<double> out(plan.variants.size(), options.duration >= 0 ? options.duration : 0.0);
+  if (options.duration >= 0) return out;
+  try {
+    const YAML::Node root = YAML::LoadFile(options.case_path);
+    for (size_t k = 0; k < out.size(); ++k) {
+      const YAML::Node duration = variant_case(root, plan, k)["simulation"]["duration"];
+      if (duration && duration.IsScalar()) out[k] = duration.as<double>();
+    }
+  } catch (const std::exception&) {
+    std::fill(out.begin(), out.end(), 0.0);
+  }
+  return out;
+}
+
+/// [s] simulated so far by the run in `dir`: the time of the last whole row of its scalars.csv
+/// (0 while it has none).
+double simulated_so_far(const std::string& dir) {
+  std::ifstream in(dir + "/scalars.csv", std::ios::binary);
+  if (!in) return 0;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(std::max<std::streamoff>(0, size - 8192));
+  const std::string tail((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t end = tail.find_last_of('\n');
+  if (end == std::string::npos || end == 0) return 0;
+  const size_t start = tail.find_last_of('\n', end - 1);
+  const std::string row = tail.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1));
+  char* stop = nullptr;
+  const double t = std::strtod(row.c_str(), &stop);
+  return stop != row.c_str() && std::isfinite(t) ? t : 0.0;
+}
+
 /// This rank's share of the variants, the threads of each and how many run at once.
 SweepRank size_this_rank(const SweepPlan& plan, const SweepOptions& options, std::ostream& log) {
   const mpi::World& world = mpi::world();
@@ -258,7 +298,7 @@ SweepRank size_this_rank(const SweepPlan& plan, const SweepOptions& options, std
   const int threads = options.threads > 0 ? options.threads : (static_cast<int>(share) >= cores ? 1 : cores);
   const int parallel = plan.parallel > 0 ? plan.parallel : std::max(1, cores / threads);
   const std::string who = world.active() ? fmt::format("rank {}: ", world.rank) : "";
-  return {plan, options, log, world, n, threads, parallel, who};
+  return {plan, options, log, world, n, threads, parallel, who, variant_durations(plan, options)};
 }
 
 /// Makes the variants' folder and says how the sweep runs.
@@ -337,6 +377,28 @@ bool fill_free_slots(const SweepRank& sweep, const ChildProgram& child, mpi::Wor
   return progressed;
 }
 
+/// [s] of wall time the rest of this rank's variants will take: each running variant at its own
+/// pace so far (its simulated time against its duration), those not yet started at the mean of
+/// the ones done, over the parallel slots. Rejected: the mean of the ones done for every variant,
+/// which a coarse-grain check's finer run (three times the case's cost) makes a third of the truth.
+double seconds_left(const SweepRank& sweep, const RankRuns& runs) {
+  const auto now = std::chrono::steady_clock::now();
+  const double per_done = runs.done > 0 ? runs.busy_seconds / static_cast<double>(runs.done) : 0.0;
+  double sum = 0, longest = 0;
+  for (const RunningVariant& r : runs.running) {
+    const double elapsed = std::chrono::duration<double>(now - r.started).count();
+    const double duration = sweep.durations[r.variant];
+    const double simulated = simulated_so_far(sweep.options.out + "/variants/" + sweep.plan.name(r.variant));
+    const double rest = duration > 0 && simulated > 0.02 * duration ? elapsed * std::max(0.0, duration - simulated) / simulated
+                                                                    : std::max(0.0, per_done - elapsed);
+    sum += rest, longest = std::max(longest, rest);
+  }
+  const size_t started = runs.done + runs.running.size();
+  const size_t waiting = sweep.world.active() || started >= sweep.n ? 0 : sweep.n - started;
+  sum += static_cast<double>(waiting) * per_done;
+  return std::max(longest, sum / std::max(1, sweep.parallel));
+}
+
 /// Takes the child `pid` that ended with `wstatus` off the running variants and tells how far
 /// the sweep is; nothing when it is not one of them.
 void variant_finished(const SweepRank& sweep, pid_t pid, int wstatus, RankRuns& runs) {
@@ -353,8 +415,7 @@ void variant_finished(const SweepRank& sweep, pid_t pid, int wstatus, RankRuns& 
   ++runs.done;
   const size_t done = runs.done, n = sweep.n;
   const std::string count = sweep.world.active() ? fmt::format("{} done on this rank", done)
-                                                 : fmt::format("{}/{} done, about {} left", done, n,
-                                                               format_seconds(runs.busy_seconds / done * static_cast<double>(n - done) / sweep.parallel));
+                                                 : fmt::format("{}/{} done, about {} left", done, n, format_seconds(seconds_left(sweep, runs)));
   sweep.log << fmt::format("{}  {} {} in {} ({}){}\n", sweep.who, plan.name(v), status[v] == 0 ? "finished" : "FAILED", format_seconds(took), count,
                            status[v] == 0 ? "" : fmt::format(": see {}/variants/{}/log.txt", sweep.options.out, plan.name(v)))
             << std::flush;
