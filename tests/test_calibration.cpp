@@ -241,6 +241,13 @@ TEST(Calibration, AFitOutOfThePlausibleOrAtItsRangesEdgeIsNamed) {
   ASSERT_EQ(words.size(), 1u);
   EXPECT_NE(words[0].find("friction = 0.79, outside 0.1 to 0.7 (what dry bulk solids usually show)"), std::string::npos) << words[0];
   EXPECT_NE(words[0].find("restitution = 0.899, at the edge of its range [0.2, 0.9]"), std::string::npos) << words[0];
+  // At the edge but undetermined (an error of half the range): said apart, not as implausible.
+  words.clear();
+  const std::vector<std::string> loose = implausible_fits(m, fitted, {0.4, 0.2, 0.201}, {0.02, 0.05, 0.3}, words);
+  EXPECT_TRUE(loose.empty());
+  ASSERT_EQ(words.size(), 1u);
+  EXPECT_EQ(words[0].find("Implausible"), std::string::npos) << words[0];
+  EXPECT_NE(words[0].find("Not determined by these experiments: restitution = 0.201 +- 0.3 in [0.2, 0.9]"), std::string::npos) << words[0];
 }
 
 TEST(MaterialModel, ReadsALibraryFile) {

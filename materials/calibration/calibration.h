@@ -375,7 +375,8 @@ struct EarlierPoints {
 std::optional<std::pair<double, double>> plausible_range(const MaterialModel& model, const std::string& key);
 /// Keys of the values out of their plausible range by more than twice their standard error
 /// (`sigma`, same order; empty: none known) or at the edge of their tunable range, with the words
-/// saying so appended to `words`.
+/// saying so appended to `words`. A value at an edge whose standard error is a quarter of the range
+/// or more is not one of them: the words say the experiments do not determine it.
 std::vector<std::string> implausible_fits(const MaterialModel& model, const std::vector<FitParameter>& parameters, const std::vector<double>& values,
                                           const std::vector<double>& sigma, std::vector<std::string>& words);
 
