@@ -55,8 +55,9 @@ echo "N = $n: median particle-steps/s per configuration and phase (speed-up over
 for phase in settle dense; do
   grep -q "^csv,[0-9]*,$phase," "$log" || continue
   base=$(grep "^csv,[0-9]*,$phase,[0-9]*,1,1," "$log" | cut -d, -f8 | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
-  for config in $(echo "$configs" | tr ' ' ','  | tr ',' ' ' | xargs -n2 | tr ' ' ','); do
+  for config in $(echo "$configs" | tr ',' '\n' | tr ' ' ','); do
     rate=$(grep "^csv,[0-9]*,$phase,[0-9]*,$config," "$log" | cut -d, -f8 | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}')
+    [ -n "$rate" ] && [ -n "$base" ] || continue
     echo "$phase ranks,threads=$config: $rate ($(awk -v r="$rate" -v b="$base" 'BEGIN {printf "%.2f", r / b}')x)"
   done
 done
