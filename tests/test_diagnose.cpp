@@ -298,35 +298,42 @@ TEST(Budget, PlansTheDiagnosisToFitAndSaysWhatItGaveUp) {
   options.budget_seconds = 1e6;
   const BudgetPlan roomy = plan_within_budget(options, first, 2, 4, 4);
   EXPECT_TRUE(roomy.given_up.empty());
-  // Defaults, 2 parameters: 2 x 14 + 3 passes; 8 candidates x 3; 2 confirmations x (2 x 22 + 3): 149 passes.
-  EXPECT_NEAR(roomy.seconds, 149 * 35.0, 1e-9);
-  options.budget_seconds = 1800;
+  // Defaults, 2 parameters: 2 x 14 + 3 passes for the plain fit; a candidate's passes counted at
+  // what they cost against the plain model's, the screen's at 2 (8 candidates x 3) and the
+  // confirmations' at 1.2 (2 x (2 x 22 + 3)): 31 + 48 + 112.8 = 191.8 passes.
+  EXPECT_NEAR(roomy.seconds, 191.8 * 35.0, 1e-9);
+  options.budget_seconds = 3000;
   const BudgetPlan tight = plan_within_budget(options, first, 2, 4, 4);
-  EXPECT_LE(tight.seconds, 1800);
-  ASSERT_FALSE(tight.given_up.empty());
+  EXPECT_LE(tight.seconds, 3000);
+  ASSERT_EQ(tight.given_up.size(), 2u);
   EXPECT_EQ(tight.given_up.front().rfind("one surrogate round", 0), 0u);
   EXPECT_EQ(tight.options.rounds, 1);
-  // The wall parameters' screen goes only after the design points and the packings (a guessed
-  // wall pair misfits like missing physics). One round, design factor 1 and signatures with one
-  // packing: 8 + 3 passes for the plain fit, 8 x 2 for the screen, 2 x (8 + 3) for confirmations
-  // that stand beside the plain fit's points (confirmation_design_points): 49 passes fit 1800 s.
-  EXPECT_TRUE(tight.options.wall_candidates);
-  EXPECT_EQ(tight.options.replicas, 3);
-  EXPECT_EQ(tight.options.signature_replicas, 1);
+  // One round (17 + 48 + 1.2 x 2 x (22 + 3) = 125 passes) is not enough; design factor 1 is: 8 + 3
+  // passes for the plain fit, 48 for the screen, 1.2 x 2 x (8 + 3) for confirmations that stand
+  // beside the plain fit's points (confirmation_design_points): 85.4 passes fit 3000 s.
   EXPECT_EQ(tight.options.design_factor, 1.0);
-  EXPECT_NEAR(tight.seconds, 49 * 35.0, 1e-9);
-  // What the first comparison took comes off the budget: with 100 s spent, 49 passes (1715 s) no
-  // longer fit the 1700 s left, and design factor 0.5 goes (7 + 3 + 16 + 2 x (8 + 3) = 48 passes);
-  // with 300 s spent, two packings (45 passes, 1575 s) are not enough either, and the wall screen
-  // goes (8 passes): 37.
+  EXPECT_EQ(tight.options.signature_replicas, 2);
+  EXPECT_NEAR(tight.seconds, 85.4 * 35.0, 1e-9);
+  // What the first comparison took comes off the budget: with 100 s spent, 85.4 passes (2989 s)
+  // no longer fit the 2900 s left, and the signatures take one packing (8 x 2 x 2 for the screen:
+  // 69.4 passes); with 600 s spent, design factor 0.5 goes too (7 + 3 + 32 + 26.4 = 68.4 passes,
+  // 2394 s). The wall parameters' screen goes only after the design points and the packings (a
+  // guessed wall pair misfits like missing physics): with 1200 s spent, two packings (9 + 32 +
+  // 1.2 x 2 x (8 + 2) = 65 passes) are not enough, and the wall screen goes (4 x 2 x 2): 49.
   const BudgetPlan later = plan_within_budget(options, first, 2, 4, 4, 100.0);
-  EXPECT_TRUE(later.options.wall_candidates);
-  EXPECT_EQ(later.options.design_factor, 0.5);
-  EXPECT_NEAR(later.seconds, 48 * 35.0, 1e-9);
-  const BudgetPlan latest = plan_within_budget(options, first, 2, 4, 4, 300.0);
-  EXPECT_EQ(latest.options.replicas, 2);
-  EXPECT_FALSE(latest.options.wall_candidates);
-  EXPECT_NEAR(latest.seconds, 37 * 35.0, 1e-9);
+  EXPECT_EQ(later.options.signature_replicas, 1);
+  EXPECT_EQ(later.options.design_factor, 1.0);
+  EXPECT_NEAR(later.seconds, 69.4 * 35.0, 1e-9);
+  const BudgetPlan latest = plan_within_budget(options, first, 2, 4, 4, 600.0);
+  EXPECT_EQ(latest.options.design_factor, 0.5);
+  EXPECT_EQ(latest.options.replicas, 3);
+  EXPECT_TRUE(latest.options.wall_candidates);
+  EXPECT_NEAR(latest.seconds, 68.4 * 35.0, 1e-9);
+  const BudgetPlan last = plan_within_budget(options, first, 2, 4, 4, 1200.0);
+  EXPECT_EQ(last.options.replicas, 2);
+  EXPECT_FALSE(last.options.wall_candidates);
+  EXPECT_EQ(last.options.confirm_candidates, 2);
+  EXPECT_NEAR(last.seconds, 49 * 35.0, 1e-9);
   // After the calibration of the model as it is, the screen and the confirmations are planned
   // again at the cost measured so far, a candidate's simulations counted at what they cost
   // against the plain model's (the screen's at 2, the confirmations' at 1.2): at 35 s a pass,

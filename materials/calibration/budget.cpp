@@ -157,8 +157,14 @@ BudgetPlan plan_within_budget(const CalibrationOptions& options, const Compariso
   double pass = 0;
   for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
   pass /= std::max(1, options.parallel);
-  return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls,
-                       [&](const CalibrationOptions& o) { return static_cast<double>(detail::diagnosis_passes(o, p, effects, walls)); });
+  // A candidate's simulations counted at what they cost against the plain model's, as the plan
+  // made again after the plain fit counts them (plan_screen_within_budget). Rejected: every pass
+  // at the first comparison's cost, which planned 15 min where a lab file of 6 mm beads then took
+  // 28 (2026-12-07, 8472b1d).
+  return fit_to_budget(options, pass, options.budget_seconds - spent, options.budget_seconds, effects + walls, [&](const CalibrationOptions& o) {
+    return detail::calibration_passes(o, p) +
+           detail::weighted_screen_and_confirmation_passes(o, p, effects, walls, detail::kScreenCost, detail::kConfirmationCost);
+  });
 }
 
 BudgetPlan plan_screen_within_budget(const CalibrationOptions& options, double pass, int p, int effects, int walls, double left, double budget) {
