@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "sim.h"
+#include "statistics/diagnostics.h"
 
 namespace dem::test {
 namespace {
@@ -138,6 +139,27 @@ TEST(MeshWalls, SlidingAndRollingAcrossSharedEdgesFeelsThePlane) {
     EXPECT_LT(worst_energy, 1e-6) << "fan " << fan;
     EXPECT_LT(worst_bump, 1e-6) << "fan " << fan;
     EXPECT_NEAR(b.state.x[0], a.state.x[0], 1e-8) << "fan " << fan;
+  }
+}
+
+// A sphere driven into a triangulated floor at a step far too large for the contact: the
+// numerical-trouble check names the mesh, as it names a plane wall or a particle pair.
+TEST(MeshWalls, ASphereSunkIntoAMeshIsNumericalTroubleThatNamesTheMesh) {
+  CaseSpec spec = floor_case(true);
+  spec.simulation.time_step = 2e-4;
+  spec.simulation.refuse_unsafe_step = false;
+  spec.particles[0].velocity = Vec3(0, 0, -8);  // 80 % of the radius in the first step
+  spec.particles[0].positions[0] = Vec3(0.001, 0.002, 0.00201);
+  Sim sim(spec);
+  try {
+    for (int k = 0; k < 100; ++k) {
+      sim.advance();
+      check_numerics(sim.model, sim.state, sim.work);
+    }
+    FAIL() << "expected numerical trouble";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("particle 0 overlaps mesh 'floor'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("time step"), std::string::npos) << e.what();
   }
 }
 

@@ -281,6 +281,25 @@ void check_numerics(const Model& model, const State& s, const Workspace& work, d
           s.time, s.step, s.id[i], model.planes[s.wall_pairs.j[k]].name, 100 * ratio, s.x[i], s.y[i], s.z[i],
           100 * max_overlap_ratio, model.advice.report));
   }
+  // Mesh contacts of the last evaluation: overlap = r - distance to the contact point, as the
+  // records count it. A sphere sunk past the limit into a liner or a belt is on its way through.
+  // Before the first evaluation (a run's start, a resumed checkpoint) no slot holds a point.
+  if (!s.has_meshes || s.candidate_begin.size() < s.owned() || s.mesh_contacts.count.size() < s.owned()) return;
+  for (size_t p = 0; p < s.owned(); ++p)
+    for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
+      const size_t c = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);
+      if (c >= work.mesh_slots.cx.size()) continue;
+      const double dx = s.x[p] - work.mesh_slots.cx[c], dy = s.y[p] - work.mesh_slots.cy[c], dz = s.z[p] - work.mesh_slots.cz[c];
+      const double ratio = 1.0 - std::sqrt(dx * dx + dy * dy + dz * dz) / s.radius[p];
+      if (ratio <= max_overlap_ratio) continue;
+      const std::int32_t m = s.mesh_contacts.mesh[p * MeshContacts::kSlots + static_cast<size_t>(k)];
+      throw NumericalError(fmt::format(
+          "t = {:.6g} s, step {}: particle {} overlaps mesh '{}' by {:.0f} % of its radius at [{:.4g}, {:.4g}, {:.4g}] m "
+          "(limit {:.0f} %).\nLikely causes: a wall material too soft for the particles' weight and speed (its Young's modulus "
+          "sets the contact's stiffness with theirs), or a time step too large ({}).",
+          s.time, s.step, s.id[p], m >= 0 && static_cast<size_t>(m) < model.meshes.size() ? model.meshes[m].name : std::string("?"), 100 * ratio,
+          s.x[p], s.y[p], s.z[p], 100 * max_overlap_ratio, model.advice.report));
+    }
 }
 
 double mechanical_energy(const Model& model, const State& s) {
