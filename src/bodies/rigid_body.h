@@ -51,14 +51,16 @@ inline void sin_cos(double x, double& s, double& c) {
   s = std::sin(x), c = std::cos(x);
 }
 
-/// Free rotation over `dt` of a body with principal moments `inertia` and world angular
-/// momentum `momentum` (unchanged): rotations about the principal axes x(dt/2) y(dt/2) z(dt)
-/// y(dt/2) x(dt/2), each exact for its part of the kinetic energy.
-inline Quaternion free_rotation(Quaternion q, const double momentum[3], const double inertia[3], double dt) {
+/// Free rotation over `dt` of a body with principal moments 1 / `inverse_inertia` and world
+/// angular momentum `momentum` (unchanged): rotations about the principal axes x(dt/2) y(dt/2)
+/// z(dt) y(dt/2) x(dt/2), each exact for its part of the kinetic energy. The inverse moments,
+/// not the moments: the five turns follow one another, and a division in each would lie on
+/// that chain.
+inline Quaternion free_rotation(Quaternion q, const double momentum[3], const double inverse_inertia[3], double dt) {
   double pi[3];
   rotate_back(q, momentum, pi);
   auto about = [&](int axis, double h) {
-    const double angle = h * pi[axis] / inertia[axis];
+    const double angle = h * pi[axis] * inverse_inertia[axis];
     // The half angle's sine and cosine give the quaternion's turn, and the whole angle's by the
     // double-angle identities.
     double half_s, half_c;
@@ -81,10 +83,10 @@ inline Quaternion free_rotation(Quaternion q, const double momentum[3], const do
 }
 
 /// World angular velocity of a body from its momentum: w = R I^-1 R^T L.
-inline void angular_velocity(const Quaternion& q, const double momentum[3], const double inertia[3], double w[3]) {
+inline void angular_velocity(const Quaternion& q, const double momentum[3], const double inverse_inertia[3], double w[3]) {
   double pi[3];
   rotate_back(q, momentum, pi);
-  const double body_w[3] = {pi[0] / inertia[0], pi[1] / inertia[1], pi[2] / inertia[2]};
+  const double body_w[3] = {pi[0] * inverse_inertia[0], pi[1] * inverse_inertia[1], pi[2] * inverse_inertia[2]};
   rotate(q, body_w, w);
 }
 

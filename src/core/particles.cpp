@@ -331,9 +331,9 @@ void place_body_spheres(const Model& model, State& s, const std::vector<std::int
 #pragma omp parallel for schedule(static) if (nb >= kParallelMin)
   for (long k = 0; k < nb; ++k) {
     const Quaternion q{b.qw[k], b.qx[k], b.qy[k], b.qz[k]};
-    const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inertia[3] = {b.ix[k], b.iy[k], b.iz[k]};
+    const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inverse_inertia[3] = {1.0 / b.ix[k], 1.0 / b.iy[k], 1.0 / b.iz[k]};
     double w[3];
-    angular_velocity(q, momentum, inertia, w);
+    angular_velocity(q, momentum, inverse_inertia, w);
     for (std::int32_t m = body_begin[k]; m < body_begin[k + 1]; ++m) {
       const std::int32_t p = body_members[m];
       const double local[3] = {s.offset_x[p], s.offset_y[p], s.offset_z[p]};

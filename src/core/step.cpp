@@ -31,13 +31,15 @@ int kick_drift(State& s, Workspace& work, const Model& model, double h, double d
   for_own_blocks(work, n, [&](long begin, long end) { moved |= kick_drift_range(s, limits, begin, end, h, dt); });
   Bodies& b = s.bodies;
   if (b.size() == 0) return moved;
-  for (size_t k = 0; k < b.size(); ++k) {
+  const long nb = static_cast<long>(b.size());
+#pragma omp parallel for schedule(static) if (nb >= kParallelMin)
+  for (long k = 0; k < nb; ++k) {
     const double a = h / b.mass[k];
     b.vx[k] += a * b.fx[k], b.vy[k] += a * b.fy[k], b.vz[k] += a * b.fz[k];
     b.lx[k] += h * b.tx[k], b.ly[k] += h * b.ty[k], b.lz[k] += h * b.tz[k];
     b.x[k] += dt * b.vx[k], b.y[k] += dt * b.vy[k], b.z[k] += dt * b.vz[k];
-    const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inertia[3] = {b.ix[k], b.iy[k], b.iz[k]};
-    const Quaternion q = free_rotation({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, inertia, dt);
+    const double momentum[3] = {b.lx[k], b.ly[k], b.lz[k]}, inverse_inertia[3] = {1.0 / b.ix[k], 1.0 / b.iy[k], 1.0 / b.iz[k]};
+    const Quaternion q = free_rotation({b.qw[k], b.qx[k], b.qy[k], b.qz[k]}, momentum, inverse_inertia, dt);
     b.qw[k] = q.w, b.qx[k] = q.x, b.qy[k] = q.y, b.qz[k] = q.z;
   }
   place_body_spheres(model, s, work.body_begin, work.body_members);
