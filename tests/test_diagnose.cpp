@@ -170,6 +170,27 @@ TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
   EXPECT_GE(std::max(off_a, off_b) - std::min(off_a, off_b), 2.0) << "the measurement decides between the two";
 }
 
+// Two effects hidden at once (wet gravel that rolls): no one candidate explains the data. The best
+// improves the fit and is said to, with what it leaves unexplained; it is not named as missing,
+// and a runner-up as good is no tie to separate by experiment (both models misfit).
+TEST(Diagnose, AnalyticTwoHiddenEffectsGetImprovesNotMissing) {
+  const Analytic sim;
+  MaterialModel truth = read_material_model(kMaterials + "/gravel.yaml");
+  for (const EffectCandidate& c : missing_effects(truth))
+    if (c.name == "liquid_bridge") c.add(truth);
+  set_parameter(truth, "liquid_content", 0.03), set_parameter(truth, "rolling_friction", 0.2), set_parameter(truth, "friction", 0.5);
+  const MeasurementSet set = synthesise(flow_tests(), truth, sim, 17);
+  const Diagnosis d = diagnose(dry_spheres(), set, {}, analytic_options(sim));
+  for (const std::string& w : d.words) std::printf("%s\n", w.c_str());
+  ASSERT_EQ(d.grade, Verdict::improves) << d.words.front();
+  EXPECT_TRUE(d.recommended.empty()) << d.recommended;
+  EXPECT_FALSE(d.best.empty());
+  EXPECT_EQ(d.words.front().rfind(d.best + " improves the fit but does not explain it", 0), 0u) << d.words.front();
+  EXPECT_FALSE(d.unexplained.empty());
+  EXPECT_TRUE(d.separators.empty()) << "no experiment sought between two models that misfit";
+  for (const std::string& w : d.words) EXPECT_EQ(w.rfind("Cannot tell", 0), std::string::npos) << w;
+}
+
 TEST(Discrimination, TheMostPromisingCandidatesAreSimulatedFirstAndAsManyAsPlanned) {
   // Two experiments, the fitted models 2 sigma apart on the density and 0.5 on the heap: the
   // standard set-ups of the tests the file lacks come first, then the density's variants, then
