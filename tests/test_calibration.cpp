@@ -147,6 +147,31 @@ experiments:
     EXPECT_EQ(read.warnings.size(), 1u) << test;
   }
   EXPECT_TRUE(m.warnings.empty());
+  // An outcome read from a number is read from the simulated numbers by the same rule: a drum
+  // whose level bed rides on the shell (no `slipping` flag, angles 0.3 and 0.6 deg) matches the
+  // lab's angle of 0.2; beds at 19 and 21 deg do not, nor does half of them.
+  {
+    const MeasurementSet read = parse_measurements(
+        text + "  - id: drum\n    test: rotating_drum\n    setup: {drum_diameter: 0.2, drum_depth: 0.05, fill_fraction: 0.35, rpm: 20, wall: steel}\n"
+               "    observed:\n      dynamic_angle_deg: {value: 0.2, sigma: 1}\n",
+        "m.yaml");
+    ASSERT_EQ(read.experiments.back().outcome_read_from, "dynamic_angle_deg");
+    MeasurementSet drum = read;
+    drum.experiments = {read.experiments.back()};
+    const auto outcome_term = [&](std::vector<double> angles) {
+      ExperimentRun run;
+      run.id = "drum", run.test = "rotating_drum", run.replicas = static_cast<int>(angles.size());
+      run.values["dynamic_angle_deg"] = angles;
+      run.mean["dynamic_angle_deg"] = angles.front(), run.sigma["dynamic_angle_deg"] = 0.1;
+      const Comparison c = compare_runs(drum, {run}, CalibrationOptions{});
+      const auto t = std::find_if(c.terms.begin(), c.terms.end(), [](const Term& x) { return x.is_outcome(); });
+      EXPECT_NE(t, c.terms.end());
+      return t == c.terms.end() ? -1.0 : t->simulated;
+    };
+    EXPECT_DOUBLE_EQ(outcome_term({0.3, 0.6}), 1.0);
+    EXPECT_DOUBLE_EQ(outcome_term({19.0, 21.0}), 0.0);
+    EXPECT_DOUBLE_EQ(outcome_term({0.3, 21.0}), 0.5);
+  }
   // A misspelt measured key still names the nearest valid one.
   const std::string bad = std::string(text).replace(text.find("poisson_ratio: 0.25"), 19, "poison_ratio: 0.25");
   try {

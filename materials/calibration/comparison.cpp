@@ -112,6 +112,14 @@ Comparison compare_runs(const MeasurementSet& measured, const std::vector<Experi
       t.measured = 1.0, t.sigma_measured = 1.0 / options.outcome_residual;
       const auto f = run.flag_fraction.find(e.outcome);
       t.simulated = f == run.flag_fraction.end() ? 0.0 : f->second;
+      // An outcome the file gave as a number is read from the simulated numbers by the same
+      // rule (outcome_read_as_number): a drum bed whose surface stays level shows an angle near 0
+      // whether it slides on the shell or rides on it, and the lab's number cannot tell which.
+      if (const auto v = run.values.find(e.outcome_read_from); !e.outcome_read_from.empty() && v != run.values.end() && !v->second.empty()) {
+        const auto read = std::count_if(v->second.begin(), v->second.end(),
+                                        [&](double x) { return outcome_read_as_number(e.setup.test, e.outcome_read_from, x) == e.outcome; });
+        t.simulated = std::max(t.simulated, static_cast<double>(read) / static_cast<double>(v->second.size()));
+      }
       if (t.simulated > 0) t.simulated_outcome = e.outcome;
       t.residual = options.outcome_residual * (t.simulated - 1.0);
       t.varied = vkey, t.varied_value = vvalue;

@@ -40,6 +40,17 @@ std::vector<std::string> outcome_names(const std::string& test) {
   return {};
 }
 
+}  // namespace
+
+std::string outcome_read_as_number(const std::string& test, const std::string& observable, double value) {
+  if (test == "angle_of_repose_cylinder" && observable == "angle_deg" && std::abs(value) < 1.0) return "no_heap";
+  if (test == "hopper_discharge" && observable == "mass_flow_rate" && value <= 0.0) return "blocked";
+  if (test == "rotating_drum" && observable == "dynamic_angle_deg" && std::abs(value) < 1.0) return "slipping";
+  return "";
+}
+
+namespace {
+
 /// Contact parameters measured directly in `map` (restitution, friction, ...: any effect
 /// parameter), as known values with `prefix` before the key; the valid keys are `fixed` and
 /// every effect parameter.
@@ -188,14 +199,13 @@ struct ExperimentReader {
   void take_outcomes_written_as_numbers(bool as_number) {
     for (auto it = e.observed.begin(); it != e.observed.end() && e.outcome.empty() && !as_number;) {
       const auto& [key, obs] = *it;
-      const bool no_heap = test == "angle_of_repose_cylinder" && key == "angle_deg" && std::abs(obs.value) < 1.0;
-      const bool no_flow = test == "hopper_discharge" && key == "mass_flow_rate" && obs.value <= 0.0;
-      const bool no_avalanche = test == "rotating_drum" && key == "dynamic_angle_deg" && std::abs(obs.value) < 1.0;
-      if (!(no_heap || no_flow || no_avalanche)) {
+      const std::string read = outcome_read_as_number(test, key, obs.value);
+      if (read.empty()) {
         ++it;
         continue;
       }
-      e.outcome = no_heap ? "no_heap" : no_flow ? "blocked" : "slipping";
+      const bool no_heap = read == "no_heap", no_flow = read == "blocked";
+      e.outcome = read, e.outcome_read_from = key;
       e.warnings.push_back(fmt::format("{}: observed.{} = {:g}: most likely {}; compared as `outcome: {}`, not as a number with sigma {:g}. "
                                        "Write `outcome: {}` beside `observed:` (at the experiment's level) and leave out the value to say "
                                        "so, or `outcome: none` to compare the number",

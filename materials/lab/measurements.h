@@ -24,9 +24,18 @@ struct Experiment {
   TestSetup setup;                               ///< setup.test names the test
   std::map<std::string, Observation> observed;   ///< observable name -> value
   std::string outcome;                           ///< "" or an observed outcome: blocked, no_heap
+  /// The observable whose value the outcome was read from (outcome_read_as_number), "" when the
+  /// file wrote the outcome: the simulated values are then read by the same rule.
+  std::string outcome_read_from;
   std::vector<std::string> warnings;             ///< see MeasurementSet::warnings
   SourceLocation location;
 };
+
+/// The outcome a value of `observable` in a `test` means, as a lab writes it, or "": no heap as
+/// an angle of repose below 1 deg, an arch as no flow, a bed that moved without avalanching as a
+/// drum angle below 1 deg. Measured values are read so (with a warning, unless the file says
+/// `outcome: none`), and so are the simulated values they are compared with.
+std::string outcome_read_as_number(const std::string& test, const std::string& observable, double value);
 
 /// A value the user measured directly: an input of the model, never fitted.
 struct KnownValue {
