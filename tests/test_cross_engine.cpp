@@ -117,6 +117,39 @@ TEST(CrossEngine, ControlWithTraitsGetsNoEffect) {
   EXPECT_LE(chi2, 1.5);
 }
 
+/// What must hold on a set whose effect the diagnosis may not yet find: no confident wrong name.
+/// "Missing" names one of `right`; "cannot tell" names one of them among the effect and its rivals.
+void expect_never_confidently_wrong(const CrossEngineRun& run, const std::vector<std::string>& right) {
+  const Diagnosis& d = run.diagnosis;
+  EXPECT_GT(d.base.after.chi2_per_n(), 3.0) << "the plain model should fail visibly on these data";
+  EXPECT_NE(d.grade, Verdict::nothing_missing);
+  const auto is_right = [&](const std::string& name) { return std::find(right.begin(), right.end(), name) != right.end(); };
+  if (d.grade == Verdict::missing) EXPECT_TRUE(is_right(d.recommended)) << "Missing: " << d.recommended;
+  if (d.grade == Verdict::cannot_tell)
+    EXPECT_TRUE(is_right(d.recommended) || std::any_of(d.rivals.begin(), d.rivals.end(), is_right)) << "cannot tell, recommended " << d.recommended;
+}
+
+// The sets with traits and an effect (glass_beads_6mm_traits_experiments.json): the beads on a liner as soft
+// as they are, particle-liner friction 0.15 against 0.4 between beads, a 27 mm (4.5 d50) silo
+// orifice, a drum whose bed slides on its shell, from the liner starting material. With LIGGGHTS
+// epsd2 rolling friction (mu_r 0.25) the cylinder leaves a low heap (5-13 deg) where the plain
+// beads leave none, and the 27 mm orifice arches in every packing where the plain beads flow.
+// demdesign with LIGGGHTS' values (epsd, mu_r 0.25, liner friction 0.15) fits these data at
+// chi^2/n 0.89; from the liner starting material, whose liner friction is a guess of 0.5, the
+// diagnosis has yet to find the effect beside the liner's friction (2026-12-07: "improves, not
+// explained", nothing named).
+TEST(CrossEngine, RollingFrictionWithTraitsIsNeverConfidentlyWrong) {
+  expect_never_confidently_wrong(diagnose_set("rolling_epsd2_traits", "glass_beads_6mm_liner"), {"epsd", "cdt"});
+}
+
+// LIGGGHTS sjkr cohesion (1e5 J/m^3 between beads and on the liner) with the same traits: on the
+// soft liner a drop rebounds at 0.24 where the dry beads' restitution is 0.45, the cohesive bed
+// rides level on the drum's shell, and the lifted cylinder leaves beads on its wall. demdesign
+// with LIGGGHTS' values fits at chi^2/n 1.30.
+TEST(CrossEngine, CohesionWithTraitsIsNeverConfidentlyWrong) {
+  expect_never_confidently_wrong(diagnose_set("cohesion_sjkr_traits", "glass_beads_6mm_liner"), {"sjkr"});
+}
+
 // LIGGGHTS epsd2 rolling friction (mu_r 0.25): demdesign's rolling resistance (epsd).
 TEST(CrossEngine, RollingFrictionEpsd2IsFound) { expect_effect_found(diagnose_set("rolling_epsd2"), "epsd"); }
 
