@@ -41,6 +41,20 @@ struct Sim {
   }
 };
 
+/// Steps `sim` up to `steps` times, checking the numerics after each; the first NumericalError's
+/// message, or "" when none came.
+inline std::string numerical_trouble_within(Sim& sim, int steps) {
+  try {
+    for (int k = 0; k < steps; ++k) {
+      sim.advance();
+      check_numerics(sim.model, sim.state, sim.work);
+    }
+  } catch (const NumericalError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 inline double overlap_of(const State& s, size_t i, size_t j) {
   const double dx = s.x[i] - s.x[j], dy = s.y[i] - s.y[j], dz = s.z[i] - s.z[j];
   return s.radius[i] + s.radius[j] - std::sqrt(dx * dx + dy * dy + dz * dz);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace dem {
@@ -24,6 +25,21 @@ double wall_overlap(const Model& m, const State& s, size_t i, size_t w) {
   const double at[3] = {s.walls.px[w], s.walls.py[w], s.walls.pz[w]}, x[3] = {s.x[i], s.y[i], s.z[i]};
   double normal[3];
   return s.radius[i] - m.planes[w].distance(at, x, normal);
+}
+
+/// Overlap of particle p's k-th mesh contact at the last evaluation: its radius minus its
+/// distance to the contact point; NaN where no evaluation has filled the slot yet (a run's start,
+/// a resumed checkpoint).
+double mesh_overlap(const State& s, const Workspace& work, size_t p, int k) {
+  const size_t c = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);  // results by candidate
+  if (c >= work.mesh_slots.cx.size()) return std::numeric_limits<double>::quiet_NaN();
+  const double dx = s.x[p] - work.mesh_slots.cx[c], dy = s.y[p] - work.mesh_slots.cy[c], dz = s.z[p] - work.mesh_slots.cz[c];
+  return s.radius[p] - std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/// Whether every owned particle has its mesh-contact slots (mesh_overlap may be asked).
+bool mesh_slots_ready(const State& s) {
+  return s.has_meshes && s.candidate_begin.size() >= s.owned() && s.mesh_contacts.count.size() >= s.owned();
 }
 
 double body_rotational_energy(const State& s, size_t k) {
@@ -146,13 +162,10 @@ ScalarParts measure_parts(const Model& model, const State& s, const Workspace& w
     count(pair_overlap(model, s, s.pairs.i[k], s.pairs.j[k]), std::min(s.radius[s.pairs.i[k]], s.radius[s.pairs.j[k]]));
   for (size_t k = 0; k < s.wall_pairs.size(); ++k)
     count(wall_overlap(model, s, s.wall_pairs.i[k], s.wall_pairs.j[k]), s.radius[s.wall_pairs.i[k]]);
-  if (s.has_meshes)  // mesh contacts of the last evaluation: overlap = r - distance to the contact point
+  if (mesh_slots_ready(s))  // mesh contacts of the last evaluation
     for (size_t p = 0; p < s.owned(); ++p)
-      for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
-        const size_t c = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);  // results by candidate
-        const double dx = s.x[p] - work.mesh_slots.cx[c], dy = s.y[p] - work.mesh_slots.cy[c], dz = s.z[p] - work.mesh_slots.cz[c];
-        count(s.radius[p] - std::sqrt(dx * dx + dy * dy + dz * dz), s.radius[p]);
-      }
+      for (int k = 0; k < s.mesh_contacts.count[p]; ++k)
+        if (const double overlap = mesh_overlap(s, work, p, k); std::isfinite(overlap)) count(overlap, s.radius[p]);
   sums[at.kContacts] = static_cast<double>(contacts), sums[at.kOverlapSum] = sum;
   for (size_t k = 0; k < s.outlets.size() && k < at.outlets; ++k) sums[at.outlet(k)] = s.outlets[k].removed_mass;
   const MeshLoads& loads = s.mesh_loads;
@@ -281,17 +294,13 @@ void check_numerics(const Model& model, const State& s, const Workspace& work, d
           s.time, s.step, s.id[i], model.planes[s.wall_pairs.j[k]].name, 100 * ratio, s.x[i], s.y[i], s.z[i],
           100 * max_overlap_ratio, model.advice.report));
   }
-  // Mesh contacts of the last evaluation: overlap = r - distance to the contact point, as the
-  // records count it. A sphere sunk past the limit into a liner or a belt is on its way through.
-  // Before the first evaluation (a run's start, a resumed checkpoint) no slot holds a point.
-  if (!s.has_meshes || s.candidate_begin.size() < s.owned() || s.mesh_contacts.count.size() < s.owned()) return;
+  // Mesh contacts of the last evaluation, as the records count them. A sphere sunk past the
+  // limit into a liner or a belt is on its way through.
+  if (!mesh_slots_ready(s)) return;
   for (size_t p = 0; p < s.owned(); ++p)
     for (int k = 0; k < s.mesh_contacts.count[p]; ++k) {
-      const size_t c = static_cast<size_t>(s.candidate_begin[p]) + static_cast<size_t>(k);
-      if (c >= work.mesh_slots.cx.size()) continue;
-      const double dx = s.x[p] - work.mesh_slots.cx[c], dy = s.y[p] - work.mesh_slots.cy[c], dz = s.z[p] - work.mesh_slots.cz[c];
-      const double ratio = 1.0 - std::sqrt(dx * dx + dy * dy + dz * dz) / s.radius[p];
-      if (ratio <= max_overlap_ratio) continue;
+      const double ratio = mesh_overlap(s, work, p, k) / s.radius[p];
+      if (!(ratio > max_overlap_ratio)) continue;  // NaN: a slot not yet filled
       const std::int32_t m = s.mesh_contacts.mesh[p * MeshContacts::kSlots + static_cast<size_t>(k)];
       throw NumericalError(fmt::format(
           "t = {:.6g} s, step {}: particle {} overlaps mesh '{}' by {:.0f} % of its radius at [{:.4g}, {:.4g}, {:.4g}] m "
