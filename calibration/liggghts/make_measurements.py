@@ -12,6 +12,9 @@ whose first line says how the values were made.
     python3 make_measurements.py --material materials/control.json \\
         --experiments glass_beads_6mm_experiments.json --out control.yaml
 
+A material may make its particles rigid clumps of two or three spheres (`shape`, LIGGGHTS
+multisphere) or wet them (`contact.cohesion: easo`, liquid bridges); every input takes either.
+
 Python 3 standard library only. Raw LIGGGHTS output stays in the temporary folder (--keep keeps
 it and prints where).
 """
@@ -33,9 +36,53 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SLIPPING_CLEARLY = 0.4  # [-] wall-layer speed / wall speed below which the drum file says `slipping`
+# LIGGGHTS' name of each cohesion model of a material description (contact.cohesion).
+COHESION_MODELS = {"off": "off", "sjkr": "sjkr", "easo": "easo/capillary/viscous"}
+# LIGGGHTS 3.8.0 (the Debian package) forms the contact angle of a pair in
+# cohesion_model_easo_capillary_viscous.h as 1/2 theta_i theta_j (radians), not as the mean
+# 1/2 (theta_i + theta_j) its documentation states (corrected upstream in 2021, 9805a233). The
+# material description gives the pairs' angles; the per-type angles LIGGGHTS reads are converted
+# so that 3.8.0 forms those. Set False for a LIGGGHTS that forms the mean.
+EASO_ANGLE_PRODUCT = True
 
 # ---------------------------------------------------------------------------------------------
 # Material
+
+
+def clump_geometry(spheres, aspect):
+    """A clump of `spheres` equal spheres on a line whose length / width is `aspect` (demdesign's
+    two_sphere_clump for two: centres (aspect - 1) r either side of the middle), scaled to a
+    volume-equivalent diameter of 1: sphere radius, centres along x, the volume of the union of
+    the spheres (overlaps counted once), its moments of inertia per density about the long axis
+    and across it through the centre of mass, the bounding radius (centre of mass to the farthest
+    surface point) and demdesign's direct-shear estimate of the bounding factor
+    (lab_direct_shear.cpp: reach / cube root of the sum of the spheres' cubed radii)."""
+    r = 1.0
+    spacing = 2 * r * (aspect - 1) / (spheres - 1)
+    centres = [(k - 0.5 * (spheres - 1)) * spacing for k in range(spheres)]
+    # Equal spheres on a line: the union's cross-section at x is that of the nearest centre's
+    # sphere, so each sphere contributes its slab up to halfway to its neighbours; the integrands
+    # are polynomials of degree 4, which 3-point Gauss-Legendre integrates exactly.
+    nodes, weights = (-math.sqrt(0.6), 0.0, math.sqrt(0.6)), (5 / 9, 8 / 9, 5 / 9)
+    volume = i_axis = i_cross = 0.0
+    for k, xk in enumerate(centres):
+        lo = -r if k == 0 else max(-r, -0.5 * spacing)
+        hi = r if k == spheres - 1 else min(r, 0.5 * spacing)
+        if hi <= lo:
+            continue
+        half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+        for t, w in zip(nodes, weights):
+            u = mid + half * t
+            area = r * r - u * u  # / pi: the slab's radius squared
+            x = xk + u
+            volume += w * half * math.pi * area
+            i_axis += w * half * math.pi / 2 * area * area
+            i_cross += w * half * (math.pi * area * x * x + math.pi / 4 * area * area)
+    d = (6 * volume / math.pi) ** (1 / 3)
+    reach = max(abs(x) for x in centres) + r
+    return {"radius": r / d, "centres": [x / d for x in centres], "volume": volume / d ** 3,
+            "i_axis": i_axis / d ** 5, "i_cross": i_cross / d ** 5, "reach": reach / d,
+            "bounding": 2 * reach / d, "shear_bounding": max(1.0, reach / (spheres ** (1 / 3) * r))}
 
 
 class Material:
@@ -68,11 +115,86 @@ class Material:
         self.cohesion = c.get("cohesion", "off")
         if self.rolling not in ("off", "epsd", "epsd2", "cdt"):
             raise SystemExit(f"{path}: contact.rolling must be off, epsd, epsd2 or cdt")
-        if self.cohesion not in ("off", "sjkr"):
-            raise SystemExit(f"{path}: contact.cohesion must be off or sjkr")
+        if self.cohesion not in COHESION_MODELS:
+            raise SystemExit(f"{path}: contact.cohesion must be off, sjkr or easo")
         self.pp = {k: float(v) for k, v in m["particle_pairs"].items()}
         self.pw = {k: float(v) for k, v in m["wall_pairs"].items()}
         self.stated = m.get("stated_in_file", {"particles": ["youngs_modulus", "poisson_ratio"], "walls": ["youngs_modulus", "poisson_ratio", "density"]})
+        # Particle shape: {"spheres": 2 or 3, "aspect_ratio": length / width}; absent: spheres.
+        # The diameters are then the clumps' volume-equivalent diameters.
+        shape = m.get("shape")
+        self.clump = None
+        if shape is not None:
+            n, aspect = shape.get("spheres"), float(shape.get("aspect_ratio", 0))
+            if n not in (2, 3) or not 1.0 < aspect <= 1.0 + (n - 1):
+                raise SystemExit(f"{path}: shape needs spheres 2 or 3 and an aspect_ratio above 1 at which neighbouring "
+                                 f"spheres still overlap or touch (at most {n}.0 for {n} spheres)")
+            self.clump = dict(clump_geometry(n, aspect), spheres=n, aspect_ratio=aspect)
+        if self.cohesion == "easo":
+            for key in ("liquid_content", "surface_tension", "contact_angle_deg"):
+                if key not in self.pp:
+                    raise SystemExit(f"{path}: cohesion easo needs particle_pairs.{key}")
+            for key in ("liquid_content", "surface_tension", "fluid_viscosity"):
+                if key in self.pw and self.pw[key] != self.pp.get(key, 0.0):
+                    raise SystemExit(f"{path}: wall_pairs.{key}: LIGGGHTS' liquid bridges on a wall hold the particle's own liquid "
+                                     f"(the wall is dry) of the one liquid; state {key} under particle_pairs only")
+            self.easo_angles()  # checks that LIGGGHTS can form the pairs' angles
+
+    def bounding(self):
+        """[-] Bounding diameter / volume-equivalent diameter: 1 for spheres."""
+        return self.clump["bounding"] if self.clump else 1.0
+
+    def spheres(self):
+        """LIGGGHTS atoms per particle."""
+        return self.clump["spheres"] if self.clump else 1
+
+    def easo_angles(self):
+        """The contact angles [deg] of atom types 1 and 2 that make LIGGGHTS form the pairs' angles
+        (particle_pairs / wall_pairs contact_angle_deg)."""
+        pp = self.pp["contact_angle_deg"]
+        pw = self.pw.get("contact_angle_deg", pp)
+        if not EASO_ANGLE_PRODUCT:
+            return pp, 2 * pw - pp
+        # 3.8.0: theta_pair = 1/2 theta_i theta_j [rad].
+        tp = math.sqrt(2 * math.radians(pp))
+        if tp == 0:
+            if pw != 0:
+                raise SystemExit(f"{self.path}: LIGGGHTS 3.8.0 forms no wall contact angle other than 0 when the particles' is 0")
+            return 0.0, 0.0
+        tw = 2 * math.radians(pw) / tp
+        if math.degrees(tp) > 180 or math.degrees(tw) > 180:
+            raise SystemExit(f"{self.path}: contact angles {pp:g} / {pw:g} deg need an angle above 180 deg per atom type in LIGGGHTS 3.8.0")
+        return math.degrees(tp), math.degrees(tw)
+
+    def bridge_volume(self, ri, rj, wall=False):
+        """[m^3] LIGGGHTS' easo bridge volume between spheres of radii ri and rj: each particle gives
+        its liquid content times its volume times half the cap its partner subtends (6.7 % of its
+        liquid between equal spheres). Against a wall (dry) 3.8.0 takes the radius sum as the
+        particle's own radius, so the bridge holds half the particle's liquid."""
+        c = self.pp["liquid_content"]
+        if wall:
+            return c * 4 / 3 * math.pi * ri ** 3 * 0.5  # radsum = ri: the whole hemisphere's share
+        cap = lambda a, b: 0.5 * (1 - math.sqrt(1 - b * b / (a + b) ** 2))
+        return c * 4 / 3 * math.pi * (ri ** 3 * cap(ri, rj) + rj ** 3 * cap(rj, ri))
+
+    def rupture_distances(self):
+        """Lian's rupture distance (1 + theta / 2) V^(1/3) of LIGGGHTS' bridges, [(ri, rj, wall, S_c)]
+        over the sphere radii of the particles (a clump's spheres) and the wall."""
+        scale = self.clump["radius"] if self.clump else 0.5
+        radii = [scale * d for d in self.sizes]
+        pp, pw = math.radians(self.pp["contact_angle_deg"]), math.radians(self.pw.get("contact_angle_deg", self.pp["contact_angle_deg"]))
+        out = []
+        for i, ri in enumerate(radii):
+            for rj in radii[i:]:
+                out.append((ri, rj, False, (1 + 0.5 * pp) * self.bridge_volume(ri, rj) ** (1 / 3)))
+            out.append((ri, ri, True, (1 + 0.5 * pw) * self.bridge_volume(ri, ri, wall=True) ** (1 / 3)))
+        return out
+
+    def max_separation_ratio(self):
+        """LIGGGHTS breaks every bridge at (ratio - 1) (r_i + r_j) (r_j = r_i at a wall): 10 % beyond
+        the largest Lian rupture distance, so that Lian's distance is the one that acts."""
+        need = max(s / (ri + rj) for ri, rj, _, s in self.rupture_distances())
+        return math.ceil(100 * (1 + 1.1 * need)) / 100
 
     # The mass median (the d50 of demdesign's size_figures) and the number-weighted mean volume.
     def d50(self):
@@ -97,33 +219,61 @@ class Material:
             "e_pp": self.pp["restitution"], "e_pw": self.pw["restitution"],
             "mu_pp": self.pp["friction"], "mu_pw": self.pw["friction"],
             "rolling": self.rolling, "rmu_pp": self.pp.get("rolling_friction", 0.0), "rmu_pw": self.pw.get("rolling_friction", 0.0),
-            "cohesion": self.cohesion,
+            "cohesion": COHESION_MODELS[self.cohesion],
             "ced_pp": self.pp.get("cohesion_energy_density", 0.0), "ced_pw": self.pw.get("cohesion_energy_density", 0.0),
             "d1": self.sizes[0], "d2": self.sizes[1], "d3": self.sizes[2],
             "f1": self.fractions[0], "f2": self.fractions[1], "f3": self.fractions[2],
             "d50": self.d50(),
         }
+        if self.cohesion == "easo":
+            angle_p, angle_w = self.easo_angles()
+            v.update(liquid_content=self.pp["liquid_content"], surface_tension=self.pp["surface_tension"],
+                     contact_angle_p=angle_p, contact_angle_w=angle_w, fluid_viscosity=self.pp.get("fluid_viscosity", 0.0),
+                     max_separation_ratio=self.max_separation_ratio())
+        if self.clump:
+            v.update(clump_spheres=self.clump["spheres"], clump_file="clump.multisphere", clump_volume=self.clump["volume"],
+                     clump_i_axis=self.clump["i_axis"], clump_i_cross=self.clump["i_cross"], bounding=self.clump["bounding"],
+                     shear_bounding=self.clump["shear_bounding"], d50_class=self.sizes.index(self.d50()) + 1)
         return v
+
+    def write_clump(self, folder):
+        """The unit clump (volume-equivalent diameter 1) for fix particletemplate/multisphere."""
+        if not self.clump:
+            return
+        with open(os.path.join(folder, "clump.multisphere"), "w") as f:
+            f.write(f"# {self.clump['spheres']} spheres, length / width {self.clump['aspect_ratio']:g}, volume-equivalent diameter 1\n")
+            for x in self.clump["centres"]:
+                f.write(f"{x!r} 0 0 {self.clump['radius']!r}\n")
 
     def describe(self):
         """The model and its parameter values, in words, for the file's first line."""
         def pars(d):
-            keys = [("restitution", "e"), ("friction", "mu"), ("rolling_friction", "mu_r"), ("cohesion_energy_density", "k_c")]
+            keys = [("restitution", "e"), ("friction", "mu"), ("rolling_friction", "mu_r"), ("cohesion_energy_density", "k_c"),
+                    ("contact_angle_deg", "theta")]
             out = []
             for k, short in keys:
                 if k == "rolling_friction" and self.rolling == "off":
                     continue
-                if k == "cohesion_energy_density" and self.cohesion == "off":
+                if k == "cohesion_energy_density" and self.cohesion != "sjkr":
+                    continue
+                if k == "contact_angle_deg" and self.cohesion != "easo":
                     continue
                 if k in d:
-                    out.append(f"{short} {fmt(d[k])}" + (" J/m^3" if k == "cohesion_energy_density" else ""))
+                    out.append(f"{short} {fmt(d[k])}" + {"cohesion_energy_density": " J/m^3", "contact_angle_deg": " deg"}.get(k, ""))
             return " ".join(out)
 
         model = "hertz, tangential history"
         model += ", rolling_friction " + self.rolling if self.rolling != "off" else ", no rolling friction"
-        model += ", cohesion " + self.cohesion if self.cohesion != "off" else ", no cohesion"
+        model += ", cohesion " + COHESION_MODELS[self.cohesion] if self.cohesion != "off" else ", no cohesion"
+        if self.cohesion == "easo":
+            model += (f" (liquid {fmt(self.pp['liquid_content'])} of each particle's volume, surface tension "
+                      f"{fmt(self.pp['surface_tension'])} N/m, viscosity {fmt(self.pp.get('fluid_viscosity', 0.0))} Pa s)")
+        shape = ""
+        if self.clump:
+            shape = (f"{self.clump['spheres']}-sphere clumps (multisphere) of length / width {fmt(self.clump['aspect_ratio'])}, "
+                     f"diameters volume-equivalent; ")
         return (f"model {model}; particle-particle {pars(self.pp)}; particle-{self.wall_name} {pars(self.pw)}; "
-                f"E {fmt(self.youngs)} Pa, nu {fmt(self.poisson)}, density {fmt(self.density)} kg/m^3; "
+                f"{shape}E {fmt(self.youngs)} Pa, nu {fmt(self.poisson)}, density {fmt(self.density)} kg/m^3; "
                 f"{self.wall_name} E {fmt(self.wall['youngs_modulus'])} Pa, nu {fmt(self.wall.get('poisson_ratio', 0.3))}")
 
 
@@ -231,14 +381,16 @@ def result_lines(log, key):
     return out
 
 
-def read_dump(path):
+def read_dump(path, names=None):
+    """The rows of a dump (ITEM: ATOMS, or ITEM: ENTRIES of a local dump) as dicts by column name;
+    `names` renames the columns in order."""
     with open(path) as f:
         lines = f.read().splitlines()
     for k, line in enumerate(lines):
-        if line.startswith("ITEM: ATOMS"):
-            cols = line.split()[2:]
+        if line.startswith("ITEM: ATOMS") or line.startswith("ITEM: ENTRIES"):
+            cols = names or line.split()[2:]
             return [dict(zip(cols, map(float, row.split()))) for row in lines[k + 1:] if row.strip()]
-    raise Failure(f"{path}: no ITEM: ATOMS section")
+    raise Failure(f"{path}: no ITEM: ATOMS or ITEM: ENTRIES section")
 
 
 def read_columns(path):
@@ -276,16 +428,19 @@ def test_drop_rebound(args, mat, setup, folder):
     out = "drop.txt"
     log, elapsed = run_liggghts(args, folder, "drop_rebound.in",
                                 dict(mat.liggghts_vars(), drop_height=h, impact_angle_deg=angle, out=out), "drop")
-    rows = read_columns(os.path.join(folder, out))  # time z vz vx
+    rows = read_columns(os.path.join(folder, out))  # time z vz vx low (centre of mass, lowest surface point)
     r = 0.5 * mat.d50()
+    reach = r * mat.bounding()  # the centre of mass starts this far above the drop height
+    # A sphere's gap to the plate is its centre's height less its radius; a clump's, its lowest point.
+    gap = (lambda row: row[4]) if mat.clump else (lambda row: row[1] - r)
     # Fall to the first touch (the centre height before the first step in contact is the reference).
     k = 0
     touch_z, vx_before = rows[0][1], rows[0][3]
-    while k < len(rows) and rows[k][1] - r > 0:
+    while k < len(rows) and gap(rows[k]) > 0:
         touch_z, vx_before = rows[k][1], rows[k][3]
         k += 1
     # Leave the plate, then rise to the apex.
-    while k < len(rows) and (rows[k][1] - r <= 0 or rows[k][2] <= 0):
+    while k < len(rows) and (gap(rows[k]) <= 0 or rows[k][2] <= 0):
         k += 1
     if k >= len(rows):
         raise Failure("drop_rebound: no rebound in the recorded time")
@@ -294,7 +449,9 @@ def test_drop_rebound(args, mat, setup, folder):
     while k < len(rows) and rows[k][2] > 0:
         apex = max(apex, rows[k][1])
         k += 1
-    fallen = max(1e-300, r + h - touch_z)
+    if k < len(rows) and len(rows[k]) > 4 and rows[k][4] > 1e19:  # no atom left: the particle left the domain
+        raise Failure("drop_rebound: the particle left the domain before its rebound apex")
+    fallen = max(1e-300, reach + h - touch_z)
     obs = {"restitution": math.sqrt(max(0.0, apex - touch_z) / fallen)}
     if angle > 0:
         obs["tangential_restitution"] = vx_after / vx_before if vx_before else 0.0
@@ -312,9 +469,13 @@ def test_bulk_density(args, mat, setup, folder):
     stl.write(os.path.join(folder, "cup.stl"))
     log, elapsed = run_liggghts(args, folder, "bulk_density.in",
                                 dict(mat.liggghts_vars(), cup_diameter=D, cup_height=H, pour_height=pour,
-                                     cup_stl="cup.stl", out="bulk_final.txt"), "bulk")
+                                     cup_stl="cup.stl", out="bulk_final.txt", bodies="bulk_bodies.txt"), "bulk")
     res = result_lines(log, "settled")[-1]
-    atoms = read_dump(os.path.join(folder, "bulk_final.txt"))
+    # Strike off: what has its centre (a clump: its centre of mass) at or below the rim, inside the cup.
+    if mat.clump:
+        atoms = read_dump(os.path.join(folder, "bulk_bodies.txt"), ["x", "y", "z", "mass"])
+    else:
+        atoms = read_dump(os.path.join(folder, "bulk_final.txt"))
     mass = sum(p["mass"] for p in atoms if p["z"] <= H and p["x"] ** 2 + p["y"] ** 2 <= R * R)
     notes = [] if res["_first"] == "1" else ["NOT settled (time cap)"]
     return {"bulk_density": mass / (math.pi * R * R * H)}, notes, elapsed, len(atoms)
@@ -372,7 +533,7 @@ def test_angle_of_repose_cylinder(args, mat, setup, folder):
     if held:
         notes.append(f"{held} particles held above the bed's top, left out")
     notes.append(f"R_heap {r_heap:.3g} m" if angle else "flag no_heap")
-    return {"angle_deg": angle}, notes, elapsed, int(float(heap.get("particles", 0)))
+    return {"angle_deg": angle}, notes, elapsed, int(float(heap.get("particles", 0))) // mat.spheres()
 
 
 def test_rotating_drum(args, mat, setup, folder):
@@ -384,7 +545,7 @@ def test_rotating_drum(args, mat, setup, folder):
         raise Failure("rotating_drum: ends must be walls or periodic")
     periodic = ends == "periodic"
     largest, d50 = mat.largest(), mat.d50()
-    min_depth = 3.0 * 1.1 * (largest + 0.25 * largest)
+    min_depth = 3.0 * 1.1 * (largest * mat.bounding() + 0.25 * largest)
     depth = max(depth_asked, min_depth) if periodic else depth_asked
     R = 0.5 * D
     around = segments_around(R, 0.5 * d50)
@@ -407,7 +568,7 @@ def test_rotating_drum(args, mat, setup, folder):
     files = [f for f in files if int(f.rsplit(".", 1)[1]) > spinup]
     if len(files) != 24:
         raise Failure(f"rotating_drum: {len(files)} samples written, 24 expected")
-    spacing = 1.05 * largest
+    spacing = 1.05 * largest * mat.bounding()
     angles, carried = [], []
     for f in files:
         atoms = read_dump(f)
@@ -432,7 +593,7 @@ def test_rotating_drum(args, mat, setup, folder):
     if SLIPPING_CLEARLY <= share < 0.5:
         notes.append("borderline: demdesign's rule (< 50 %) would flag slipping; outcome not stated")
     obs = {"dynamic_angle_deg": sum(angles) / len(angles) if angles else 0.0}
-    return obs, notes + [f"flag {x}" for x in flags], elapsed, len(read_dump(files[-1]))
+    return obs, notes + [f"flag {x}" for x in flags], elapsed, len(read_dump(files[-1])) // mat.spheres()
 
 
 def drum_surface_angle(atoms, d50):
@@ -580,7 +741,7 @@ def fmt(v):
     return f"{mantissa}e{int(exponent)}"
 
 
-TEMPLATE_SEEDS = {15485867, 32452843, 49979687, 67867967}  # contact.in's particle templates: LIGGGHTS wants every seed distinct
+TEMPLATE_SEEDS = {15485867, 32452843, 49979687, 67867967, 86028157}  # the particle templates' and distributions' (contact.in, drop_rebound.in): LIGGGHTS wants every seed distinct
 
 
 def placement_seeds(first, count):
@@ -589,7 +750,7 @@ def placement_seeds(first, count):
     def prime(n):
         return n > 1 and all(n % d for d in range(2, int(math.isqrt(n)) + 1))
     if first in TEMPLATE_SEEDS:
-        raise SystemExit(f"--seed {first}: contact.in's particle templates use it; LIGGGHTS wants every seed distinct")
+        raise SystemExit(f"--seed {first}: a particle template or distribution uses it (contact.in, drop_rebound.in); LIGGGHTS wants every seed distinct")
     seeds, n = [first], first
     while len(seeds) < count:
         n += 1
@@ -715,12 +876,14 @@ def main():
     try:
         for e in experiments:
             # A lab repeats a test and states the mean with its standard error; so does this file.
-            # One particle falls the same way whatever the placement seed: the drop runs once.
-            count = 1 if e["test"] == "drop_rebound" else args.packings
+            # One sphere falls the same way whatever the placement seed: its drop runs once. A
+            # clump strikes at the orientation its seed gives, and rebounds accordingly.
+            count = 1 if e["test"] == "drop_rebound" and not mat.clump else args.packings
             packings = []
             for k in range(count):
                 folder = os.path.join(work, e["id"], f"packing_{k + 1}")
                 os.makedirs(folder)
+                mat.write_clump(folder)
                 print(f"{e['id']}: {e['test']}, packing {k + 1} of {count} ...", file=sys.stderr, flush=True)
                 try:
                     obs, notes, elapsed, particles = TESTS[e["test"]](argparse.Namespace(**dict(vars(args), seed=seeds[k])), mat, e["setup"], folder)
