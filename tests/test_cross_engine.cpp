@@ -135,11 +135,14 @@ void expect_never_confidently_wrong(const CrossEngineRun& run, const std::vector
 // epsd2 rolling friction (mu_r 0.25) the cylinder leaves a low heap (5-13 deg) where the plain
 // beads leave none, and the 27 mm orifice arches in every packing where the plain beads flow.
 // demdesign with LIGGGHTS' values (epsd, mu_r 0.25, liner friction 0.15) fits these data at
-// chi^2/n 0.89; from the liner starting material, whose liner friction is a guess of 0.5, the
-// diagnosis has yet to find the effect beside the liner's friction (2026-12-07: "improves, not
-// explained", nothing named).
-TEST(CrossEngine, RollingFrictionWithTraitsIsNeverConfidentlyWrong) {
-  expect_never_confidently_wrong(diagnose_set("rolling_epsd2_traits", "glass_beads_6mm_liner"), {"epsd", "cdt"});
+// chi^2/n 0.89. From the liner starting material, whose liner friction is a guess of 0.5, the
+// diagnosis finds that the data depend on that guess, calibrates it with the others, and names
+// rolling resistance (2026-12-07: "Missing: epsd", chi^2/n 7.68 to 0.93, rolling friction 0.24,
+// liner friction 0.145).
+TEST(CrossEngine, RollingFrictionWithTraitsIsFound) {
+  const CrossEngineRun run = diagnose_set("rolling_epsd2_traits", "glass_beads_6mm_liner");
+  expect_never_confidently_wrong(run, {"epsd", "cdt"});
+  expect_effect_found(run, "epsd");
 }
 
 // LIGGGHTS sjkr cohesion (1e5 J/m^3 between beads and on the liner) with the same traits: on the

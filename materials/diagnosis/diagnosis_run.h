@@ -29,12 +29,6 @@ struct ScreenBasis;
 struct SignaturePass;
 struct CandidateScreen;
 
-// The screen's state (defined with the screen, below).
-struct ScreenResidual;
-struct ScreenBasis;
-struct SignaturePass;
-struct CandidateScreen;
-
 /// The state a diagnosis passes from phase to phase; diagnose() below reads as the list of them.
 class DiagnosisRun {
  public:
@@ -53,6 +47,7 @@ class DiagnosisRun {
         count_(command_.count()) {}
 
   void calibrate_as_it_is();
+  void probe_guessed_walls(const Comparison& first);
   void check_at_full_size();
   bool nothing_to_look_for();
   void replan_for_the_screen();
@@ -63,17 +58,22 @@ class DiagnosisRun {
   void write_verdict();
   void describe_candidates();
   Diagnosis result() {
+    // After the verdict: the plain fit's values out of the plausible, and before them the guessed
+    // wall parameters it calibrated.
     if (!implausible_.empty()) d_.words.insert(d_.words.begin() + std::min<std::ptrdiff_t>(1, std::ssize(d_.words)), implausible_);
+    d_.words.insert(d_.words.begin() + std::min<std::ptrdiff_t>(1, std::ssize(d_.words)), guessed_walls_.begin(), guessed_walls_.end());
     return std::move(d_);
   }
 
  private:
   const MaterialModel& model_;
   const MeasurementSet& measured_;
-  const std::vector<FitParameter> parameters_;
+  std::vector<FitParameter> parameters_;  ///< a guessed wall parameter the data depend on joins them (probe_guessed_walls)
   const CalibrationOptions& given_;
   CalibrationOptions options_;  ///< a budget may reduce it; the commands it calls share its context
-  const int experiments_, fitted_, walls_, lacking_;
+  const int experiments_;
+  int fitted_, walls_;
+  const int lacking_;
   const detail::CommandScope command_;
   detail::CommandProgress& count_;
   Diagnosis d_;
@@ -86,6 +86,7 @@ class DiagnosisRun {
   std::vector<std::string> undecided_, nonlinear_, unconfirmed_;
   std::string screen_leader_;  ///< the screen's first: the candidates are ranked again by their fits later
   bool screen_silent_ = false;
+  std::vector<std::string> guessed_walls_;         ///< the guessed wall parameters calibrated with the others, and why
   std::string implausible_;                        ///< the plain fit's values out of the plausible
 
   std::string shrunk_words_;      ///< why and how the apparatus was shrunk (shrink)
@@ -123,7 +124,7 @@ class DiagnosisRun {
   void rank_candidate(const EffectCandidate& c, const ScreenBasis& basis, SignaturePass& pass, CandidateScreen& screen, CandidateResult& cr);
   void rank_by_share();
   template <class SignatureOf, class OwnChi2>
-  std::string weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
+  std::string weaker_strength(const EffectCandidate& c, int side, double multiple, double linear, double rr, const SignatureOf& signature_of,
                               const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor, detail::Progress& progress,
                               double& measured_chi2, CandidateResult& cr);
   void fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of);

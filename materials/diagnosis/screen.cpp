@@ -120,7 +120,7 @@ struct CandidateScreen {
   explicit CandidateScreen(const ScreenBasis& basis) : reachable(basis.orthogonal(basis.r).squaredNorm()), measured_chi2(basis.rr) {}
 
   Eigen::VectorXd perp[2];     ///< each strength's signature, orthogonal to the fitted directions (ScreenBasis::orthogonal)
-  Eigen::VectorXd at_start;    ///< the signature at the start values
+  Eigen::VectorXd at[2];       ///< each strength's signature as measured: at the start values and at the stronger step
   double strength_needed = 0;  // of the added parameter, from the linear screen at either strength
   // The better strength's own chi^2 after the linear recalibration: what its change takes off the
   // part of the residual the fitted parameters cannot reach (a fit pinned at a bound reaches
@@ -147,18 +147,21 @@ void bound_first_round(const EffectCandidate& c, double strength_needed, Candida
 /// linear share says a fraction `multiple` of its start would) is simulated once more, at that
 /// fraction: the likelihood of the data at a strength the data may hold, not only at two that are
 /// too strong. Returns the words for its rank (" and at STRENGTH"), or "" when nothing was run.
+/// A two-sided candidate (EffectCandidate::two_sided) is simulated on the `side` that explains
+/// more: 0 toward its start values, 1 toward its stronger step.
 /// Rejected: the two strengths alone, with which rolling resistance explained 0 % of
 /// lab_rolling.yaml's misfit on a fit pinned at friction 0.9 (its start step was about twice what
 /// the data hold), and the linear share (a threshold makes it meaningless).
 template <class SignatureOf, class OwnChi2>
-std::string DiagnosisRun::weaker_strength(const EffectCandidate& c, double multiple, double linear, double rr, const SignatureOf& signature_of,
+std::string DiagnosisRun::weaker_strength(const EffectCandidate& c, int side, double multiple, double linear, double rr, const SignatureOf& signature_of,
                                           const OwnChi2& own_chi2, int replicas, const std::map<std::string, double>& floor,
                                           detail::Progress& progress, double& measured_chi2, CandidateResult& cr) {
   if (c.parameters.size() != 1 || !(multiple > 0.05 && multiple < 0.9) || measured_chi2 <= rr * (1 - linear)) return "";
   const auto& [key, range] = *c.parameters.begin();
-  if (!c.start.count(key)) return "";
+  const std::map<std::string, double>& toward = side == 1 ? c.stronger : c.start;
+  if (!toward.count(key)) return "";
   const double from = c.unchanged.count(key) ? c.unchanged.at(key) : range.first;
-  const double value = from + multiple * (c.start.at(key) - from);
+  const double value = from + multiple * (toward.at(key) - from);
   MaterialModel with = d_.base.fitted;
   c.add(with);
   for (const auto& [k, v] : c.start) set_parameter(with, k, v);
@@ -313,7 +316,7 @@ void DiagnosisRun::measure_strengths(const EffectCandidate& c, const detail::Sig
     for (const ExperimentRun& run : runs) cr.cost += run.wall_seconds, cr.simulations += run.replicas;
     const Comparison changed = compare_runs(measured_, runs, options_, basis.floor);
     const Eigen::VectorXd s = signature_of_runs(basis, changed, screen.flips);
-    if (strength == 0) screen.at_start = s;
+    screen.at[strength] = s;
     screen.perp[strength] = basis.orthogonal(s);
     screen.measured_chi2 = std::min(screen.measured_chi2, own_runs_chi2(basis, screen.reachable, s));
     (strength == 0 ? cr.explained_start : cr.explained_stronger) = basis.explained_by(screen.perp[strength], s);
@@ -359,12 +362,15 @@ void DiagnosisRun::rank_candidate(const EffectCandidate& c, const ScreenBasis& b
   // Strengths that change the terms by less than one sigma in all have no direction to disagree on.
   const double norms = perp[0].norm() * perp[1].norm();
   const bool signature = perp[0].norm() >= 1.0 || perp[1].norm() >= 1.0;
-  cr.agreement = signature && norms > 0 ? perp[0].dot(perp[1]) / norms : 1.0;
+  // A two-sided candidate's steps go opposite ways: a linear response changes the terms oppositely.
+  const double sense = c.two_sided ? -1.0 : 1.0;
+  cr.agreement = signature && norms > 0 ? sense * perp[0].dot(perp[1]) / norms : 1.0;
   cr.stable = cr.agreement >= 0.5 && screen.flips.empty();
   const double linear = std::max(cr.explained_start, cr.explained_stronger);
   const auto signature_of = [&](const Comparison& changed) { return signature_of_runs(basis, changed, screen.flips); };
   const auto own_chi2 = [&](const Eigen::VectorXd& s) { return own_runs_chi2(basis, screen.reachable, s); };
-  const std::string weaker = cr.stable ? std::string() : weaker_strength(c, basis.cancelling(perp[0], screen.at_start), linear, rr, signature_of, own_chi2,
+  const int side = c.two_sided && cr.explained_stronger > cr.explained_start ? 1 : 0;
+  const std::string weaker = cr.stable ? std::string() : weaker_strength(c, side, basis.cancelling(perp[side], screen.at[side]), linear, rr, signature_of, own_chi2,
                                                                         pass.replicas, basis.floor, pass.progress, screen.measured_chi2, cr);
   cr.screen_chi2 = cr.stable ? rr * (1 - linear) : screen.measured_chi2;
   cr.explained = rr > 0 ? std::max(0.0, 1 - cr.screen_chi2 / rr) : 0.0;

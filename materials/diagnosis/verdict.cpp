@@ -165,8 +165,10 @@ void DiagnosisRun::describe_candidates() {
   }
   d_.words.insert(d_.words.end(), left_out_.begin(), left_out_.end());
   for (CandidateResult& cr : d_.candidates) {
-    const std::string screen = fmt::format("explains {:.0f} % of the residual ({:.0f} % at its start, {:.0f} % at twice the step; agreement {:.2f}; {})",
-                                           100 * cr.explained, 100 * cr.explained_start, 100 * cr.explained_stronger, cr.agreement, cr.ranked_why);
+    const bool two_sided = effect_of(cr).two_sided;
+    const std::string screen = fmt::format("explains {:.0f} % of the residual ({:.0f} % {}, {:.0f} % {}; agreement {:.2f}; {})", 100 * cr.explained,
+                                           100 * cr.explained_start, two_sided ? "a step below its value" : "at its start", 100 * cr.explained_stronger,
+                                           two_sided ? "a step above" : "at twice the step", cr.agreement, cr.ranked_why);
     cr.words = cr.confirmed ? fmt::format("{}: {}; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).", cr.name, screen,
                                           cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
                             : fmt::format("{}: {} (signature only, not confirmed).", cr.name, screen);

@@ -47,6 +47,10 @@ struct EffectCandidate {
   /// calibration too. Empty when there is none (a clump of aspect ratio 1 is two coincident
   /// spheres, not the model's sphere).
   std::map<std::string, double> unchanged;
+  /// `start` and `stronger` lie on either side of `unchanged`, the same step from it: a guessed
+  /// value that may be off either way (a wall parameter), not an effect switched on from nothing.
+  /// Its two signatures agree when they are opposite.
+  bool two_sided = false;
 };
 
 /// The candidates the model does not yet use: every effect of the table that declares itself a
