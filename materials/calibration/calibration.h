@@ -416,6 +416,9 @@ struct CandidateResult {
   int simulations = 0;               ///< how many signature simulations `cost` is the time of
   std::string ranked_why;            ///< why it stands where it is in the ranking
   bool confirmed = false;
+  /// Confirmed past the budget without the refinement round its surrogate's miss asked for: its
+  /// chi^2 is an upper bound, and as a rival it counts at the surrogate's prediction when lower.
+  bool unrefined = false;
   CalibrationResult fit;             ///< when confirmed
   double chi2 = 0, bic = 0, delta_bic = 0;  ///< confirmed: after recalibration; delta = base BIC - this BIC
   int k = 0;                         ///< fitted parameters

@@ -176,7 +176,14 @@ void DiagnosisRun::confirm(CandidateResult& cr, const CalibrationOptions& option
     if (done.confirmed)
       confirming.no_rival_above_chi2 = std::min(confirming.no_rival_above_chi2,
                                                 done.bic + 2 * options_.rival_margin - cr.k * std::log(static_cast<double>(std::max(n_, 1))));
-  if (options_.progress) options_.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters)", cr.name, params.size()));
+  // Past the budget, a runner-up gets no refinement round: its confirmed chi^2 is then an upper
+  // bound, and the verdict counts it as a rival at its surrogate's prediction (write_verdict).
+  // Rejected: refining every confirmation, which took a diagnosis with a guessed liner friction
+  // fitted (four parameters a confirmation) from a plan of 22 minutes past 45.
+  const bool first_confirmed = std::none_of(d_.candidates.begin(), d_.candidates.end(), [](const CandidateResult& c) { return c.confirmed; });
+  if (!first_confirmed && budgeted() && count_.elapsed() >= given_.budget_seconds - full_size_reserve_) confirming.refine_rounds = 0, cr.unrefined = true;
+  if (options_.progress) options_.progress(fmt::format("diagnose: confirming {} (recalibrating {} parameters{})", cr.name, params.size(),
+                                                       cr.unrefined ? "; the budget is spent: without a refinement round" : ""));
   cr.fit = calibrate(with, measured_, params, confirming, &at_start_.at(cr.name), earlier);
   cr.confirmed = true;
   cr.chi2 = cr.fit.after.chi2;

@@ -69,9 +69,16 @@ void DiagnosisRun::write_verdict() {
   d_.best = best->name;
   const double line = noise_line(options_, best->fit.after.n, best->k);
   const bool fits = best->fit.after.chi2_per_n() <= line;
+  // A runner-up confirmed without its refinement round (CandidateResult::unrefined) is a rival at
+  // the better of its simulations and its surrogate's prediction: it is never ruled out on a fit
+  // the budget cut short.
+  const auto rival_bic = [&](const CandidateResult& c) {
+    return c.unrefined ? bic(std::min(c.chi2, c.fit.surrogate_chi2), c.k, c.fit.after.n) : c.bic;
+  };
   std::vector<const CandidateResult*> rivals;
   for (const CandidateResult& c : d_.candidates)
-    if (&c != best && c.confirmed && c.delta_bic > options_.bic_margin && c.bic - best->bic < options_.bic_margin) rivals.push_back(&c);
+    if (&c != best && c.confirmed && d_.base_bic - rival_bic(c) > options_.bic_margin && rival_bic(c) - best->bic < options_.bic_margin)
+      rivals.push_back(&c);
   std::vector<std::string> misfits;  // which patterns the effect answers
   for (const Pattern& p : d_.base.after.patterns)
     if (p.kind != "fits") misfits.push_back(p.words);
@@ -169,8 +176,12 @@ void DiagnosisRun::describe_candidates() {
     const std::string screen = fmt::format("explains {:.0f} % of the residual ({:.0f} % {}, {:.0f} % {}; agreement {:.2f}; {})", 100 * cr.explained,
                                            100 * cr.explained_start, two_sided ? "a step below its value" : "at its start", 100 * cr.explained_stronger,
                                            two_sided ? "a step above" : "at twice the step", cr.agreement, cr.ranked_why);
-    cr.words = cr.confirmed ? fmt::format("{}: {}; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).", cr.name, screen,
-                                          cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic)
+    const std::string unrefined =
+        cr.unrefined ? fmt::format(" Not refined, the budget being spent: its surrogate predicts chi^2/n {:.2f}, and as a rival it counts at the better of the two.",
+                                   cr.fit.surrogate_chi2 / std::max(1, cr.fit.after.n))
+                     : "";
+    cr.words = cr.confirmed ? fmt::format("{}: {}; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).{}", cr.name, screen,
+                                          cr.fit.after.chi2_per_n(), cr.bic, -cr.delta_bic, unrefined)
                             : fmt::format("{}: {} (signature only, not confirmed).", cr.name, screen);
   }
 }
