@@ -129,16 +129,22 @@ TEST(Diagnose, AnalyticHiddenLiquidBridgesAreNamedFirst) {
   EXPECT_TRUE(d.rivals.empty()) << "a yield locus at three stresses tells an offset (bridges) from a steeper slope";
 }
 
+/// A heap angle and a bulk density of `truth`, measured by `sim`: two numbers that any effect, with
+/// friction, fits exactly.
+MeasurementSet heap_and_density_of(const MaterialModel& truth, const Simulator& sim) {
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
+  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
+  return synthesise(set, truth, sim, 5);
+}
+
 TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
   // Truth: liquid bridges. Measured: a heap angle and a bulk density only. Friction cannot move
   // both as the bridges did, but any effect that moves them in another direction, with friction,
   // fits two numbers exactly: the runner-up is as good, and the diagnosis must say so.
   const Analytic sim;
   const MaterialModel start = dry_spheres(), truth = wet_spheres(0.03);
-  MeasurementSet set;
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  set = synthesise(set, truth, sim, 5);
+  const MeasurementSet set = heap_and_density_of(truth, sim);
   const Diagnosis d = diagnose(start, set, {}, analytic_options(sim));
   for (const std::string& w : d.words) std::printf("%s\n", w.c_str());
   for (const CandidateResult& c : d.candidates) std::printf("  %s\n", c.words.c_str());
@@ -175,11 +181,8 @@ TEST(Diagnose, AnalyticRivalsTheDataCannotTellApartAreNamed) {
 // simulations and its surrogate's prediction), never ruled out on a fit the budget cut short.
 TEST(Diagnose, ARunnerUpConfirmedPastTheBudgetIsNotRefinedAndStaysARival) {
   const Analytic sim;
-  const MaterialModel start = dry_spheres(), truth = wet_spheres(0.03);
-  MeasurementSet set;
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 1.0);
-  add(set, "density", "bulk_density", {{"cup_diameter", 0.1}}, "bulk_density", 10);
-  set = synthesise(set, truth, sim, 5);
+  const MaterialModel start = dry_spheres();
+  const MeasurementSet set = heap_and_density_of(wet_spheres(0.03), sim);
   CalibrationOptions options = analytic_options(sim);
   options.budget_seconds = 1e-3;
   options.screen_margin = 0.2;  // the screen's shares (74 %, 62 %, 62 %, 59 %) within it: tied, each confirmed whatever the budget
