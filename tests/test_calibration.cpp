@@ -684,6 +684,52 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
   EXPECT_EQ(within.after.chi2, refined.after.chi2);
 }
 
+// A refinement round that would end past its deadline (a diagnosis's budget, for a runner-up) is
+// not run: the first round's optimum stands, the result says so and is marked unrefined, and the
+// surrogate's prediction stays beside the simulations for the verdict (write_verdict).
+TEST(Calibration, ARefinementRoundPastItsDeadlineIsNotRun) {
+  const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions&) {
+    const double mu = get_parameter(m, "friction");
+    SimulatedOutcome out;
+    if (s.test == "angle_of_repose_cylinder") out.observables["angle_deg"] = 20 + 12 * std::tanh((mu - 0.45) / 0.05);
+    else out.observables["dynamic_angle_deg"] = 25 + 4 * std::tanh((mu - 0.45) / 0.05);
+    return out;
+  };
+  MeasurementSet set;
+  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 0.5);
+  add(set, "drum", "rotating_drum", {{"rpm", 20}}, "dynamic_angle_deg", 0.5);
+  MaterialModel truth = dry_spheres();
+  set_parameter(truth, "friction", 0.5);
+  for (Experiment& e : set.experiments)
+    for (auto& [key, obs] : e.observed) obs.value = sim(truth, e.setup, TestOptions{}).observables.at(key);
+  CalibrationOptions o = analytic_options(sim);
+  o.replicas = 2, o.rounds = 1, o.design_factor = 0.5;
+  o.refine_deadline = 3600;  // an hour away: refined
+  const CalibrationResult refined = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  ASSERT_TRUE(std::any_of(refined.words.begin(), refined.words.end(), [](const std::string& w) { return w.starts_with("One more surrogate round"); }));
+  EXPECT_FALSE(refined.unrefined);
+  o.refine_deadline = 0;  // already past
+  const CalibrationResult cut = calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), o);
+  EXPECT_TRUE(cut.unrefined);
+  EXPECT_TRUE(std::none_of(cut.words.begin(), cut.words.end(), [](const std::string& w) { return w.starts_with("One more surrogate round"); }));
+  EXPECT_TRUE(std::any_of(cut.words.begin(), cut.words.end(), [](const std::string& w) { return w.find("would end past the budget") != std::string::npos; }));
+  EXPECT_GT(cut.after.chi2, 2 * refined.after.chi2) << "the round not run is the one that found the optimum";
+  // Simulations that say they took 10 s each (2 experiments, one at a time): a refinement round of
+  // 4 points and its 2-packing comparison is counted at 2 min. A deadline 1 min away cuts it, one
+  // an hour away does not.
+  const Simulator timed = [&](const MaterialModel& m, const TestSetup& s, const TestOptions& t) {
+    SimulatedOutcome out = sim(m, s, t);
+    out.wall_seconds = 10;
+    return out;
+  };
+  CalibrationOptions slow = analytic_options(timed);
+  slow.replicas = 2, slow.rounds = 1, slow.design_factor = 0.5;
+  slow.refine_deadline = 60;
+  EXPECT_TRUE(calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), slow).unrefined) << "2 min of refinement before a deadline 1 min away";
+  slow.refine_deadline = 3600;
+  EXPECT_FALSE(calibrate(dry_spheres(), set, fit_parameters(dry_spheres(), {"friction"}), slow).unrefined);
+}
+
 // The first stage of a calibration: the drops on the steel plate settle the particle-steel
 // restitution before the bulk fit, so the guessed wall value neither misfits the drops nor is
 // left to the diagnosis; a measured wall restitution is an input and is not fitted.

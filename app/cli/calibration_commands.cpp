@@ -1,6 +1,7 @@
 #include "cli/calibration_commands.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <omp.h>
 
@@ -386,7 +387,9 @@ void CalibrationCommands::record_diagnosis(Campaign& campaign) {
   for (LedgerEntry& e : entries)
     if (!diagnosis.best.empty() && e.label == "+ " + diagnosis.best) judged = &e;
   judged->verdict = verdict_words(diagnosis.grade) + (diagnosis.best.empty() ? "" : ": " + diagnosis.best) +
-                    (diagnosis.confirm_next.empty() ? "" : "; confirm next: " + diagnosis.confirm_next);
+                    (diagnosis.confirm_next.empty() ? "" : "; confirm next: " + diagnosis.confirm_next) +
+                    (diagnosis.rivals.empty() ? "" : "; rivals: " + fmt::format("{}", fmt::join(diagnosis.rivals, ","))) +
+                    (diagnosis.unconfirmed_rivals.empty() ? "" : "; not ruled out, not recalibrated: " + fmt::format("{}", fmt::join(diagnosis.unconfirmed_rivals, ",")));
   std::cout << "verdict: " << judged->verdict << "\n";
   campaign.input.ledger = append_ledger(campaign.ledger_path, campaign.model.name, entries);
 }

@@ -318,9 +318,10 @@ struct Fit {
   int p;                                        ///< parameters fitted
   int points;                                   ///< design points of the first round
   int rounds;                                   ///< surrogate rounds before any refinement
-  /// Design points of a zoom or refinement round: the full rule where the first round's design
-  /// stood beside known points (confirmation_design_points), which a smaller box mostly leaves out.
+  /// Design points of a zoom round: the full rule where the first round's design stood beside
+  /// known points (confirmation_design_points), which a smaller box mostly leaves out.
   int later_points;
+  int refine_points;                            ///< of a refinement round, its box's earlier points included (refinement_design_points)
 };
 
 /// The surrogate rounds' state: the box searched, its optimum, and every point simulated so far.
@@ -330,6 +331,7 @@ struct Search {
   Surrogate full_range;                    ///< of round 1, over the whole parameter box: drawn in the contour maps
   Eigen::MatrixXd all_points, all_values;  ///< (points simulated x p), (points simulated x terms)
   std::vector<Eigen::VectorXd> included;   ///< points the first round takes from EarlierPoints::include
+  double seconds_per_point = 0;            ///< [s] what a point (every experiment once) takes: the refinement's estimate
   void add_point(const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
     all_points.conservativeResize(all_points.rows() + 1, Eigen::NoChange);
     all_values.conservativeResize(all_values.rows() + 1, Eigen::NoChange);
@@ -500,8 +502,8 @@ std::vector<Eigen::VectorXd> included_points(const Fit& fit, const EarlierPoints
 
 /// The round's design points (points x p): a Latin hypercube in the box, and in the first round
 /// the points included from earlier simulations.
-Eigen::MatrixXd round_design(const Fit& fit, const Search& search, int round) {
-  const int points = round == 0 ? fit.points : fit.later_points;
+Eigen::MatrixXd round_design(const Fit& fit, const Search& search, int round, int later_points) {
+  const int points = round == 0 ? fit.points : later_points;
   const int own = round == 0 ? points - static_cast<int>(search.included.size()) : points;
   Eigen::MatrixXd design(points, fit.p);
   design.topRows(own) = latin_hypercube(search.box, own, fit.options.seed + 7919u * static_cast<std::uint64_t>(round));
@@ -604,8 +606,8 @@ void optimise_round(const Fit& fit, const Eigen::MatrixXd& P, int round, Search&
 /// random numbers: the same packing seed everywhere); the surrogate over every point simulated so
 /// far inside the box; its optimum from several starts. A point whose simulation fails is
 /// skipped; bad input (CaseError) stops the calibration.
-void design_round(const Fit& fit, int round, Search& search, Progress& progress, CalibrationResult& result) {
-  const Eigen::MatrixXd design = round_design(fit, search, round);
+void design_round(const Fit& fit, int round, Search& search, Progress& progress, CalibrationResult& result, int later_points) {
+  const Eigen::MatrixXd design = round_design(fit, search, round, later_points);
   simulate_design(fit, design, round, search, progress, result);
   const Eigen::MatrixXd P = fit_round_surrogate(fit, round, search, result);
   optimise_round(fit, P, round, search, result);
@@ -615,7 +617,7 @@ void design_round(const Fit& fit, int round, Search& search, Progress& progress,
 void run_rounds(const Fit& fit, Search& search, Progress& progress, CalibrationResult& result) {
   for (int round = 0; round < fit.rounds; ++round) {
     if (round > 0) search.box = zoom(fit.parameters, search.x_best, fit.parameters, 0.25);  // a quarter of each range around the last optimum
-    design_round(fit, round, search, progress, result);
+    design_round(fit, round, search, progress, result, fit.later_points);
   }
 }
 
@@ -649,12 +651,43 @@ std::vector<std::string> edges_reached(const Fit& fit, const Search& search) {
   return edges;
 }
 
+/// Points simulated so far that lie inside `box`.
+int points_inside(const Search& search, const std::vector<FitParameter>& box) {
+  int inside = 0;
+  for (Eigen::Index r = 0; r < search.all_points.rows(); ++r) {
+    bool in = true;
+    for (size_t i = 0; i < box.size(); ++i) {
+      const double x = search.all_points(r, static_cast<Eigen::Index>(i));
+      in = in && x >= box[i].min - 1e-12 && x <= box[i].max + 1e-12;
+    }
+    inside += in ? 1 : 0;
+  }
+  return inside;
+}
+
+/// Design points of a refinement round in `box`: its rule's (refinement_design_points), and never
+/// fewer than the surrogate needs beside the points already inside the box.
+int refinement_points(const Fit& fit, const Search& search, const std::vector<FitParameter>& box) {
+  return std::max(fit.refine_points, basis_size(fit.p) + 1 - points_inside(search, box));
+}
+
 /// The point simulated so far whose simulations lie nearest the measurements (the optimum when none was).
 Eigen::VectorXd best_simulated(const Fit& fit, const Search& search) {
   int best_row = 0;
   for (int r = 1; r < search.all_points.rows(); ++r)
     if (simulated_chi2(fit.targets, search, r) < simulated_chi2(fit.targets, search, best_row)) best_row = r;
   return search.all_points.rows() > 0 ? Eigen::VectorXd(search.all_points.row(best_row).transpose()) : search.x_best;
+}
+
+/// What a point of a later round takes (every experiment once, `parallel` at a time): the larger of
+/// the start comparison's cost and the rounds' own time over the points they simulated, so that
+/// points replayed from the store do not make a round look free.
+double seconds_per_point(const Fit& fit, const Search& search, const Comparison& start, double rounds_seconds) {
+  double from_start = 0;
+  for (const ExperimentRun& run : start.runs) from_start += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
+  from_start /= std::max(1, fit.options.parallel);
+  const int simulated = fit.points - static_cast<int>(search.included.size()) + (fit.rounds - 1) * fit.later_points + std::max(1, fit.options.replicas);
+  return std::max(from_start, rounds_seconds / std::max(1, simulated));
 }
 
 /// Refinement: when the simulations miss what the surrogate predicted, or the optimum lies on an
@@ -677,17 +710,29 @@ void refine_around_best(const Fit& fit, Search& search, Progress& progress, Cali
     const Eigen::VectorXd centre = best_simulated(fit, search);
     const std::string why = missed ? fmt::format("the simulations at the surrogate's optimum give chi^2/n {:.2f} where it predicted {:.2f}", real, predicted)
                                    : fmt::format("the optimum lies on the edge of the searched box in {}", join(edges));
+    const std::vector<FitParameter> box = missed ? zoom(fit.parameters, centre, search.box, 0.5) : zoom(fit.parameters, search.x_best, search.box, 1.0);
+    const int points = refinement_points(fit, search, box);
+    detail::CommandProgress& count = options.context->count;
+    const double takes = (points + std::max(1, options.replicas)) * search.seconds_per_point;
+    if (refine >= options.refine_before_deadline && count.elapsed() + takes > options.refine_deadline) {
+      result.unrefined = true;
+      result.words.push_back(fmt::format("Not refined: {}, but one more round ({} points, about {}) would end past the budget; the surrogate's "
+                                         "prediction stands beside the simulations.",
+                                         why, points, detail::duration_text(takes)));
+      if (options.progress) options.progress("calibrate: " + result.words.back());
+      break;
+    }
     const Comparison kept_after = result.after;
     const Surrogate kept_surrogate = result.surrogate;
     const Eigen::VectorXd kept_x = search.x_best;
     const double kept_chi2 = result.surrogate_chi2;
-    search.box = missed ? zoom(fit.parameters, centre, search.box, 0.5) : zoom(fit.parameters, search.x_best, search.box, 1.0);
-    if (options.progress) options.progress(fmt::format("calibrate: {}: one more round around the best point simulated so far", why));
+    search.box = box;
+    if (options.progress) options.progress(fmt::format("calibrate: {}: one more round of {} points around the best point simulated so far", why, points));
     const int n_experiments = static_cast<int>(fit.measured.experiments.size());
-    for (const Experiment& e : fit.measured.experiments) progress.plan(e, fit.later_points);
-    if (detail::CommandProgress& count = options.context->count; count.active()) count.plan_more(n_experiments * (fit.later_points + std::max(1, options.replicas)));
+    for (const Experiment& e : fit.measured.experiments) progress.plan(e, points);
+    if (count.active()) count.plan_more(n_experiments * (points + std::max(1, options.replicas)));
     search.x_best = centre;
-    design_round(fit, fit.rounds + refine, search, progress, result);
+    design_round(fit, fit.rounds + refine, search, progress, result, points);
     result.after = confirm_optimum(fit, search, result);
     if (result.after.chi2 <= kept_after.chi2) {
       result.words.push_back(fmt::format("One more surrogate round: {}; refined, the simulations give chi^2/n {:.2f}.", why, result.after.chi2_per_n()));
@@ -832,13 +877,15 @@ CalibrationResult calibrate(const MaterialModel& given_model, const MeasurementS
   CalibrationOptions full_rule = options;
   if (!earlier.known.empty()) full_rule.design_points = 0;
   const Fit fit{walls.first.model, measured, parameters, options, targets, p, detail::design_points(options, p), std::max(1, options.rounds),
-                detail::design_points(full_rule, p)};
+                detail::design_points(full_rule, p), detail::refinement_design_points(full_rule, p)};
   Progress progress{options, "design"};
   Search search = start_search(fit, result.start, progress);
   feed_known_points(fit, earlier, walls.moved, search, result);
   search.included = included_points(fit, earlier);
+  const Clock::time_point rounds_began = Clock::now();
   run_rounds(fit, search, progress, result);
   result.after = confirm_optimum(fit, search, result);
+  search.seconds_per_point = seconds_per_point(fit, search, result.before, seconds_since(rounds_began));
   refine_around_best(fit, search, progress, result);
   keep_optimum(fit, search.x_best, result);
   estimate_uncertainty(fit, search.x_best, result);

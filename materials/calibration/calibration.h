@@ -137,6 +137,19 @@ struct CalibrationOptions {
   /// lies above it too) and no packings beyond `replicas` in its comparisons (compare()).
   /// Infinity: refine and add packings as above.
   double no_rival_above_chi2 = std::numeric_limits<double>::infinity();
+  /// [s on the outermost command's clock (CommandContext)] A refinement round starts only when
+  /// it would end before this, at what the calibration's own first round cost a simulation; a
+  /// round not started is said, and CalibrationResult::unrefined set. A diagnosis sets it for a
+  /// runner-up the screen could rank. Infinity: refine whenever asked.
+  double refine_deadline = std::numeric_limits<double>::infinity();
+  int refine_before_deadline = 0;  ///< refinement rounds run whatever refine_deadline says (the first ones)
+  /// Design factor of a refinement round when below design_factor; 0: design_factor. A diagnosis
+  /// gives its runners-up 1 (the quadratic's coefficients and two more): a runner-up's fit only
+  /// has to show whether it rivals the leader's. Rejected for the leading confirmation: with
+  /// design factor 1 (14 and 16 points for four parameters against 32), epsd on LIGGGHTS rolling
+  /// resistance with a guessed liner friction stayed at chi^2/n 2.74 and 2.25 where 32 points
+  /// reached 0.93.
+  double refine_design_factor = 0;
   int starts = 8;               ///< NLopt starts (best design points and the centre)
   double outcome_residual = 3.0;    ///< [sigma] residual of a mismatched outcome
   double fits_within_noise = 1.5;   ///< chi^2/n at or below which a model fits within the noise
@@ -353,6 +366,9 @@ struct CalibrationResult {
   std::vector<SimulatedPoint> points;
   int simulations = 0;
   double wall_seconds = 0;
+  /// A refinement round was asked for (the simulations missed the surrogate, or the optimum lay
+  /// on an edge of its box) and not run: it would have ended past refine_deadline.
+  bool unrefined = false;
 };
 
 /// What a calibration may take from simulations made before it (a diagnosis's).
@@ -416,8 +432,9 @@ struct CandidateResult {
   int simulations = 0;               ///< how many signature simulations `cost` is the time of
   std::string ranked_why;            ///< why it stands where it is in the ranking
   bool confirmed = false;
-  /// Confirmed past the budget without the refinement round its surrogate's miss asked for: its
-  /// chi^2 is an upper bound, and as a rival it counts at the surrogate's prediction when lower.
+  /// Confirmed without the refinement round its surrogate's miss asked for, which would have ended
+  /// past the budget: its chi^2 is an upper bound, and as a rival it counts at the surrogate's
+  /// prediction when lower.
   bool unrefined = false;
   CalibrationResult fit;             ///< when confirmed
   double chi2 = 0, bic = 0, delta_bic = 0;  ///< confirmed: after recalibration; delta = base BIC - this BIC
@@ -460,6 +477,9 @@ struct Diagnosis {
   std::vector<std::string> unexplained;     ///< improves: the terms the best model still misses by more than 2 sigma
   std::string confirm_next;                 ///< improves: the unconfirmed candidate to recalibrate next ("" for none)
   std::vector<std::string> rivals;          ///< confirmed candidates the data cannot tell from the recommended one
+  /// Candidates not recalibrated that the data do not rule out against the recommended one: the
+  /// grade is then cannot_tell, with the command that confirms them.
+  std::vector<std::string> unconfirmed_rivals;
   /// Per rival: the experiments that would tell it from the recommended candidate, best first.
   std::map<std::string, std::vector<Separator>> separators;
   std::vector<std::string> words;

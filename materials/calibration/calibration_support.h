@@ -198,6 +198,17 @@ inline int confirmation_design_points(const CalibrationOptions& o, int k, int ad
   return std::min(design_points(o, k), std::max(design_points_beside_known(k, added), static_cast<int>(std::ceil(o.design_factor * open)) + 2));
 }
 
+/// Design points of a refinement round fitting `k` parameters (refine_around_best): a
+/// design_points given, else those of its design factor (CalibrationOptions::refine_design_factor).
+inline int refinement_design_points(const CalibrationOptions& o, int k) {
+  CalibrationOptions refining = o;
+  if (o.refine_design_factor > 0) refining.design_factor = std::min(o.design_factor, o.refine_design_factor);
+  return design_points(refining, k);
+}
+
+/// Passes over the experiments of a refinement round and its confirming comparison.
+inline int refinement_passes(const CalibrationOptions& o, int k) { return refinement_design_points(o, k) + std::max(1, o.replicas); }
+
 /// Passes over the experiments (a simulation of each) that a calibration of `p` parameters
 /// makes after its first comparison: the design rounds and the confirming comparison.
 inline int calibration_passes(const CalibrationOptions& o, int p) { return std::max(1, o.rounds) * design_points(o, p) + std::max(1, o.replicas); }

@@ -79,6 +79,18 @@ void DiagnosisRun::write_verdict() {
   for (const CandidateResult& c : d_.candidates)
     if (&c != best && c.confirmed && d_.base_bic - rival_bic(c) > options_.bic_margin && rival_bic(c) - best->bic < options_.bic_margin)
       rivals.push_back(&c);
+  // An effect not recalibrated is not ruled out when it would fit with as many parameters as the
+  // data have terms (any effect then may, with the fitted parameters), or when the screen put it
+  // within the BIC margin of the best (the screen's estimates compared with each other: a
+  // recalibration lowers chi^2 far below the linear screen's estimate).
+  const int n = best->fit.after.n;
+  const auto exact = [&](const CandidateResult& c) { return n <= c.k; };
+  const double best_screened = bic(best->screen_chi2, best->k, n);
+  std::vector<const CandidateResult*> unconfirmed;
+  for (const CandidateResult& c : d_.candidates)
+    if (!c.confirmed && c.kind != "parameter" && c.explained >= 0.05 &&
+        (exact(c) || bic(c.screen_chi2, c.k, n) - best_screened < options_.bic_margin))
+      unconfirmed.push_back(&c);
   std::vector<std::string> misfits;  // which patterns the effect answers
   for (const Pattern& p : d_.base.after.patterns)
     if (p.kind != "fits") misfits.push_back(p.words);
@@ -101,12 +113,25 @@ void DiagnosisRun::write_verdict() {
                                             : fmt::format("Confirm next: {} (demdesign diagnose MATERIAL MEASUREMENTS --effects {}).", d_.confirm_next,
                                                           d_.confirm_next)));
   } else {
-    d_.grade = rivals.empty() ? Verdict::missing : Verdict::cannot_tell;
+    const bool told_apart = rivals.empty() && unconfirmed.empty();
+    d_.grade = told_apart ? Verdict::missing : Verdict::cannot_tell;
     d_.recommended = best->name;
     say(fmt::format("{}: {} ({}; switch it on with `{}`). Why: {}. It could explain {:.0f} % of the weighted residual of the calibrated model; "
                     "added and recalibrated it fits within the noise (chi^2/n {:.2f} <= {:.2f}): {}, with {} more parameter{}).",
-                    rivals.empty() ? "Missing" : "Most likely missing, but not told apart", best->name, best->title, best->switch_on, best->why,
+                    told_apart ? "Missing" : "Most likely missing, but not told apart", best->name, best->title, best->switch_on, best->why,
                     100 * best->explained, best->fit.after.chi2_per_n(), line, gain, best->adds.size(), best->adds.size() == 1 ? "" : "s"));
+    if (!unconfirmed.empty()) {
+      std::vector<std::string> names{best->name}, each;
+      for (const CandidateResult* c : unconfirmed) {
+        d_.unconfirmed_rivals.push_back(c->name), names.push_back(c->name);
+        each.push_back(fmt::format("{} ({:.0f} %{}; {})", c->name, 100 * c->explained, c->stable ? "" : ", unstable",
+                                   exact(*c) ? fmt::format("{} fitted parameters for {} measured terms: it may fit them as well", c->k, n)
+                                             : fmt::format("the screen put it within the BIC margin of {}", best->name)));
+      }
+      say(fmt::format("Not ruled out, not recalibrated: {}. Confirm {} with `demdesign diagnose MATERIAL MEASUREMENTS --effects {}` (the simulations "
+                      "done are kept in the store).",
+                      join(each, "; "), unconfirmed.size() == 1 ? "it" : "them", join(names, ",")));
+    }
   }
   if (!misfits.empty()) say("Where the model without it fails: " + join(misfits, " "));
   for (const CandidateResult* rival : rivals) {
@@ -177,7 +202,8 @@ void DiagnosisRun::describe_candidates() {
                                            100 * cr.explained_start, two_sided ? "a step below its value" : "at its start", 100 * cr.explained_stronger,
                                            two_sided ? "a step above" : "at twice the step", cr.agreement, cr.ranked_why);
     const std::string unrefined =
-        cr.unrefined ? fmt::format(" Not refined, the budget being spent: its surrogate predicts chi^2/n {:.2f}, and as a rival it counts at the better of the two.",
+        cr.unrefined ? fmt::format(" A refinement round its surrogate asked for did not fit the budget: the surrogate predicts chi^2/n {:.2f}, and as a rival "
+                                   "it counts at the better of the two.",
                                    cr.fit.surrogate_chi2 / std::max(1, cr.fit.after.n))
                      : "";
     cr.words = cr.confirmed ? fmt::format("{}: {}; recalibrated chi^2/n = {:.2f}, BIC {:.1f} ({:+.1f} against the model as it is).{}", cr.name, screen,
