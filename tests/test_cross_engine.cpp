@@ -190,7 +190,10 @@ TEST(CrossEngine, LabFileRollingResistanceIsFound) {
 // the spheres leave none, the drum at 37 deg against 23, peaks of the locus about 1.6 times the
 // spheres'. The diagnosis names the shape (clump_shape), or says that rolling resistance explains
 // the data as well and names an experiment whose two predictions lie at least 3 sigma apart;
-// never another effect with the grade missing, and the model named fits.
+// never another effect with the grade missing, and the model named fits. Not yet met (2026-12-07,
+// 5400511, 1665 s): the screen put demdesign's clumps at LIGGGHTS' own aspect ratio at 5 %, and
+// cdt, confirmed, "improves, not explained" (chi^2/n 35.79 to 10.50; the shear peaks, the poured
+// density and the silo still off): no confident wrong name, but shape not found.
 TEST(CrossEngine, ShapeIsNamedOrTiedWithRollingResistance) {
   const CrossEngineRun run = diagnose_set("shape_multisphere");
   const Diagnosis& d = run.diagnosis;
