@@ -117,6 +117,15 @@ TEST(DirectShear, ClumpsArePlacedAndInterlock) {
               clumps.observables.at("peak_shear_stress"), static_cast<long long>(clumps.particles), clumps.wall_seconds);
   EXPECT_NEAR(clumps.observables.at("plate_normal_stress"), 1000, 0.05 * 1000);
   EXPECT_GT(clumps.observables.at("peak_shear_stress"), spheres);
+  // Each clump's mass counted once (every sphere of a clump carries the whole clump's mass for
+  // the integrator): a consolidated bed of frictional elongated grains at a solid fraction between
+  // 0.45 and 0.75 (loose to dense random packings of frictional spheres 0.55-0.64, of ellipsoids
+  // near aspect 2 up to about 0.7: Donev et al. 2004, Science 303:990). It reads 0.54
+  // (2026-12-07); counted once per sphere it read twice that, above 1.
+  const double fraction = clumps.observables.at("bulk_density") / 2500;
+  std::printf("  clumps' solid fraction %.3f\n", fraction);
+  EXPECT_GT(fraction, 0.45);
+  EXPECT_LT(fraction, 0.75);
 }
 
 TEST(DirectShear, MissingSetupKeyNamesIt) {

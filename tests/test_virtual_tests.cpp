@@ -427,6 +427,21 @@ TEST(RotatingDrum, ClumpsTooLongForTheLatticeArePouredAndTheBedIsSampled) {
   EXPECT_FALSE(flagged(out, "slipping"));
 }
 
+// Two-sphere clumps of aspect 1.5 through an orifice of five volume-equivalent diameters: they
+// discharge, and the mass that left is measured against the mass that was in the silo, each
+// clump counted once (counted once per sphere, at most half could ever leave: the test read
+// `blocked` after 43 % where LIGGGHTS' clumps flowed at 0.17 kg/s).
+TEST(HopperDischarge, ClumpsDischargeAndEachIsCountedOnce) {
+  MaterialModel m = beads(0.5, 0.0, 0.5, 0.005);
+  m.particle.youngs_modulus = 2e5;
+  set_parameter(m, "clump_aspect_ratio", 1.5);
+  const SimulatedOutcome out = run_virtual_test(
+      m, setup_of("hopper_discharge", {{"silo_diameter", 0.0625}, {"orifice_diameter", 0.025}, {"fill_height", 0.04}}, {{"wall", "steel"}}), {});
+  print("hopper_discharge, clumps of aspect 1.5", out);
+  EXPECT_FALSE(flagged(out, "blocked"));
+  EXPECT_GT(out.observables.at("mass_flow_rate"), 0.0);
+}
+
 // Hopper: W = C rho_b sqrt(g) (D0 - k d)^2.5 (Beverloo, Leniger & van de Velde 1961) with C in
 // 0.45-0.75 and k in 1-3 for frictional spheres (published 0.55-0.65, 1.3-2.9; Nedderman 1992),
 // bulk density measured by the bulk_density test; an orifice of 2.5 diameters arches (blocked).

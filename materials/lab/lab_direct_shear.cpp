@@ -336,10 +336,9 @@ bool hold(const ShearPlan& plan, Run& run, double target, double max_time) {
 void start_run(const ShearPlan& plan, Run& run, SimulatedOutcome& out) {
   run.start(phase_case(plan, plan.preshear, plan.servo_speed, 0.0));
   std::int64_t free_count = 0;
-  double free_mass = 0;
-  for (size_t p = 0; p < run.state.size(); ++p)
-    if (run.state.attached[p] < 0) ++free_count, free_mass += 1.0 / run.state.inv_mass[p] / plan.mass_scaling;
-  run.free_count = free_count, run.free_mass = free_mass;
+  for (size_t p = 0; p < run.state.size(); ++p) free_count += run.state.attached[p] < 0 ? 1 : 0;
+  run.free_count = free_count;
+  run.free_mass = detail::mass_of_spheres(run.state, [&](std::size_t p) { return run.state.attached[p] < 0; }) / plan.mass_scaling;
   out.particles = static_cast<std::int64_t>(run.state.size());
   run.dt = run.model.dt;
 }

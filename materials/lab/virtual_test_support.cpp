@@ -273,10 +273,21 @@ double Runner::mean_speed(const std::function<bool(std::size_t)>& keep) const {
   return n ? sum / static_cast<double>(n) : 0.0;
 }
 
-double Runner::particle_mass() const {
+double mass_of_spheres(const State& state, const std::function<bool(std::size_t)>& counted) {
+  std::vector<int> members(state.bodies.size(), 0);
+  for (std::size_t p = 0; p < state.size(); ++p)
+    if (state.body[p] >= 0) ++members[static_cast<std::size_t>(state.body[p])];
   double m = 0;
-  for (std::size_t p = 0; p < state.size(); ++p) m += 1.0 / state.inv_mass[p];
+  for (std::size_t p = 0; p < state.size(); ++p) {
+    if (!counted(p)) continue;
+    const std::int32_t b = state.body[p];
+    m += b < 0 ? 1.0 / state.inv_mass[p] : state.bodies.mass[static_cast<std::size_t>(b)] / members[static_cast<std::size_t>(b)];
+  }
   return m;
+}
+
+double Runner::particle_mass() const {
+  return mass_of_spheres(state, [](std::size_t) { return true; });
 }
 
 std::pair<double, double> fit_line(const std::vector<double>& x, const std::vector<double>& y) {

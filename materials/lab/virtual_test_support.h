@@ -101,6 +101,12 @@ int segments_around(double r, double edge);
 
 /// A compiled case with its state, stepped by the tests. `restart` recompiles a phase-2 spec
 /// (same materials, walls and particles, a motion that starts now) and continues the state.
+/// [kg] The mass of the particles whose spheres `counted(p)` accepts: a free sphere's own, and a
+/// clump's shared equally among its spheres (each sphere of a clump carries the whole clump's
+/// mass for the integrator, State::attach, so a sum over spheres would count a clump once per
+/// sphere).
+double mass_of_spheres(const State& state, const std::function<bool(std::size_t)>& counted);
+
 struct Runner {
   Model model;
   State state;
