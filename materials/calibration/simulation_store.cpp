@@ -50,9 +50,10 @@ std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup
   // `meaning` counts changes of what the same inputs simulate within one version, so a stored
   // simulation of an older meaning is run again. 2: a wall that does not state a contact
   // parameter leaves it to the particles (before: mixed with the parameter's default). 3: the
-  // silo's floor an exact disc (before: facets). The lab tests' time-step rule is written out, so
-  // a change of it runs them again.
-  std::string out = fmt::format("engine: demdesign {}\nmeaning: 3\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
+  // silo's floor an exact disc (before: facets). 4: a clump's mass counted once in the direct
+  // shear's bulk density and the silo's initial mass (before: once per sphere). The lab tests'
+  // time-step rule is written out, so a change of it runs them again.
+  std::string out = fmt::format("engine: demdesign {}\nmeaning: 4\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
   for (const auto& [k, v] : setup.numbers) out += fmt::format("setup.{}: {}\n", k, number(v));
   for (const auto& [k, v] : setup.words) out += fmt::format("setup.{}: {}\n", k, v);
   out += fmt::format("time_step: {{rayleigh_fraction: {}, steps_per_contact: {}}}\n",
