@@ -643,10 +643,10 @@ TEST(Calibration, SurrogateFormsAreChosenByLeaveOneOutError) {
   EXPECT_NEAR(s.predict(Eigen::Vector2d(1.0, 1.0))[1], 1.0, 1e-9);
 }
 
-TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) {
-  // An angle that saturates within a narrow band of friction (a heap that stops forming below
-  // 0.4): four design points cannot draw it as a quadratic, and the surrogate's optimum, simulated,
-  // misses. One more round in half the box around the best point simulated so far finds it.
+/// An angle that saturates within a narrow band of friction (a heap that stops forming below
+/// 0.4), and a heap and a drum measured of friction 0.5: four design points cannot draw it as a
+/// quadratic, so the surrogate's optimum, simulated, misses.
+std::pair<Simulator, MeasurementSet> saturating_angles() {
   const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions&) {
     const double mu = get_parameter(m, "friction");
     SimulatedOutcome out;
@@ -661,6 +661,13 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
   set_parameter(truth, "friction", 0.5);
   for (Experiment& e : set.experiments)
     for (auto& [key, obs] : e.observed) obs.value = sim(truth, e.setup, TestOptions{}).observables.at(key);
+  return {sim, set};
+}
+
+TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) {
+  // One more round in half the box around the best point simulated so far finds the optimum the
+  // saturating angles hide from the first round.
+  const auto [sim, set] = saturating_angles();
   CalibrationOptions o = analytic_options(sim);
   o.replicas = 2, o.rounds = 1, o.design_factor = 0.5;
   o.refine_rounds = 0;
@@ -688,20 +695,7 @@ TEST(Calibration, AConfirmationThatMissesTheSurrogateRefinesAroundTheBestPoint) 
 // not run: the first round's optimum stands, the result says so and is marked unrefined, and the
 // surrogate's prediction stays beside the simulations for the verdict (write_verdict).
 TEST(Calibration, ARefinementRoundPastItsDeadlineIsNotRun) {
-  const Simulator sim = [](const MaterialModel& m, const TestSetup& s, const TestOptions&) {
-    const double mu = get_parameter(m, "friction");
-    SimulatedOutcome out;
-    if (s.test == "angle_of_repose_cylinder") out.observables["angle_deg"] = 20 + 12 * std::tanh((mu - 0.45) / 0.05);
-    else out.observables["dynamic_angle_deg"] = 25 + 4 * std::tanh((mu - 0.45) / 0.05);
-    return out;
-  };
-  MeasurementSet set;
-  add(set, "aor", "angle_of_repose_cylinder", {{"fill_height", 0.1}}, "angle_deg", 0.5);
-  add(set, "drum", "rotating_drum", {{"rpm", 20}}, "dynamic_angle_deg", 0.5);
-  MaterialModel truth = dry_spheres();
-  set_parameter(truth, "friction", 0.5);
-  for (Experiment& e : set.experiments)
-    for (auto& [key, obs] : e.observed) obs.value = sim(truth, e.setup, TestOptions{}).observables.at(key);
+  const auto [sim, set] = saturating_angles();
   CalibrationOptions o = analytic_options(sim);
   o.replicas = 2, o.rounds = 1, o.design_factor = 0.5;
   o.refine_deadline = 3600;  // an hour away: refined
