@@ -124,11 +124,14 @@ void expect_never_confidently_wrong(const CrossEngineRun& run, const std::vector
   EXPECT_GT(d.base.after.chi2_per_n(), 3.0) << "the plain model should fail visibly on these data";
   EXPECT_NE(d.grade, Verdict::nothing_missing);
   const auto is_right = [&](const std::string& name) { return std::find(right.begin(), right.end(), name) != right.end(); };
-  if (d.grade == Verdict::missing) EXPECT_TRUE(is_right(d.recommended)) << "Missing: " << d.recommended;
-  if (d.grade == Verdict::cannot_tell)
+  if (d.grade == Verdict::missing) {
+    EXPECT_TRUE(is_right(d.recommended)) << "Missing: " << d.recommended;
+  }
+  if (d.grade == Verdict::cannot_tell) {
     EXPECT_TRUE(is_right(d.recommended) || std::any_of(d.rivals.begin(), d.rivals.end(), is_right) ||
                 std::any_of(d.unconfirmed_rivals.begin(), d.unconfirmed_rivals.end(), is_right))
         << "cannot tell, recommended " << d.recommended;
+  }
 }
 
 // The sets with traits and an effect (glass_beads_6mm_traits_experiments.json): the beads on a liner as soft
