@@ -154,9 +154,7 @@ BudgetPlan fit_to_budget(const CalibrationOptions& options, double pass, double 
 BudgetPlan plan_within_budget(const CalibrationOptions& options, const Comparison& first, int p, int effects, int walls, double spent) {
   // One pass: a simulation of every experiment, at the measured mean cost of each; passes run
   // `parallel` simulations at once.
-  double pass = 0;
-  for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
-  pass /= std::max(1, options.parallel);
+  const double pass = detail::seconds_per_pass(first, options.parallel);
   // A candidate's simulations counted at what they cost against the plain model's, as the plan
   // made again after the plain fit counts them (plan_screen_within_budget). Rejected: every pass
   // at the first comparison's cost, which planned 15 min where a lab file of 6 mm beads then took

@@ -321,7 +321,7 @@ struct Fit {
   /// Design points of a zoom round: the full rule where the first round's design stood beside
   /// known points (confirmation_design_points), which a smaller box mostly leaves out.
   int later_points;
-  int refine_points;                            ///< of a refinement round, its box's earlier points included (refinement_design_points)
+  int refine_points;                            ///< of a refinement round (refinement_design_points)
 };
 
 /// The surrogate rounds' state: the box searched, its optimum, and every point simulated so far.
@@ -557,16 +557,23 @@ void simulate_design(const Fit& fit, const Eigen::MatrixXd& design, int round, S
   }
 }
 
+/// The rows of the points simulated so far that lie inside `box`.
+std::vector<int> rows_inside(const Search& search, const std::vector<FitParameter>& box) {
+  std::vector<int> inside;
+  for (int k = 0; k < search.all_points.rows(); ++k) {
+    bool in = true;
+    for (int i = 0; i < static_cast<int>(box.size()); ++i)
+      in = in && search.all_points(k, i) >= box[i].min - 1e-12 && search.all_points(k, i) <= box[i].max + 1e-12;
+    if (in) inside.push_back(k);
+  }
+  return inside;
+}
+
 /// The surrogate over every point simulated so far inside the box; returns those points (inside x p).
 Eigen::MatrixXd fit_round_surrogate(const Fit& fit, int round, Search& search, CalibrationResult& result) {
   const int p = fit.p;
   const std::vector<FitParameter>& box = search.box;
-  std::vector<int> inside;
-  for (int k = 0; k < search.all_points.rows(); ++k) {
-    bool in = true;
-    for (int i = 0; i < p; ++i) in = in && search.all_points(k, i) >= box[i].min - 1e-12 && search.all_points(k, i) <= box[i].max + 1e-12;
-    if (in) inside.push_back(k);
-  }
+  const std::vector<int> inside = rows_inside(search, box);
   if (static_cast<int>(inside.size()) < basis_size(p))
     throw std::runtime_error(fmt::format("calibration: only {} of {} design points simulated; need {} for the surrogate", inside.size(), fit.points, basis_size(p)));
   Eigen::MatrixXd P(inside.size(), p), V(inside.size(), search.all_values.cols());
@@ -651,24 +658,10 @@ std::vector<std::string> edges_reached(const Fit& fit, const Search& search) {
   return edges;
 }
 
-/// Points simulated so far that lie inside `box`.
-int points_inside(const Search& search, const std::vector<FitParameter>& box) {
-  int inside = 0;
-  for (Eigen::Index r = 0; r < search.all_points.rows(); ++r) {
-    bool in = true;
-    for (size_t i = 0; i < box.size(); ++i) {
-      const double x = search.all_points(r, static_cast<Eigen::Index>(i));
-      in = in && x >= box[i].min - 1e-12 && x <= box[i].max + 1e-12;
-    }
-    inside += in ? 1 : 0;
-  }
-  return inside;
-}
-
 /// Design points of a refinement round in `box`: its rule's (refinement_design_points), and never
 /// fewer than the surrogate needs beside the points already inside the box.
 int refinement_points(const Fit& fit, const Search& search, const std::vector<FitParameter>& box) {
-  return std::max(fit.refine_points, basis_size(fit.p) + 1 - points_inside(search, box));
+  return std::max(fit.refine_points, basis_size(fit.p) + 1 - static_cast<int>(rows_inside(search, box).size()));
 }
 
 /// The point simulated so far whose simulations lie nearest the measurements (the optimum when none was).
@@ -683,9 +676,7 @@ Eigen::VectorXd best_simulated(const Fit& fit, const Search& search) {
 /// the start comparison's cost and the rounds' own time over the points they simulated, so that
 /// points replayed from the store do not make a round look free.
 double seconds_per_point(const Fit& fit, const Search& search, const Comparison& start, double rounds_seconds) {
-  double from_start = 0;
-  for (const ExperimentRun& run : start.runs) from_start += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
-  from_start /= std::max(1, fit.options.parallel);
+  const double from_start = detail::seconds_per_pass(start, fit.options.parallel);
   const int simulated = fit.points - static_cast<int>(search.included.size()) + (fit.rounds - 1) * fit.later_points + std::max(1, fit.options.replicas);
   return std::max(from_start, rounds_seconds / std::max(1, simulated));
 }

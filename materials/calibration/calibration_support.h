@@ -206,6 +206,14 @@ inline int refinement_design_points(const CalibrationOptions& o, int k) {
   return design_points(refining, k);
 }
 
+/// [s] One pass over the experiments (a simulation of each) at the mean cost a packing of
+/// `comparison`'s runs, `parallel` simulations at once.
+inline double seconds_per_pass(const Comparison& comparison, int parallel) {
+  double pass = 0;
+  for (const ExperimentRun& run : comparison.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
+  return pass / std::max(1, parallel);
+}
+
 /// Passes over the experiments of a refinement round and its confirming comparison.
 inline int refinement_passes(const CalibrationOptions& o, int k) { return refinement_design_points(o, k) + std::max(1, o.replicas); }
 

@@ -190,10 +190,10 @@ void DiagnosisRun::confirm(CandidateResult& cr, const CalibrationOptions& option
   // A runner-up the screen could rank gets no refinement round that would end past the budget:
   // its confirmed chi^2 is then an upper bound, and the verdict counts it as a rival at its
   // surrogate's prediction (write_verdict). One the screen cannot tell from the leader is refined
-  // as its surrogate asks. Rejected: refining every confirmation,
-  // which took a diagnosis with a guessed liner friction fitted (four parameters a confirmation)
-  // from a plan of 22 minutes past 45; and no refinement once the budget is spent, with which a
-  // runner-up begun before that refined 7 min past it.
+  // as its surrogate asks. Rejected: refining every confirmation, which took a diagnosis with a
+  // guessed liner friction fitted (four parameters a confirmation) from a plan of 22 minutes past
+  // 45; and no refinement once the budget is spent, with which a runner-up begun before that
+  // refined 7 min past it.
   // The first confirmed, on whose fit the verdict most often rests, refines once whatever the
   // budget and once more if its simulations still miss and the round fits the budget. Rejected:
   // one round, after which epsd on LIGGGHTS rolling resistance with a guessed liner friction

@@ -219,9 +219,7 @@ void DiagnosisRun::calibrate_as_it_is() {
   } else if (command_.outermost() && options_.progress) {
     // Without a budget the whole plan, at what the first comparison's simulations cost (a
     // candidate's at kScreenCost and kConfirmationCost times that).
-    double pass = 0;
-    for (const ExperimentRun& run : first.runs) pass += run.replicas > 0 ? run.wall_seconds / run.replicas : 0.0;
-    pass /= std::max(1, options_.parallel);
+    const double pass = detail::seconds_per_pass(first, options_.parallel);
     const double passes = detail::calibration_passes(options_, fitted_) +
                           detail::weighted_screen_and_confirmation_passes(options_, fitted_, lacking_, walls_, detail::kScreenCost, detail::kConfirmationCost);
     options_.progress(fmt::format("diagnose: the first comparison took {}; the whole diagnosis will take about {} more (give --budget to fit it "
