@@ -744,6 +744,10 @@ def fmt(v):
 TEMPLATE_SEEDS = {15485867, 32452843, 49979687, 67867967, 86028157}  # the particle templates' and distributions' (contact.in, drop_rebound.in): LIGGGHTS wants every seed distinct
 
 
+# Orientations a clump is dropped at (materials/lab/lab_drop_rebound.cpp, kClumpDrops).
+CLUMP_DROPS = 12
+
+
 def placement_seeds(first, count):
     """`count` placement seeds for LIGGGHTS (which wants primes above 10000, distinct from the
     templates' seeds): `first` and the primes after it."""
@@ -872,13 +876,17 @@ def main():
     rng = random.Random(args.noise_seed)
     results = {}
     total = 0.0
-    seeds = placement_seeds(args.seed, args.packings)
+    seeds = placement_seeds(args.seed, max(args.packings, CLUMP_DROPS if mat.clump else 1))
     try:
         for e in experiments:
             # A lab repeats a test and states the mean with its standard error; so does this file.
             # One sphere falls the same way whatever the placement seed: its drop runs once. A
-            # clump strikes at the orientation its seed gives, and rebounds accordingly.
-            count = 1 if e["test"] == "drop_rebound" and not mat.clump else args.packings
+            # clump strikes at the orientation its seed gives and rebounds accordingly (its
+            # tangential restitution spans 0.2 to 1 over orientations): CLUMP_DROPS of them, as
+            # demdesign's drop test averages a clump's.
+            count = args.packings
+            if e["test"] == "drop_rebound":
+                count = CLUMP_DROPS if mat.clump else 1
             packings = []
             for k in range(count):
                 folder = os.path.join(work, e["id"], f"packing_{k + 1}")
@@ -929,7 +937,8 @@ def main():
     header = (f"# Simulated with {version}, not measured: variant {mat.variant}, {mat.describe()}; "
               f"made {today} by calibration/liggghts/make_measurements.py; {noise}")
     comments = [
-        f"Material {os.path.basename(args.material)}, experiments {os.path.basename(args.experiments)}, placement seeds {', '.join(map(str, seeds))}.",
+        f"Material {os.path.basename(args.material)}, experiments {os.path.basename(args.experiments)}, placement seeds {', '.join(map(str, seeds[:args.packings]))}"
+        + (f" (a clump's drops: {CLUMP_DROPS} orientations, the seeds from {seeds[0]} on)." if mat.clump else "."),
         "Each value is the extraction rule of demdesign's virtual test applied to LIGGGHTS runs of the same",
         "protocol (calibration/liggghts/README.md says where the LIGGGHTS set-ups differ), averaged over the packings;",
         "each sigma is the stated instrument noise and the packings' standard error combined. Simulated, per packing, before noise:",

@@ -51,9 +51,10 @@ std::string simulation_inputs(const MaterialModel& model, const TestSetup& setup
   // simulation of an older meaning is run again. 2: a wall that does not state a contact
   // parameter leaves it to the particles (before: mixed with the parameter's default). 3: the
   // silo's floor an exact disc (before: facets). 4: a clump's mass counted once in the direct
-  // shear's bulk density and the silo's initial mass (before: once per sphere). The lab tests'
-  // time-step rule is written out, so a change of it runs them again.
-  std::string out = fmt::format("engine: demdesign {}\nmeaning: 4\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
+  // shear's bulk density and the silo's initial mass (before: once per sphere). 5: a clump's
+  // drop the mean of 12 orientations, and every drop started just above the plate (its fall is
+  // ballistic). The lab tests' time-step rule is written out, so a change of it runs them again.
+  std::string out = fmt::format("engine: demdesign {}\nmeaning: 5\ntest: {}\n", DEMDESIGN_VERSION, setup.test);
   for (const auto& [k, v] : setup.numbers) out += fmt::format("setup.{}: {}\n", k, number(v));
   for (const auto& [k, v] : setup.words) out += fmt::format("setup.{}: {}\n", k, v);
   out += fmt::format("time_step: {{rayleigh_fraction: {}, steps_per_contact: {}}}\n",
