@@ -91,7 +91,7 @@ void DiagnosisRun::confirm_leaders() {
 /// confirming one of two the screen cannot separate would name it on a coin toss. The result
 /// says by how much that exceeds the budget.
 void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, std::map<std::string, int>& design_points_of) {
-  if (!budgeted() || confirming.size() <= 1) return;
+  if (!budgeted() || confirming.empty()) return;
   const double left = given_.budget_seconds - count_.elapsed() - full_size_reserve_;
   std::vector<double> costs, per_simulation;
   std::vector<int> points;  // each confirmation's design points a round
@@ -122,11 +122,18 @@ void DiagnosisRun::fit_confirmations_to_budget(std::vector<size_t>& confirming, 
     for (size_t k = 0; k < costs.size(); ++k)
       if (std::isfinite(smaller[k])) costs[k] = smaller[k];
     std::vector<std::string> which;
-    for (const auto& [name, points] : fewer_points) which.push_back(fmt::format("{} {}", name, points));
+    for (const auto& [name, count] : fewer_points) which.push_back(fmt::format("{} {}", name, count));
     say(fmt::format("To fit the budget of {} with a tie, the confirmations design fewer points ({} a round, against {}): the plain "
                     "fit's points, where each candidate changes nothing, determine the rest of their surrogates.",
                     detail::duration_text(given_.budget_seconds), join(which), detail::design_points(options_, d_.candidates[confirming.front()].k)));
   }
+  // The leader is recalibrated whatever it costs: a diagnosis names no effect it has not
+  // recalibrated. Said before it runs, so that the overrun is no surprise.
+  if (costs.front() > left)
+    say(fmt::format("The budget of {} will be exceeded by about {}: {}, the leading candidate, is recalibrated whatever the budget "
+                    "(about {}, with {} left), since no effect is named that has not been.",
+                    detail::duration_text(given_.budget_seconds), detail::duration_text(costs.front() - std::max(left, 0.0)),
+                    d_.candidates[confirming.front()].name, detail::duration_text(costs.front()), detail::duration_text(std::max(left, 0.0))));
   std::vector<size_t> kept;
   std::vector<std::string> dropped, beyond;
   std::vector<std::string> each;  // the dropped ones with their costs
