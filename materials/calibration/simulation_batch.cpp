@@ -17,8 +17,10 @@
 #include <optional>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 #include "calibration/simulation_store.h"
+#include "statistics/steady_state.h"
 #include "statistics/diagnostics.h"
 
 namespace dem::materials {
@@ -123,11 +125,7 @@ void append_replica(ExperimentRun& run, const SimulatedOutcome& out, std::map<st
 void summarise(ExperimentRun& run, const std::map<std::string, int>& flags) {
   for (const auto& [key, list] : run.values) {
     const double n = static_cast<double>(list.size());
-    const double mean = std::accumulate(list.begin(), list.end(), 0.0) / n;
-    double ss = 0;
-    for (double v : list) ss += (v - mean) * (v - mean);
-    run.mean[key] = mean;
-    run.sigma[key] = list.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+    std::tie(run.mean[key], run.sigma[key]) = mean_and_standard_error(list);
     // Two replicas that happen to agree must not make the mean look surer than each run's own
     // extraction says: the standard error is at least that of the runs' errors, averaged.
     const auto e = run.extraction.find(key);

@@ -17,6 +17,7 @@
 #include <numbers>
 
 #include "lab/virtual_test_support.h"
+#include "statistics/steady_state.h"
 
 namespace dem::materials::detail {
 namespace {
@@ -108,21 +109,16 @@ SimulatedOutcome run_drop_rebound(const MaterialModel& model, const TestSetup& s
     list.push_back(drop_once(model, options, plate, height, angle_deg, options.seed * kClumpDrops + static_cast<std::uint64_t>(k), run));
 
   SimulatedOutcome out;
-  const auto mean_and_error = [&](auto value) {
-    double sum = 0, ss = 0;
-    for (const Drop& d : list) sum += value(d);
-    const double mean = sum / drops;
-    for (const Drop& d : list) ss += (value(d) - mean) * (value(d) - mean);
-    return std::pair{mean, drops > 1 ? std::sqrt(ss / (drops - 1) / drops) : 0.0};
+  // A clump's observables: the means of its drops, with their standard errors.
+  const auto put = [&](const std::string& key, double Drop::*value) {
+    std::vector<double> values;
+    for (const Drop& d : list) values.push_back(d.*value);
+    const auto [mean, error] = mean_and_standard_error(values);
+    out.observables[key] = mean;
+    if (drops > 1) out.uncertainty[key] = error;
   };
-  const auto [e, e_error] = mean_and_error([](const Drop& d) { return d.restitution; });
-  out.observables["restitution"] = e;
-  if (drops > 1) out.uncertainty["restitution"] = e_error;
-  if (angle_deg > 0) {
-    const auto [et, et_error] = mean_and_error([](const Drop& d) { return d.tangential; });
-    out.observables["tangential_restitution"] = et;
-    if (drops > 1) out.uncertainty["tangential_restitution"] = et_error;
-  }
+  put("restitution", &Drop::restitution);
+  if (angle_deg > 0) put("tangential_restitution", &Drop::tangential);
   out.notes.push_back(fmt::format("impact {:.3f} m/s normal, {:.3f} m/s tangential", -list[0].vz_before, list[0].vx_before));
   if (drops > 1) out.notes.push_back(fmt::format("a clump: {} orientations, their mean", drops));
   if (std::any_of(list.begin(), list.end(), [](const Drop& d) { return d.capped; })) out.notes.push_back("time cap reached before the rebound apex");

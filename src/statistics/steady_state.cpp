@@ -186,6 +186,15 @@ std::vector<double> rate_of(std::span<const double> t, std::span<const double> c
   return rate;
 }
 
+std::pair<double, double> mean_and_standard_error(std::span<const double> samples) {
+  const double n = static_cast<double>(samples.size());
+  double sum = 0, ss = 0;
+  for (double v : samples) sum += v;
+  const double mean = sum / n;
+  for (double v : samples) ss += (v - mean) * (v - mean);
+  return {mean, samples.size() > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0};
+}
+
 IntervalStats average_over(std::span<const double> t, std::span<const double> y, double t0, double t1) {
   IntervalStats s;
   const std::size_t n = std::min(t.size(), y.size());

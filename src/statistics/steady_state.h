@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dem {
@@ -52,6 +53,10 @@ struct IntervalStats {
   std::size_t samples = 0;
 };
 IntervalStats average_over(std::span<const double> t, std::span<const double> y, double t0, double t1);
+
+/// Mean of independent samples and its standard error sqrt(s^2 / n) (0 for one sample); the
+/// replicas of a simulation, the drops of a clump. Needs one sample.
+std::pair<double, double> mean_and_standard_error(std::span<const double> samples);
 
 /// Least-squares slope of y(t) over [begin, end) and its t statistic, computed on batch means
 /// (10 to 30 batches) so that correlated noise does not look significant.
